@@ -1,0 +1,80 @@
+//! Cost of the shader library on the host: composing every module into a cold naga_oil Composer,
+//! composing one user shader against a warm library, exporting it, and `lodkit check` of one small
+//! shader end to end (process start included).
+//!
+//! `cargo bench --bench compose`
+
+use std::hint::black_box;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use lodkit::shaders::{self, ComposeDescriptor, ExportOptions, ExportTarget, ShaderLibrary};
+
+const USER_SHADER: &str = "#import lodkit::normal_distance::foreshortened_normal_distance
+#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+
+@vertex
+fn vs(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
+
+@fragment
+fn fs(v: FullscreenVertex) -> @location(0) vec4<f32> {
+    return vec4<f32>(foreshortened_normal_distance(vec3(v.uv, 1.0), vec3(0.0, 0.0, 1.0)));
+}
+";
+
+fn compose(library: &mut ShaderLibrary) -> shaders::Composed {
+    library
+        .compose(&ComposeDescriptor {
+            source: USER_SHADER,
+            file_path: "user.wgsl",
+            ..Default::default()
+        })
+        .expect("composes")
+}
+
+fn benches(c: &mut Criterion) {
+    c.bench_function("library: cold composer + every module + one shader", |b| {
+        b.iter(|| {
+            let mut library = ShaderLibrary::new().expect("library");
+            black_box(compose(&mut library))
+        })
+    });
+    let mut library = ShaderLibrary::new().expect("library");
+    c.bench_function("compose one shader (warm library)", |b| {
+        b.iter(|| black_box(compose(&mut library)))
+    });
+    let composed = compose(&mut library);
+    c.bench_function("export SPIR-V", |b| {
+        b.iter(|| {
+            black_box(shaders::export(
+                &composed,
+                ExportTarget::SpirV,
+                &ExportOptions::default(),
+            ))
+        })
+    });
+    let dir = std::env::temp_dir().join(format!("lodkit-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("user.wgsl");
+    std::fs::write(&file, USER_SHADER).unwrap();
+    c.bench_function(
+        "`lodkit check` of one small shader (process wall time)",
+        |b| {
+            b.iter(|| {
+                let status = std::process::Command::new(env!("CARGO_BIN_EXE_lodkit"))
+                    .arg("check")
+                    .arg(&file)
+                    .stdout(std::process::Stdio::null())
+                    .status()
+                    .unwrap();
+                assert!(status.success());
+            })
+        },
+    );
+}
+
+criterion_group! {
+    name = compose_benches;
+    config = Criterion::default().sample_size(30);
+    targets = benches
+}
+criterion_main!(compose_benches);

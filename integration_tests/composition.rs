@@ -1,0 +1,417 @@
+//! Every module and pass of the library composes, validates, exports through every back end, and
+//! passes the independent tools (spirv-val, glslangValidator); the GLSL twins match the WGSL
+//! modules name for name.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use lodkit::shaders::{
+    self, ComposeDescriptor, Composed, ExportOptions, ExportTarget, Exported, Language, ModuleInfo,
+    ModuleKind, ShaderLibrary, SourceLanguage,
+};
+
+use crate::harness::{render, tool};
+
+fn wgsl_modules() -> impl Iterator<Item = &'static ModuleInfo> {
+    shaders::modules()
+        .iter()
+        .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
+}
+
+fn scratch(name: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "lodkit-test-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Splits a parameter list at top-level commas (generic arguments contain commas too).
+fn params(signature: &str) -> Vec<(String, String)> {
+    let open = signature.find('(').unwrap();
+    let close = signature.rfind(')').unwrap();
+    let (mut depth, mut start, mut out) = (0, open + 1, Vec::new());
+    let inner_end = close;
+    for (i, c) in signature.char_indices().take(inner_end).skip(open + 1) {
+        match c {
+            '<' | '(' => depth += 1,
+            '>' | ')' => depth -= 1,
+            ',' if depth == 0 => {
+                out.push(signature[start..i].to_owned());
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    out.push(signature[start..inner_end].to_owned());
+    out.into_iter()
+        .filter(|p| !p.trim().is_empty())
+        .map(|p| {
+            let (name, ty) = p.split_once(':').expect("typed parameter");
+            (name.trim().to_owned(), ty.trim().to_owned())
+        })
+        .collect()
+}
+
+/// A fragment shader that imports `module` and calls every function it exports with zero
+/// values (textures and samplers become bindings), so that every function reaches the back ends.
+fn wgsl_harness(module: &ModuleInfo) -> String {
+    let path = module.import_path.as_deref().unwrap();
+    let mut globals = String::new();
+    let mut calls = String::new();
+    for (i, f) in module.functions.iter().enumerate() {
+        let mut args = Vec::new();
+        for (j, (_, ty)) in params(&f.signature).into_iter().enumerate() {
+            if ty.starts_with("texture") || ty.starts_with("sampler") {
+                let binding = i * 8 + j;
+                globals.push_str(&format!(
+                    "@group(0) @binding({binding}) var g{binding}: {ty};\n"
+                ));
+                args.push(format!("g{binding}"));
+            } else if module.source.contains(&format!("struct {ty} ")) {
+                args.push(format!("{path}::{ty}()"));
+            } else {
+                args.push(format!("{ty}()"));
+            }
+        }
+        let call = format!("{path}::{}({})", f.name, args.join(", "));
+        if f.signature.contains("->") {
+            calls.push_str(&format!("    _ = {call};\n"));
+        } else {
+            calls.push_str(&format!("    {call};\n"));
+        }
+    }
+    format!(
+        "#import {path}\n{globals}\n@fragment\nfn lodkit_harness() -> @location(0) vec4<f32> {{\n{calls}    return vec4<f32>(0.0);\n}}\n"
+    )
+}
+
+fn compose(source: &str, file: &str, language: SourceLanguage) -> Composed {
+    ShaderLibrary::new()
+        .unwrap()
+        .compose(&ComposeDescriptor {
+            source,
+            file_path: file,
+            language,
+            ..Default::default()
+        })
+        .unwrap_or_else(|e| panic!("{file} does not compose:\n{}\n{source}", render(&e)))
+}
+
+/// Exports to every back end (GLSL once per entry point); SPIR-V goes through spirv-val.
+fn export_everywhere(composed: &Composed, what: &str) {
+    for target in ExportTarget::ALL {
+        let entries: Vec<Option<String>> = if target.one_entry_point() {
+            composed
+                .module
+                .entry_points
+                .iter()
+                .map(|e| Some(e.name.clone()))
+                .collect()
+        } else {
+            vec![None]
+        };
+        for entry in entries {
+            let out = shaders::export(
+                composed,
+                target,
+                &ExportOptions {
+                    entry_point: entry.clone(),
+                },
+            )
+            .unwrap_or_else(|e| panic!("{what}: export to {target} ({entry:?}) failed: {e}"));
+            match out {
+                Exported::Text(t) => assert!(!t.trim().is_empty(), "{what}: empty {target}"),
+                Exported::SpirV(words) => spirv_val(&words, what),
+            }
+        }
+    }
+}
+
+fn spirv_val(words: &[u32], what: &str) {
+    assert_eq!(words.first(), Some(&0x0723_0203), "{what}: SPIR-V magic");
+    let Some(mut cmd) = tool("spirv-val") else {
+        return;
+    };
+    let path = scratch("module.spv");
+    std::fs::write(&path, Exported::SpirV(words.to_vec()).to_bytes()).unwrap();
+    let out = cmd.arg(&path).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{what}: spirv-val rejects the SPIR-V export:\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn every_file_under_shader_lib_is_embedded() {
+    fn walk(dir: &Path, root: &Path, out: &mut Vec<String>) {
+        for e in std::fs::read_dir(dir).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, root, out);
+            } else {
+                out.push(
+                    p.strip_prefix(root)
+                        .unwrap()
+                        .to_string_lossy()
+                        .replace('\\', "/"),
+                );
+            }
+        }
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib");
+    let mut on_disk = Vec::new();
+    walk(&root, &root, &mut on_disk);
+    on_disk.sort();
+    let mut embedded: Vec<String> = shaders::modules()
+        .iter()
+        .map(|m| m.path.to_owned())
+        .collect();
+    embedded.sort();
+    assert_eq!(on_disk, embedded);
+}
+
+#[test]
+fn every_wgsl_module_composes_validates_and_exports() {
+    let mut count = 0;
+    for module in wgsl_modules() {
+        let harness = wgsl_harness(module);
+        let composed = compose(&harness, module.path, SourceLanguage::Wgsl);
+        export_everywhere(&composed, module.path);
+        count += 1;
+    }
+    assert!(count >= 2, "expected the library's modules, found {count}");
+}
+
+#[test]
+fn every_pass_composes_validates_and_exports() {
+    let passes: Vec<_> = shaders::modules()
+        .iter()
+        .filter(|m| m.kind == ModuleKind::Pass)
+        .collect();
+    assert!(!passes.is_empty());
+    for pass in passes {
+        let composed = compose(pass.source, pass.path, SourceLanguage::Wgsl);
+        assert!(
+            !composed.module.entry_points.is_empty(),
+            "{}: no entry point",
+            pass.path
+        );
+        export_everywhere(&composed, pass.path);
+    }
+}
+
+fn glsl_harness(twin: &ModuleInfo) -> String {
+    format!(
+        "#version 450\n#extension GL_GOOGLE_include_directive : require\n#include \"{}\"\nlayout(location = 0) out vec4 lodkit_color;\nvoid main() {{ lodkit_color = vec4(0.0); }}\n",
+        twin.include_path.as_deref().unwrap()
+    )
+}
+
+#[test]
+fn every_glsl_twin_compiles_with_glslang_and_passes_spirv_val() {
+    let Some(_) = tool("glslangValidator") else {
+        return;
+    };
+    let include_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib/glsl");
+    for twin in shaders::modules()
+        .iter()
+        .filter(|m| m.language == Language::Glsl)
+    {
+        let frag = scratch("harness.frag");
+        std::fs::write(&frag, glsl_harness(twin)).unwrap();
+        let spv = frag.with_extension("spv");
+        let out = std::process::Command::new("glslangValidator")
+            .args(["-V", "-S", "frag"])
+            .arg(format!("-I{}", include_root.display()))
+            .arg(&frag)
+            .arg("-o")
+            .arg(&spv)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}: glslangValidator rejects it:\n{}",
+            twin.path,
+            String::from_utf8_lossy(&out.stdout)
+        );
+        let bytes = std::fs::read(&spv).unwrap();
+        let words: Vec<u32> = bytes
+            .chunks(4)
+            .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        spirv_val(&words, twin.path);
+    }
+}
+
+#[test]
+fn every_glsl_twin_composes_through_naga() {
+    for twin in shaders::modules()
+        .iter()
+        .filter(|m| m.language == Language::Glsl)
+    {
+        let composed = compose(
+            &glsl_harness(twin),
+            "harness.frag",
+            SourceLanguage::Glsl(naga::ShaderStage::Fragment),
+        );
+        let names: Vec<&str> = composed
+            .module
+            .functions
+            .iter()
+            .filter_map(|(_, f)| f.name.as_deref())
+            .collect();
+        for f in &twin.functions {
+            assert!(
+                names.contains(&f.name.as_str()),
+                "{}: {} missing after compose",
+                twin.path,
+                f.name
+            );
+        }
+    }
+}
+
+#[test]
+fn glsl_twins_match_wgsl_modules_name_for_name() {
+    for module in wgsl_modules() {
+        let twin = shaders::glsl_twin(module)
+            .unwrap_or_else(|| panic!("{} has no GLSL twin", module.path));
+        let want: Vec<String> = module
+            .functions
+            .iter()
+            .map(|f| format!("lodkit_{}", f.name))
+            .collect();
+        let got: Vec<String> = twin.functions.iter().map(|f| f.name.clone()).collect();
+        assert_eq!(got, want, "functions of {} vs {}", twin.path, module.path);
+        let want: Vec<String> = module
+            .constants
+            .iter()
+            .map(|c| format!("LODKIT_{c}"))
+            .collect();
+        assert_eq!(
+            twin.constants, want,
+            "constants of {} vs {}",
+            twin.path, module.path
+        );
+        let defs = |m: &ModuleInfo| {
+            m.shader_defs
+                .iter()
+                .map(|d| d.name.clone())
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(
+            defs(twin),
+            defs(module),
+            "shader defs of {} vs {}",
+            twin.path,
+            module.path
+        );
+    }
+}
+
+#[test]
+fn every_wgsl_function_has_a_rust_twin_of_the_same_name() {
+    for module in wgsl_modules() {
+        let topic = module
+            .import_path
+            .as_deref()
+            .unwrap()
+            .trim_start_matches("lodkit::");
+        let rust = std::fs::read_to_string(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("src/{topic}.rs")),
+        )
+        .unwrap_or_else(|_| {
+            panic!(
+                "src/{topic}.rs (the Rust twins of {}) is missing",
+                module.path
+            )
+        });
+        for f in &module.functions {
+            assert!(
+                rust.contains(&format!("pub fn {}(", f.name)),
+                "src/{topic}.rs has no twin of {}",
+                f.name
+            );
+        }
+    }
+}
+
+#[test]
+fn every_shader_file_documents_itself() {
+    for m in shaders::modules() {
+        let header: String = m
+            .source
+            .lines()
+            .take_while(|l| l.starts_with("//"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        assert!(
+            header.contains("Shader defs:"),
+            "{}: header has no `Shader defs:` line",
+            m.path
+        );
+        let section = if m.kind == ModuleKind::Pass {
+            "Entry points:"
+        } else {
+            "Exports:"
+        };
+        assert!(
+            header.contains(section),
+            "{}: header has no `{section}` section",
+            m.path
+        );
+        assert!(
+            !m.summary.is_empty(),
+            "{}: header has no summary line",
+            m.path
+        );
+        for f in &m.functions {
+            assert!(
+                !f.doc.is_empty(),
+                "{}: `{}` has no /// doc comment",
+                m.path,
+                f.name
+            );
+            assert!(
+                header.contains(&f.name),
+                "{}: header does not list `{}`",
+                m.path,
+                f.name
+            );
+        }
+        for d in &m.shader_defs {
+            assert!(
+                !d.doc.is_empty(),
+                "{}: shader def {} is not documented in the header",
+                m.path,
+                d.name
+            );
+        }
+    }
+}
+
+#[test]
+fn add_to_composer_lets_a_foreign_composer_import_lodkit() {
+    let mut composer = naga_oil::compose::Composer::default();
+    shaders::add_to_composer(&mut composer).unwrap();
+    // Adding twice is harmless (an engine may call it from several plugins).
+    shaders::add_to_composer(&mut composer).unwrap();
+    let module = composer
+        .make_naga_module(naga_oil::compose::NagaModuleDescriptor {
+            source: "#import lodkit::normal_distance::foreshortened_normal_distance\n\
+                     #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}\n\
+                     @vertex fn vs(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }\n\
+                     @fragment fn fs(v: FullscreenVertex) -> @location(0) vec4<f32> {\n\
+                       return vec4<f32>(foreshortened_normal_distance(vec3(v.uv, 1.0), vec3(0.0, 0.0, 1.0)));\n}\n",
+            file_path: "engine.wgsl",
+            ..Default::default()
+        })
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+    assert_eq!(module.entry_points.len(), 2);
+}

@@ -1,0 +1,269 @@
+//! The GPU test harness: one shared headless device, and a probe that runs a shader function over
+//! a table of inputs (one compute invocation per case) and reads the results back.
+//!
+//! GPU tests start with `lodkit_test_gpu!()`. Without an adapter they fail when
+//! `LODKIT_REQUIRE_GPU=1`, and otherwise return early after writing a SKIPPED line straight to
+//! stderr (past the test harness's capture), so a skip is never silent.
+
+use std::io::Write;
+use std::sync::OnceLock;
+
+use lodkit::gpu::{GpuContext, GpuOptions};
+use lodkit::shaders::{ComposeDescriptor, ShaderLibrary, SourceLanguage};
+use wgpu::util::DeviceExt;
+
+/// Whether missing GPU or reference tools are failures (`LODKIT_REQUIRE_GPU=1`, as CI sets it).
+pub fn strict() -> bool {
+    std::env::var("LODKIT_REQUIRE_GPU").is_ok_and(|v| v == "1")
+}
+
+/// Writes past libtest's output capture, so the line shows in a normal `cargo test` run.
+pub fn say(line: &str) {
+    let _ = writeln!(std::io::stderr(), "{line}");
+}
+
+fn test_name() -> String {
+    std::thread::current()
+        .name()
+        .unwrap_or("a GPU test")
+        .to_owned()
+}
+
+/// The shared GPU, or why there is none.
+pub fn gpu() -> Result<&'static GpuContext, String> {
+    static GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
+    let gpu = GPU.get_or_init(|| {
+        let gpu = GpuContext::new_headless(&GpuOptions::default()).map_err(|e| e.to_string());
+        if let Ok(g) = &gpu {
+            say(&format!("lodkit GPU tests run on: {}", g.adapter_summary()));
+        }
+        gpu
+    });
+    gpu.as_ref().map_err(Clone::clone)
+}
+
+/// The shared GPU; with none, panics under `LODKIT_REQUIRE_GPU=1`, else returns `None` after
+/// saying the calling test was skipped.
+pub fn gpu_or_skip() -> Option<&'static GpuContext> {
+    match gpu() {
+        Ok(g) => Some(g),
+        Err(e) if strict() => panic!("LODKIT_REQUIRE_GPU=1 but there is no GPU adapter: {e}"),
+        Err(e) => {
+            say(&format!(
+                "SKIPPED {}: {e}. Set LODKIT_REQUIRE_GPU=1 to make this a failure",
+                test_name()
+            ));
+            None
+        }
+    }
+}
+
+/// The shared GPU, or return from the test (see [`gpu_or_skip`]).
+macro_rules! lodkit_test_gpu {
+    () => {
+        match $crate::harness::gpu_or_skip() {
+            Some(gpu) => gpu,
+            None => return,
+        }
+    };
+}
+
+/// Runs `program` (which must not fail to spawn) or, if it is missing, fails under
+/// `LODKIT_REQUIRE_GPU=1` and skips loudly otherwise. Returns `None` when skipped.
+pub fn tool(program: &str) -> Option<std::process::Command> {
+    let found = std::process::Command::new(program)
+        .arg("--version")
+        .output()
+        .is_ok();
+    if found {
+        return Some(std::process::Command::new(program));
+    }
+    if strict() {
+        panic!(
+            "LODKIT_REQUIRE_GPU=1 but `{program}` is not installed (apt-get install glslang-tools spirv-tools)"
+        );
+    }
+    say(&format!(
+        "SKIPPED {}: `{program}` is not installed",
+        test_name()
+    ));
+    None
+}
+
+/// A shader function under test: the WGSL and GLSL text around it. Inside `body`,
+/// `inp_f(k)`/`inp_u(k)` read input word k of the current case, `out_f(k, v)`/`out_u(k, v)`
+/// write output word k.
+pub struct Probe<'a> {
+    /// Imports (WGSL) or includes (GLSL) at the top of the shader.
+    pub header: &'a str,
+    /// Statements run once per case.
+    pub body: &'a str,
+    /// Input words (f32 or u32 bits) per case.
+    pub inputs: usize,
+    /// Output words per case.
+    pub outputs: usize,
+}
+
+fn wgsl_probe(p: &Probe) -> String {
+    format!(
+        "{header}
+@group(0) @binding(0) var<storage, read> probe_in: array<u32>;
+@group(0) @binding(1) var<storage, read_write> probe_out: array<u32>;
+var<private> probe_case: u32;
+fn inp_u(k: u32) -> u32 {{ return probe_in[probe_case * {inputs}u + k]; }}
+fn inp_f(k: u32) -> f32 {{ return bitcast<f32>(inp_u(k)); }}
+fn out_u(k: u32, v: u32) {{ probe_out[probe_case * {outputs}u + k] = v; }}
+fn out_f(k: u32, v: f32) {{ out_u(k, bitcast<u32>(v)); }}
+@compute @workgroup_size(1)
+fn main(@builtin(workgroup_id) id: vec3<u32>) {{
+    probe_case = id.x;
+    {body}
+}}
+",
+        header = p.header,
+        inputs = p.inputs,
+        outputs = p.outputs,
+        body = p.body
+    )
+}
+
+/// The GLSL probe shader (compute, `#include`s resolved against the library).
+pub fn glsl_probe(p: &Probe) -> String {
+    format!(
+        "#version 450
+#extension GL_GOOGLE_include_directive : require
+layout(local_size_x = 1) in;
+layout(std430, set = 0, binding = 0) readonly buffer ProbeIn {{ uint probe_in[]; }};
+layout(std430, set = 0, binding = 1) buffer ProbeOut {{ uint probe_out[]; }};
+{header}
+uint probe_case;
+uint inp_u(uint k) {{ return probe_in[probe_case * {inputs}u + k]; }}
+float inp_f(uint k) {{ return uintBitsToFloat(inp_u(k)); }}
+void out_u(uint k, uint v) {{ probe_out[probe_case * {outputs}u + k] = v; }}
+void out_f(uint k, float v) {{ out_u(k, floatBitsToUint(v)); }}
+void main() {{
+    probe_case = gl_WorkGroupID.x;
+    {body}
+}}
+",
+        header = p.header,
+        inputs = p.inputs,
+        outputs = p.outputs,
+        body = p.body
+    )
+}
+
+/// Runs the WGSL probe over `cases` (flattened input words) and returns the output words.
+pub fn run_wgsl(gpu: &GpuContext, probe: &Probe, cases: &[u32]) -> Vec<u32> {
+    let source = wgsl_probe(probe);
+    run(gpu, probe, cases, &source, SourceLanguage::Wgsl)
+}
+
+/// Runs the GLSL probe (the GLSL twins) over `cases`.
+pub fn run_glsl(gpu: &GpuContext, probe: &Probe, cases: &[u32]) -> Vec<u32> {
+    let source = glsl_probe(probe);
+    run(
+        gpu,
+        probe,
+        cases,
+        &source,
+        SourceLanguage::Glsl(naga::ShaderStage::Compute),
+    )
+}
+
+fn run(
+    gpu: &GpuContext,
+    probe: &Probe,
+    cases: &[u32],
+    source: &str,
+    language: SourceLanguage,
+) -> Vec<u32> {
+    assert_eq!(
+        cases.len() % probe.inputs,
+        0,
+        "inputs are not a whole number of cases"
+    );
+    let n = cases.len() / probe.inputs;
+    let mut library = ShaderLibrary::new().expect("library");
+    let composed = library
+        .compose(&ComposeDescriptor {
+            source,
+            file_path: "probe",
+            language,
+            ..Default::default()
+        })
+        .unwrap_or_else(|e| panic!("probe does not compose:\n{}\n{source}", render(&e)));
+    let device = &gpu.device;
+    let module = gpu.shader_module("probe", &composed);
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("probe"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("probe in"),
+        contents: bytemuck::cast_slice(cases),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let size = (n * probe.outputs * 4) as u64;
+    let output = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("probe out"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("probe"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: input.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: output.as_entire_binding(),
+            },
+        ],
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(n as u32, 1, 1);
+    }
+    let bytes = crate::readback::read_buffer(gpu, encoder, &output, size);
+    bytemuck::cast_slice(&bytes).to_vec()
+}
+
+/// Human rendering of a shader error (the diagnostic when there is one).
+pub fn render(e: &lodkit::shaders::ShaderError) -> String {
+    e.diagnostic().map_or_else(|| e.to_string(), |d| d.render())
+}
+
+/// f32 inputs as probe words.
+pub fn words(values: &[f32]) -> Vec<u32> {
+    values.iter().map(|v| v.to_bits()).collect()
+}
+
+/// Probe words as f32.
+pub fn floats(words: &[u32]) -> Vec<f32> {
+    words.iter().map(|w| f32::from_bits(*w)).collect()
+}
+
+/// Asserts `got` matches `want` within `tol` relative to max(1, |want|), naming the first case
+/// that does not.
+pub fn assert_close(got: &[f32], want: &[f32], tol: f32, what: &str) {
+    assert_eq!(got.len(), want.len(), "{what}: result count");
+    for (i, (g, w)) in got.iter().zip(want).enumerate() {
+        let ok = (g - w).abs() <= tol * w.abs().max(1.0);
+        assert!(
+            ok,
+            "{what}: case {i}: GPU {g} vs Rust twin {w} (tolerance {tol})"
+        );
+    }
+}

@@ -1,0 +1,9 @@
+//! lodkit's integration tests: composition and export of the whole shader library, the CLI, and
+//! shader functions on a GPU (lavapipe / llvmpipe in CI) held against their Rust twins.
+
+#[macro_use]
+mod harness;
+mod cli;
+mod composition;
+mod gpu_twins;
+mod readback;

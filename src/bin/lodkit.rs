@@ -1,0 +1,422 @@
+//! `lodkit`: list the shader library, check shaders that import it, export them to other languages.
+//!
+//! Exit codes: 0 success, 1 a shader is invalid, 2 usage or I/O error.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use lodkit::shaders::{
+    self, ComposeDescriptor, ExportOptions, ExportTarget, Exported, ShaderDefValue, ShaderError,
+    ShaderLibrary, SourceLanguage,
+};
+
+#[derive(Parser)]
+#[command(
+    name = "lodkit",
+    version,
+    about = "Smooth discrete-LOD and framebuffer-LOD shader modules"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, Default, ValueEnum)]
+enum Format {
+    /// Diagnostics for people: file:line:col, the source line, a caret.
+    #[default]
+    Human,
+    /// One JSON document on stdout, for CI tools.
+    Json,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Stage {
+    Vertex,
+    Fragment,
+    Compute,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Target {
+    Spv,
+    Msl,
+    Hlsl,
+    Glsl,
+    GlslEs,
+    Wgsl,
+}
+
+#[derive(clap::Args)]
+struct ComposeArgs {
+    /// Folder of your own modules (`#define_import_path`) and GLSL headers; repeatable.
+    #[arg(short = 'I', value_name = "DIR")]
+    include: Vec<PathBuf>,
+    /// Shader def: NAME (true), NAME=true|false, NAME=-3 (int), NAME=3u (uint); repeatable.
+    #[arg(short = 'D', value_name = "NAME[=VALUE]", value_parser = parse_def)]
+    define: Vec<(String, ShaderDefValue)>,
+    /// Stage of a GLSL file (default: from the extension .vert, .frag, .comp).
+    #[arg(long)]
+    stage: Option<Stage>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the library's modules, their functions and the shader defs they read.
+    Modules {
+        #[arg(long, value_enum, default_value_t)]
+        format: Format,
+    },
+    /// Compose each shader against the lodkit modules (and yours) and validate it.
+    Check {
+        #[command(flatten)]
+        compose: ComposeArgs,
+        #[arg(long, value_enum, default_value_t)]
+        format: Format,
+        /// Shaders to check (.wgsl; .glsl/.vert/.frag/.comp).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
+    /// Compose a shader and write it through one of naga's back ends.
+    Export {
+        #[command(flatten)]
+        compose: ComposeArgs,
+        /// Output language.
+        #[arg(long, value_enum)]
+        to: Target,
+        /// Entry point for GLSL output (needed when the shader has several).
+        #[arg(long)]
+        entry: Option<String>,
+        /// Output file (`-` for stdout).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The shader to export.
+        file: PathBuf,
+    },
+}
+
+fn parse_def(s: &str) -> Result<(String, ShaderDefValue), String> {
+    let (name, value) = match s.split_once('=') {
+        None => (s, ShaderDefValue::Bool(true)),
+        Some((name, "true")) => (name, ShaderDefValue::Bool(true)),
+        Some((name, "false")) => (name, ShaderDefValue::Bool(false)),
+        Some((name, v)) => match v.strip_suffix('u') {
+            Some(u) => (
+                name,
+                ShaderDefValue::UInt(u.parse().map_err(|_| format!("`{v}` is not a u32"))?),
+            ),
+            None => (
+                name,
+                ShaderDefValue::Int(
+                    v.parse()
+                        .map_err(|_| format!("`{v}` is not an i32, true or false"))?,
+                ),
+            ),
+        },
+    };
+    let valid = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !valid {
+        return Err(format!("`{name}` is not a shader def name"));
+    }
+    Ok((name.to_owned(), value))
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Modules { format } => modules(format),
+        Command::Check {
+            compose,
+            format,
+            files,
+        } => check(&compose, format, &files),
+        Command::Export {
+            compose,
+            to,
+            entry,
+            output,
+            file,
+        } => export(&compose, to, entry, &output, &file),
+    }
+}
+
+fn modules(format: Format) -> ExitCode {
+    let modules = shaders::modules();
+    if let Format::Json = format {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(modules).unwrap_or_default()
+        );
+        return ExitCode::SUCCESS;
+    }
+    for m in modules {
+        let name = m.import_path.clone().unwrap_or_else(|| m.path.to_owned());
+        let kind = match (m.kind, m.language) {
+            (shaders::ModuleKind::Pass, _) => "pass",
+            (_, shaders::Language::Wgsl) => "wgsl",
+            (_, shaders::Language::Glsl) => "glsl twin",
+        };
+        println!("{name}  [{kind}: shader_lib/{}]", m.path);
+        println!("    {}", m.summary);
+        for f in &m.functions {
+            println!("    {}", f.signature);
+            if !f.doc.is_empty() {
+                println!("        {}", f.doc);
+            }
+        }
+        if m.shader_defs.is_empty() {
+            println!("    shader defs: none");
+        }
+        for d in &m.shader_defs {
+            println!("    shader def {} {}", d.name, d.doc);
+        }
+        println!();
+    }
+    ExitCode::SUCCESS
+}
+
+/// What happened to one file.
+enum Outcome {
+    Valid(Box<shaders::Composed>),
+    Invalid(ShaderError),
+    Unreadable(ShaderError),
+}
+
+fn library(args: &ComposeArgs) -> Result<ShaderLibrary, ShaderError> {
+    let mut library = ShaderLibrary::new()?;
+    library.add_import_dirs(&args.include)?;
+    Ok(library)
+}
+
+fn language_of(path: &Path, stage: Option<Stage>) -> Result<SourceLanguage, String> {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    if name.ends_with(".wgsl") {
+        return Ok(SourceLanguage::Wgsl);
+    }
+    let from_name = [
+        (".vert", naga::ShaderStage::Vertex),
+        (".frag", naga::ShaderStage::Fragment),
+        (".comp", naga::ShaderStage::Compute),
+    ]
+    .into_iter()
+    .find(|(ext, _)| name.ends_with(ext) || name.contains(&format!("{ext}.")))
+    .map(|(_, s)| s);
+    let stage = stage.map(|s| match s {
+        Stage::Vertex => naga::ShaderStage::Vertex,
+        Stage::Fragment => naga::ShaderStage::Fragment,
+        Stage::Compute => naga::ShaderStage::Compute,
+    });
+    match stage.or(from_name) {
+        Some(stage) => Ok(SourceLanguage::Glsl(stage)),
+        None if name.ends_with(".glsl") => Err(format!(
+            "{}: a GLSL file needs a stage: pass --stage or name it .vert/.frag/.comp",
+            path.display()
+        )),
+        None => Err(format!(
+            "{}: unknown shader language (expected .wgsl, .glsl, .vert, .frag or .comp)",
+            path.display()
+        )),
+    }
+}
+
+fn compose_file(library: &mut ShaderLibrary, args: &ComposeArgs, path: &Path) -> Outcome {
+    let language = match language_of(path, args.stage) {
+        Ok(l) => l,
+        Err(message) => {
+            return Outcome::Unreadable(ShaderError::Io {
+                path: path.to_path_buf(),
+                source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+            });
+        }
+    };
+    let source = match shaders::read_source(path) {
+        Ok(s) => s,
+        Err(e @ ShaderError::Io { .. }) => return Outcome::Unreadable(e),
+        Err(e) => return Outcome::Invalid(e),
+    };
+    let defs: HashMap<String, ShaderDefValue> = args.define.iter().cloned().collect();
+    let file_path = path.display().to_string();
+    match library.compose(&ComposeDescriptor {
+        source: &source,
+        file_path: &file_path,
+        language,
+        shader_defs: defs,
+    }) {
+        Ok(c) => Outcome::Valid(Box::new(c)),
+        Err(e) => Outcome::Invalid(e),
+    }
+}
+
+fn error_json(file: &Path, e: &ShaderError) -> serde_json::Value {
+    match e.diagnostic() {
+        Some(d) => serde_json::to_value(d).unwrap_or_default(),
+        None => serde_json::json!({
+            "kind": match e { ShaderError::Io { .. } => "io", _ => "export" },
+            "message": e.to_string(),
+            "file": file.display().to_string(),
+            "hint": null,
+            "notes": [],
+        }),
+    }
+}
+
+fn print_error(e: &ShaderError) {
+    match e.diagnostic() {
+        Some(d) => eprint!("{}", d.render()),
+        None => eprintln!("error: {e}"),
+    }
+}
+
+fn check(args: &ComposeArgs, format: Format, files: &[PathBuf]) -> ExitCode {
+    let mut library = match library(args) {
+        Ok(l) => l,
+        Err(e) => {
+            let code = if matches!(e, ShaderError::Io { .. }) {
+                2
+            } else {
+                1
+            };
+            report_setup_error(format, &e);
+            return ExitCode::from(code);
+        }
+    };
+    let (mut invalid, mut unreadable) = (0, 0);
+    let mut reports = Vec::new();
+    for path in files {
+        let outcome = compose_file(&mut library, args, path);
+        let file = path.display().to_string();
+        match &outcome {
+            Outcome::Valid(c) => {
+                let entry_points: Vec<String> = c
+                    .module
+                    .entry_points
+                    .iter()
+                    .map(|e| e.name.clone())
+                    .collect();
+                if let Format::Human = format {
+                    println!(
+                        "ok: {file} ({} entry point{})",
+                        entry_points.len(),
+                        if entry_points.len() == 1 { "" } else { "s" }
+                    );
+                }
+                reports.push(serde_json::json!({"file": file, "valid": true, "entry_points": entry_points, "diagnostics": []}));
+            }
+            Outcome::Invalid(e) | Outcome::Unreadable(e) => {
+                if matches!(outcome, Outcome::Invalid(_)) {
+                    invalid += 1
+                } else {
+                    unreadable += 1
+                }
+                if let Format::Human = format {
+                    print_error(e);
+                }
+                reports.push(serde_json::json!({"file": file, "valid": false, "entry_points": [], "diagnostics": [error_json(path, e)]}));
+            }
+        }
+    }
+    match format {
+        Format::Json => println!(
+            "{}",
+            serde_json::json!({"valid": invalid + unreadable == 0, "files": reports})
+        ),
+        Format::Human if files.len() > 1 => eprintln!(
+            "checked {} files: {} valid, {} invalid, {} unreadable",
+            files.len(),
+            files.len() - invalid - unreadable,
+            invalid,
+            unreadable
+        ),
+        Format::Human => {}
+    }
+    ExitCode::from(if unreadable > 0 {
+        2
+    } else if invalid > 0 {
+        1
+    } else {
+        0
+    })
+}
+
+fn report_setup_error(format: Format, e: &ShaderError) {
+    match format {
+        Format::Human => print_error(e),
+        Format::Json => println!(
+            "{}",
+            serde_json::json!({"valid": false, "files": [], "diagnostics": [error_json(Path::new(""), e)]})
+        ),
+    }
+}
+
+fn export(
+    args: &ComposeArgs,
+    to: Target,
+    entry: Option<String>,
+    output: &Path,
+    file: &Path,
+) -> ExitCode {
+    let mut library = match library(args) {
+        Ok(l) => l,
+        Err(e) => {
+            print_error(&e);
+            return ExitCode::from(if matches!(e, ShaderError::Io { .. }) {
+                2
+            } else {
+                1
+            });
+        }
+    };
+    let composed = match compose_file(&mut library, args, file) {
+        Outcome::Valid(c) => *c,
+        Outcome::Invalid(e) => {
+            print_error(&e);
+            return ExitCode::from(1);
+        }
+        Outcome::Unreadable(e) => {
+            print_error(&e);
+            return ExitCode::from(2);
+        }
+    };
+    let target = match to {
+        Target::Spv => ExportTarget::SpirV,
+        Target::Msl => ExportTarget::Msl,
+        Target::Hlsl => ExportTarget::Hlsl,
+        Target::Glsl => ExportTarget::Glsl,
+        Target::GlslEs => ExportTarget::GlslEs,
+        Target::Wgsl => ExportTarget::Wgsl,
+    };
+    let exported = match shaders::export(&composed, target, &ExportOptions { entry_point: entry }) {
+        Ok(x) => x,
+        Err(e) => {
+            print_error(&e);
+            return ExitCode::from(1);
+        }
+    };
+    let result = if output == Path::new("-") {
+        use std::io::Write;
+        std::io::stdout().write_all(&exported.to_bytes())
+    } else {
+        std::fs::write(output, exported.to_bytes())
+    };
+    match result {
+        Ok(()) => {
+            if output != Path::new("-") {
+                let what = match exported {
+                    Exported::SpirV(w) => format!("{} SPIR-V words", w.len()),
+                    Exported::Text(t) => format!("{} bytes of {target}", t.len()),
+                };
+                eprintln!("wrote {} ({what})", output.display());
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: cannot write `{}`: {e}", output.display());
+            ExitCode::from(2)
+        }
+    }
+}

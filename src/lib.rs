@@ -1,0 +1,22 @@
+//! # lodkit
+//!
+//! Composable WGSL/GLSL shader modules for smooth discrete level-of-detail transitions and
+//! geometry-aware framebuffer LOD, validated and composed through naga / naga_oil, with the host
+//! math and wgpu glue an engine needs to splice them into its own pipeline.
+//!
+//! - [`shaders`]: the embedded module library, composition of your shaders that
+//!   `#import lodkit::...` (or `#include "lodkit/....glsl"`), validation and export.
+//! - [`normal_distance`], [`fullscreen`]: Rust twins of the shader functions of the same names.
+//! - [`gpu`] (feature `wgpu`): headless devices and ready-made passes.
+//!
+//! Every pure shader function has a Rust twin with the same name; tests hold the GPU result
+//! against it.
+
+#![warn(missing_docs)]
+
+pub mod fullscreen;
+pub mod normal_distance;
+pub mod shaders;
+
+#[cfg(feature = "wgpu")]
+pub mod gpu;

@@ -1,0 +1,614 @@
+//! [`ShaderLibrary`]: a naga_oil `Composer` that knows every lodkit module and the user's own.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use naga_oil::compose::{
+    ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
+    ShaderType, get_preprocessor_data,
+};
+
+use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error, validation_diagnostic};
+use super::registry::{self, Language, ModuleKind};
+use super::{ShaderError, closest, glsl, read_source};
+
+/// Shader defs by name, as naga_oil takes them (`-D NAME=VALUE` on the command line).
+pub type ShaderDefs = HashMap<String, ShaderDefValue>;
+
+/// Language (and for GLSL, stage) of a top-level shader.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SourceLanguage {
+    /// WGSL; stages come from its entry points. Imports lodkit with `#import lodkit::<topic>`.
+    #[default]
+    Wgsl,
+    /// GLSL 450 of one stage. Includes lodkit with `#include "lodkit/<topic>.glsl"`.
+    Glsl(naga::ShaderStage),
+}
+
+/// A top-level shader to compose.
+#[derive(Clone, Debug, Default)]
+pub struct ComposeDescriptor<'a> {
+    /// The shader's source text.
+    pub source: &'a str,
+    /// Path used in diagnostics (and, for GLSL, to find `#include`s next to the file).
+    pub file_path: &'a str,
+    /// Language of `source`.
+    pub language: SourceLanguage,
+    /// Shader defs for this composition.
+    pub shader_defs: ShaderDefs,
+}
+
+/// Options for a [`ShaderLibrary`].
+#[derive(Clone, Debug, Default)]
+pub struct LibraryDescriptor {
+    /// Capabilities the validator allows (default: naga's defaults, the WebGPU baseline).
+    pub capabilities: naga::valid::Capabilities,
+}
+
+/// A composed and validated module.
+#[derive(Debug)]
+pub struct Composed {
+    /// The naga IR.
+    pub module: naga::Module,
+    /// What naga's validator found out about it (needed by every back end).
+    pub info: naga::valid::ModuleInfo,
+}
+
+/// The entry object: a naga_oil [`Composer`] holding every lodkit WGSL module, plus the user's
+/// modules and include folders.
+///
+/// ```
+/// use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
+/// let mut library = ShaderLibrary::new().unwrap();
+/// let composed = library
+///     .compose(&ComposeDescriptor {
+///         source: "#import lodkit::normal_distance::foreshortened_normal_distance\n\
+///                  @fragment fn main() -> @location(0) vec4<f32> {\n\
+///                  return vec4<f32>(foreshortened_normal_distance(vec3(0.0, 0.0, 1.0), vec3(0.6, 0.0, 0.8)));\n}",
+///         file_path: "example.wgsl",
+///         ..Default::default()
+///     })
+///     .unwrap();
+/// assert_eq!(composed.module.entry_points.len(), 1);
+/// ```
+pub struct ShaderLibrary {
+    composer: Composer,
+    capabilities: naga::valid::Capabilities,
+    include_dirs: Vec<PathBuf>,
+    user_modules: Vec<String>,
+}
+
+impl std::fmt::Debug for ShaderLibrary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ShaderLibrary")
+            .field("include_dirs", &self.include_dirs)
+            .field("user_modules", &self.user_modules)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Adds every lodkit WGSL module to `composer`, dependencies first, skipping any it already has.
+/// This is how an engine that owns its own naga_oil `Composer` (Bevy-style) gets
+/// `#import lodkit::...` to resolve.
+pub fn add_to_composer(composer: &mut Composer) -> Result<(), ShaderError> {
+    let sources: Vec<(String, Arc<str>)> = registry::modules()
+        .iter()
+        .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
+        .map(|m| (format!("shader_lib/{}", m.path), Arc::from(m.source)))
+        .collect();
+    add_modules(composer, sources)
+}
+
+impl ShaderLibrary {
+    /// A library with every lodkit module and naga's default capabilities.
+    pub fn new() -> Result<Self, ShaderError> {
+        Self::with_descriptor(&LibraryDescriptor::default())
+    }
+
+    /// A library with every lodkit module and the given options.
+    pub fn with_descriptor(desc: &LibraryDescriptor) -> Result<Self, ShaderError> {
+        // `with_capabilities` builds a second Composer (naga_oil compiles its regexes again, ~5 ms):
+        // only pay for it when the capabilities differ from the default.
+        let mut composer = if desc.capabilities == naga::valid::Capabilities::default() {
+            Composer::default()
+        } else {
+            Composer::default().with_capabilities(desc.capabilities)
+        };
+        add_to_composer(&mut composer)?;
+        Ok(Self {
+            composer,
+            capabilities: desc.capabilities,
+            include_dirs: Vec::new(),
+            user_modules: Vec::new(),
+        })
+    }
+
+    /// The underlying naga_oil composer.
+    pub fn composer(&self) -> &Composer {
+        &self.composer
+    }
+
+    /// The underlying naga_oil composer, to add modules of your own by hand.
+    pub fn composer_mut(&mut self) -> &mut Composer {
+        &mut self.composer
+    }
+
+    /// Import paths of the user modules added so far, in the order they were added.
+    pub fn user_modules(&self) -> &[String] {
+        &self.user_modules
+    }
+
+    /// Adds user folders: every `.wgsl` file under them that declares `#define_import_path`
+    /// becomes importable (imports among them are ordered; a cycle or a duplicate import path is
+    /// an error naming the file and line), and GLSL `#include`s are searched in them.
+    /// Returns the import paths added.
+    pub fn add_import_dirs(&mut self, dirs: &[PathBuf]) -> Result<Vec<String>, ShaderError> {
+        let mut files = Vec::new();
+        for dir in dirs {
+            if !dir.is_dir() {
+                return Err(ShaderError::Io {
+                    path: dir.clone(),
+                    source: std::io::Error::new(std::io::ErrorKind::NotFound, "not a folder"),
+                });
+            }
+            collect_wgsl(dir, &mut files)?;
+            self.include_dirs.push(dir.clone());
+        }
+        files.sort();
+        let mut sources = Vec::new();
+        for file in files {
+            let text = read_source(&file)?;
+            if registry::define_import_path(&text).is_some() {
+                sources.push((file.display().to_string(), Arc::from(text)));
+            }
+        }
+        let names: Vec<String> = sources
+            .iter()
+            .filter_map(|(_, s)| registry::define_import_path(s))
+            .collect();
+        add_modules(&mut self.composer, sources)?;
+        self.user_modules.extend(names.iter().cloned());
+        Ok(names)
+    }
+
+    /// Adds one user module from source (it must declare `#define_import_path`).
+    pub fn add_module(&mut self, file_path: &str, source: &str) -> Result<String, ShaderError> {
+        let Some(name) = registry::define_import_path(source) else {
+            return Err(ShaderError::Source(Box::new(Diagnostic::new(
+                DiagnosticKind::Parse,
+                file_path,
+                "a module needs a `#define_import_path` line",
+            ))));
+        };
+        add_modules(
+            &mut self.composer,
+            vec![(file_path.to_owned(), Arc::from(source))],
+        )?;
+        self.user_modules.push(name.clone());
+        Ok(name)
+    }
+
+    /// Composes a top-level shader against the library and validates it.
+    pub fn compose(&mut self, desc: &ComposeDescriptor) -> Result<Composed, ShaderError> {
+        let module = match desc.language {
+            SourceLanguage::Wgsl => self.compose_wgsl(desc)?,
+            SourceLanguage::Glsl(stage) => return self.compose_glsl(desc, stage),
+        };
+        let info = validate_with(&module, self.capabilities, desc.file_path)?;
+        Ok(Composed { module, info })
+    }
+
+    fn compose_wgsl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
+        self.check_imports(desc)?;
+        self.composer
+            .make_naga_module(NagaModuleDescriptor {
+                source: desc.source,
+                file_path: desc.file_path,
+                shader_type: ShaderType::Wgsl,
+                shader_defs: desc.shader_defs.clone(),
+                additional_imports: &[],
+            })
+            .map_err(|e| {
+                let d = from_composer_error(&e, &self.composer, Some(desc.source));
+                ShaderError::Source(Box::new(self.with_import_hint(d)))
+            })
+    }
+
+    /// Every `#import` must name a module the composer has, used or not (naga_oil itself only
+    /// complains about imports that are used).
+    fn check_imports(&self, desc: &ComposeDescriptor) -> Result<(), ShaderError> {
+        for (import, line_at) in declared_imports(desc.source) {
+            let mut candidate = import.as_str();
+            let found = loop {
+                if self.composer.contains_module(candidate) {
+                    break true;
+                }
+                match candidate.rsplit_once("::") {
+                    Some((head, _)) => candidate = head,
+                    None => break false,
+                }
+            };
+            if !found {
+                let name = module_prefix(&import);
+                let mut span = import_site(desc.source, name);
+                if span.is_empty() {
+                    span = line_at..line_at + "#import".len();
+                }
+                let d = Diagnostic::new(
+                    DiagnosticKind::UnknownImport,
+                    desc.file_path,
+                    format!("unknown import `{name}`"),
+                )
+                .with_span(Arc::from(desc.source), span)
+                .with_label("no module has this import path");
+                return Err(ShaderError::Source(Box::new(self.with_import_hint(d))));
+            }
+        }
+        Ok(())
+    }
+
+    fn with_import_hint(&self, mut d: Diagnostic) -> Diagnostic {
+        if d.kind == DiagnosticKind::UnknownImport {
+            let name = d
+                .message
+                .trim_start_matches("unknown import `")
+                .trim_end_matches('`')
+                .to_owned();
+            let known: Vec<String> = registry::import_paths()
+                .into_iter()
+                .map(str::to_owned)
+                .chain(self.user_modules.iter().cloned())
+                .collect();
+            let module_part = module_prefix(&name);
+            if let Some(best) = closest(module_part, known.iter().map(String::as_str)) {
+                d = d.with_hint(format!("did you mean `{best}`?"));
+            }
+            d = d.with_note(format!(
+                "lodkit modules: {}",
+                registry::import_paths().join(", ")
+            ));
+        }
+        d
+    }
+
+    fn compose_glsl(
+        &mut self,
+        desc: &ComposeDescriptor,
+        stage: naga::ShaderStage,
+    ) -> Result<Composed, ShaderError> {
+        let expanded = glsl::expand_includes(desc.file_path, desc.source, &self.include_dirs)?;
+        let defines = desc
+            .shader_defs
+            .iter()
+            .map(|(k, v)| {
+                let v = match v {
+                    ShaderDefValue::Bool(b) => u32::from(*b).to_string(),
+                    ShaderDefValue::Int(i) => i.to_string(),
+                    ShaderDefValue::UInt(u) => u.to_string(),
+                };
+                (k.clone(), v)
+            })
+            .collect();
+        let options = naga::front::glsl::Options { stage, defines };
+        let module = naga::front::glsl::Frontend::default()
+            .parse(&options, &expanded.text)
+            .map_err(|e| {
+                let first = e.errors.first();
+                let span = first.and_then(|e| e.meta.to_range()).unwrap_or(0..0);
+                let message = first.map(|e| e.kind.to_string()).unwrap_or_default();
+                let mut d = expanded.diagnostic(DiagnosticKind::Parse, span, message);
+                for more in e.errors.iter().skip(1) {
+                    d = d.with_note(more.kind.to_string());
+                }
+                ShaderError::Source(Box::new(d))
+            })?;
+        let info =
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), self.capabilities)
+                .validate(&module)
+                .map_err(|e| {
+                    let span = e
+                        .spans()
+                        .next()
+                        .and_then(|(s, _)| s.to_range())
+                        .unwrap_or(0..0);
+                    let (file, source, range) = expanded.locate(span.clone()).unwrap_or((
+                        desc.file_path.to_owned(),
+                        Arc::from(""),
+                        0..0,
+                    ));
+                    let d = validation_diagnostic(&e, file, source, |_| range.clone());
+                    ShaderError::Source(Box::new(d))
+                })?;
+        Ok(Composed { module, info })
+    }
+}
+
+/// Validates a naga module (one you built yourself) with `capabilities`.
+pub fn validate(
+    module: &naga::Module,
+    capabilities: naga::valid::Capabilities,
+) -> Result<naga::valid::ModuleInfo, ShaderError> {
+    validate_with(module, capabilities, "<module>")
+}
+
+fn validate_with(
+    module: &naga::Module,
+    capabilities: naga::valid::Capabilities,
+    file: &str,
+) -> Result<naga::valid::ModuleInfo, ShaderError> {
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
+        .validate(module)
+        .map_err(|e| {
+            ShaderError::Source(Box::new(validation_diagnostic(
+                &e,
+                file.to_owned(),
+                Arc::from(""),
+                |_| 0..0,
+            )))
+        })
+}
+
+/// The module part of an import (`lodkit::a::item` -> `lodkit::a` when `lodkit::a::item` is no
+/// module itself).
+fn module_prefix(import: &str) -> &str {
+    if registry::find_module(import).is_some() {
+        return import;
+    }
+    match import.rsplit_once("::") {
+        Some((head, _)) if head.contains("::") => head,
+        _ => import,
+    }
+}
+
+fn collect_wgsl(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), ShaderError> {
+    let entries = std::fs::read_dir(dir).map_err(|source| ShaderError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            collect_wgsl(&path, out)?;
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            out.push(path);
+        }
+    }
+    Ok(())
+}
+
+/// Every path an `#import` statement names, fully expanded (`#import a::{b, c::d}` names `a::b`
+/// and `a::c::d`), with the byte offset of its `#import`. Unlike naga_oil's own scan, imports that
+/// are never used count too.
+fn declared_imports(source: &str) -> Vec<(String, usize)> {
+    fn expand(list: &str, prefix: &str, out: &mut Vec<String>) {
+        let mut depth = 0;
+        let mut start = 0;
+        let mut items = Vec::new();
+        for (i, c) in list.char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' => depth -= 1,
+                ',' if depth == 0 => {
+                    items.push(&list[start..i]);
+                    start = i + 1;
+                }
+                _ => {}
+            }
+        }
+        items.push(&list[start..]);
+        for item in items {
+            let item = item.trim();
+            let item = match item.rsplit_once(" as ") {
+                Some((head, alias)) if !alias.contains('}') => head.trim(),
+                _ => item,
+            };
+            if item.is_empty() {
+                continue;
+            }
+            match (item.find('{'), item.rfind('}')) {
+                (Some(open), Some(close)) if open < close => {
+                    let head = item[..open].trim().trim_end_matches("::");
+                    let joined = if head.is_empty() {
+                        prefix.to_owned()
+                    } else {
+                        format!("{prefix}{head}::")
+                    };
+                    expand(&item[open + 1..close], &joined, out);
+                }
+                _ => out.push(format!("{prefix}{item}")),
+            }
+        }
+    }
+    let mut out = Vec::new();
+    let mut offset = 0;
+    let mut pending: Option<(String, usize)> = None;
+    for line in source.split_inclusive('\n') {
+        let code = line.split("//").next().unwrap_or_default();
+        let at = offset;
+        offset += line.len();
+        let (text, start) = match pending.take() {
+            Some((mut text, start)) => {
+                text.push_str(code);
+                (text, start)
+            }
+            None => match code.trim_start().strip_prefix("#import") {
+                Some(rest) => (rest.to_owned(), at + (code.len() - code.trim_start().len())),
+                None => continue,
+            },
+        };
+        if text.matches('{').count() > text.matches('}').count() {
+            pending = Some((text, start));
+            continue;
+        }
+        let mut paths = Vec::new();
+        expand(text.trim().trim_end_matches(';'), "", &mut paths);
+        out.extend(paths.into_iter().map(|p| (p, start)));
+    }
+    out
+}
+
+/// Where `#import <module>` is written in `source` (the module name's bytes), if it is.
+fn import_site(source: &str, module: &str) -> std::ops::Range<usize> {
+    let mut offset = 0;
+    for line in source.split_inclusive('\n') {
+        if let Some(rest) = line.trim_start().strip_prefix("#import")
+            && let Some(i) = rest.find(module)
+        {
+            let at = offset + (line.len() - rest.len()) + i;
+            return at..at + module.len();
+        }
+        offset += line.len();
+    }
+    0..0
+}
+
+/// Adds `(file, source)` modules to `composer` so that every module comes after those it imports.
+fn add_modules(
+    composer: &mut Composer,
+    sources: Vec<(String, Arc<str>)>,
+) -> Result<(), ShaderError> {
+    let mut by_name: HashMap<String, usize> = HashMap::new();
+    let mut deps: Vec<Vec<String>> = Vec::new();
+    for (i, (file, source)) in sources.iter().enumerate() {
+        let (name, imports, _) = get_preprocessor_data(source);
+        let name = name.unwrap_or_default();
+        if let Some(&j) = by_name.get(&name) {
+            let d = Diagnostic::new(
+                DiagnosticKind::DuplicateModule,
+                file.clone(),
+                format!("`{name}` is also defined in {}", sources[j].0),
+            )
+            .with_span(source.clone(), import_site_define(source));
+            return Err(ShaderError::Source(Box::new(d)));
+        }
+        by_name.insert(name, i);
+        deps.push(imports.into_iter().map(|d| d.import).collect());
+    }
+    // Resolve each import to a module of this batch (the longest matching prefix).
+    let resolve = |import: &str| -> Option<usize> {
+        let mut candidate = import;
+        loop {
+            if let Some(&i) = by_name.get(candidate) {
+                return Some(i);
+            }
+            candidate = candidate.rsplit_once("::")?.0;
+        }
+    };
+    let n = sources.len();
+    let mut state = vec![0u8; n]; // 0 new, 1 on stack, 2 done
+    let mut order = Vec::with_capacity(n);
+    fn visit(
+        i: usize,
+        deps: &[Vec<String>],
+        resolve: &dyn Fn(&str) -> Option<usize>,
+        state: &mut [u8],
+        stack: &mut Vec<(usize, String)>,
+        order: &mut Vec<usize>,
+    ) -> Result<(), (usize, Vec<(usize, String)>)> {
+        state[i] = 1;
+        for import in &deps[i] {
+            let Some(j) = resolve(import) else { continue };
+            stack.push((i, import.clone()));
+            match state[j] {
+                1 => return Err((j, stack.clone())),
+                0 => visit(j, deps, resolve, state, stack, order)?,
+                _ => {}
+            }
+            stack.pop();
+        }
+        state[i] = 2;
+        order.push(i);
+        Ok(())
+    }
+    for i in 0..n {
+        if state[i] == 0 {
+            let mut stack = Vec::new();
+            if let Err((start, stack)) =
+                visit(i, &deps, &resolve, &mut state, &mut stack, &mut order)
+            {
+                let cycle: Vec<&(usize, String)> =
+                    stack.iter().skip_while(|(m, _)| *m != start).collect();
+                let (first, import) = cycle[0];
+                let names: Vec<String> = cycle
+                    .iter()
+                    .map(|(m, _)| registry::define_import_path(&sources[*m].1).unwrap_or_default())
+                    .chain(registry::define_import_path(&sources[start].1))
+                    .collect();
+                let (file, source) = &sources[*first];
+                let d = Diagnostic::new(
+                    DiagnosticKind::ImportCycle,
+                    file.clone(),
+                    format!("import cycle: {}", names.join(" -> ")),
+                )
+                .with_span(
+                    source.clone(),
+                    import_site(source, module_prefix_of(import, &by_name)),
+                )
+                .with_label("this import closes the cycle")
+                .with_hint("move what both modules need into a third module that imports neither");
+                return Err(ShaderError::Source(Box::new(d)));
+            }
+        }
+    }
+    for i in order {
+        let (file, source) = &sources[i];
+        let name = registry::define_import_path(source).unwrap_or_default();
+        if composer.contains_module(&name) {
+            continue;
+        }
+        let added = composer.add_composable_module(ComposableModuleDescriptor {
+            source,
+            file_path: file,
+            language: ShaderLanguage::Wgsl,
+            ..Default::default()
+        });
+        if let Err(e) = added {
+            return Err(ShaderError::Source(Box::new(from_composer_error(
+                &e, composer, None,
+            ))));
+        }
+    }
+    Ok(())
+}
+
+fn module_prefix_of<'a>(import: &'a str, by_name: &HashMap<String, usize>) -> &'a str {
+    let mut candidate = import;
+    while !by_name.contains_key(candidate) {
+        match candidate.rsplit_once("::") {
+            Some((head, _)) => candidate = head,
+            None => return import,
+        }
+    }
+    candidate
+}
+
+fn import_site_define(source: &str) -> std::ops::Range<usize> {
+    source
+        .find("#define_import_path")
+        .map(|i| i..i + "#define_import_path".len())
+        .unwrap_or(0..0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::declared_imports;
+
+    #[test]
+    fn declared_imports_expand_nested_lists_and_aliases() {
+        let src = "// header\n#import a::b::item\n#import c::{d, e::{f, g} , h as k}\n  #import m as n // trailing\nfn x() {}\n";
+        let paths: Vec<String> = declared_imports(src).into_iter().map(|(p, _)| p).collect();
+        assert_eq!(
+            paths,
+            ["a::b::item", "c::d", "c::e::f", "c::e::g", "c::h", "m"]
+        );
+    }
+
+    #[test]
+    fn multi_line_import_is_one_statement() {
+        let src = "#import lodkit::{\n  fullscreen,\n  normal_distance,\n}\n";
+        let got = declared_imports(src);
+        assert_eq!(got.len(), 2);
+        assert!(got.iter().all(|(_, at)| *at == 0));
+    }
+}

@@ -1,0 +1,327 @@
+//! The embedded shader library: every file under `shader_lib/`, described from its own source.
+
+use std::sync::OnceLock;
+
+/// `(path relative to shader_lib/, source)` for every `.wgsl` and `.glsl` file, sorted by path.
+static FILES: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/shader_lib.rs"));
+
+/// Shading language of a library file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Language {
+    /// WGSL, composed with naga_oil (`#import lodkit::<topic>`).
+    Wgsl,
+    /// GLSL 450, included textually (`#include "lodkit/<topic>.glsl"`).
+    Glsl,
+}
+
+/// What a library file is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModuleKind {
+    /// An importable module (`shader_lib/wgsl/lodkit/*.wgsl` or its GLSL twin).
+    Module,
+    /// A complete entry-point shader built from modules (`shader_lib/passes/`).
+    Pass,
+}
+
+/// A function a module exports.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct FunctionInfo {
+    /// Name as written in the source (`lodkit_`-prefixed in GLSL twins).
+    pub name: String,
+    /// The declaration up to the opening brace, e.g. `fn f(a: f32) -> f32`.
+    pub signature: String,
+    /// The `///` doc comment above the function, lines joined by spaces.
+    pub doc: String,
+}
+
+/// A shader def a module reads (`#ifdef NAME`, `#if NAME == ...`, `#{NAME}`).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct ShaderDefInfo {
+    /// Name of the def.
+    pub name: String,
+    /// What the file header says about it (type, default, meaning); empty when undocumented.
+    pub doc: String,
+}
+
+/// One embedded file of the shader library, described from its own source.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ModuleInfo {
+    /// Path relative to `shader_lib/`, e.g. `wgsl/lodkit/normal_distance.wgsl`.
+    pub path: &'static str,
+    /// Language of the file.
+    pub language: Language,
+    /// Module or complete pass.
+    pub kind: ModuleKind,
+    /// `lodkit::<topic>` for modules and their GLSL twins; `None` for passes.
+    pub import_path: Option<String>,
+    /// Path to `#include` for GLSL twins (`lodkit/<topic>.glsl`); `None` otherwise.
+    pub include_path: Option<String>,
+    /// First line of the header, after the module name.
+    pub summary: String,
+    /// Functions defined at file scope, in source order.
+    pub functions: Vec<FunctionInfo>,
+    /// Constants defined at file scope, in source order.
+    pub constants: Vec<String>,
+    /// Shader defs the file reads.
+    pub shader_defs: Vec<ShaderDefInfo>,
+    /// The whole source text.
+    #[serde(skip)]
+    pub source: &'static str,
+}
+
+impl ModuleInfo {
+    /// Looks up an exported function by name.
+    pub fn function(&self, name: &str) -> Option<&FunctionInfo> {
+        self.functions.iter().find(|f| f.name == name)
+    }
+}
+
+/// Every file of the shader library, described: modules by import path (each WGSL module followed
+/// by its GLSL twin), then passes. Parsed once, on first use.
+pub fn modules() -> &'static [ModuleInfo] {
+    static MODULES: OnceLock<Vec<ModuleInfo>> = OnceLock::new();
+    MODULES.get_or_init(|| {
+        let mut all: Vec<ModuleInfo> = FILES
+            .iter()
+            .map(|(path, src)| describe(path, src))
+            .collect();
+        all.sort_by_key(|m| {
+            (
+                m.kind == ModuleKind::Pass,
+                m.import_path.clone(),
+                m.language == Language::Glsl,
+                m.path,
+            )
+        });
+        all
+    })
+}
+
+/// The WGSL module with import path `import_path` (e.g. `lodkit::normal_distance`).
+pub fn find_module(import_path: &str) -> Option<&'static ModuleInfo> {
+    modules().iter().find(|m| {
+        m.language == Language::Wgsl
+            && m.kind == ModuleKind::Module
+            && m.import_path.as_deref() == Some(import_path)
+    })
+}
+
+/// The GLSL twin whose include path is `include_path` (e.g. `lodkit/normal_distance.glsl`).
+pub fn find_glsl_include(include_path: &str) -> Option<&'static ModuleInfo> {
+    modules()
+        .iter()
+        .find(|m| m.include_path.as_deref() == Some(include_path))
+}
+
+/// The GLSL twin of a WGSL module (same topic), if there is one.
+pub fn glsl_twin(wgsl: &ModuleInfo) -> Option<&'static ModuleInfo> {
+    let topic = wgsl.import_path.as_deref()?.strip_prefix("lodkit::")?;
+    find_glsl_include(&format!("lodkit/{topic}.glsl"))
+}
+
+/// Import paths of all WGSL modules, sorted.
+pub fn import_paths() -> Vec<&'static str> {
+    modules()
+        .iter()
+        .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
+        .filter_map(|m| m.import_path.as_deref())
+        .collect()
+}
+
+fn describe(path: &'static str, source: &'static str) -> ModuleInfo {
+    let language = if path.ends_with(".glsl") {
+        Language::Glsl
+    } else {
+        Language::Wgsl
+    };
+    let kind = if path.starts_with("passes/") {
+        ModuleKind::Pass
+    } else {
+        ModuleKind::Module
+    };
+    let stem = path
+        .rsplit('/')
+        .next()
+        .and_then(|f| f.split('.').next())
+        .unwrap_or_default();
+    let (import_path, include_path) = match (kind, language) {
+        (ModuleKind::Pass, _) => (None, None),
+        (ModuleKind::Module, Language::Wgsl) => (define_import_path(source), None),
+        (ModuleKind::Module, Language::Glsl) => (
+            Some(format!("lodkit::{stem}")),
+            path.strip_prefix("glsl/").map(str::to_owned),
+        ),
+    };
+    let header = header_lines(source);
+    let summary = header
+        .first()
+        .map(|l| match l.split_once(" — ") {
+            Some((_, rest)) => rest.trim().to_owned(),
+            None => l.trim().to_owned(),
+        })
+        .unwrap_or_default();
+    let guard = format!("LODKIT_{}_GLSL", stem.to_ascii_uppercase());
+    let shader_defs = used_shader_defs(source)
+        .into_iter()
+        .filter(|d| *d != guard)
+        .map(|name| ShaderDefInfo {
+            doc: header_def_doc(&header, &name),
+            name,
+        })
+        .collect();
+    ModuleInfo {
+        path,
+        language,
+        kind,
+        import_path,
+        include_path,
+        summary,
+        functions: functions(source, language),
+        constants: constants(source, language),
+        shader_defs,
+        source,
+    }
+}
+
+/// The name after `#define_import_path`, if the source declares one.
+pub(crate) fn define_import_path(source: &str) -> Option<String> {
+    source.lines().find_map(|l| {
+        l.trim()
+            .strip_prefix("#define_import_path")
+            .map(|rest| rest.trim().to_owned())
+            .filter(|s| !s.is_empty())
+    })
+}
+
+/// The leading `//` comment block, without the slashes.
+fn header_lines(source: &str) -> Vec<&str> {
+    source
+        .lines()
+        .take_while(|l| l.starts_with("//"))
+        .map(|l| l.trim_start_matches('/').strip_prefix(' ').unwrap_or(""))
+        .collect()
+}
+
+/// What the header's `Shader defs:` section says about `name`.
+fn header_def_doc(header: &[&str], name: &str) -> String {
+    let Some(start) = header.iter().position(|l| l.starts_with("Shader defs:")) else {
+        return String::new();
+    };
+    header[start..]
+        .iter()
+        .map(|l| l.trim_start_matches("Shader defs:").trim())
+        .find_map(|l| l.strip_prefix(name).map(|rest| rest.trim().to_owned()))
+        .unwrap_or_default()
+}
+
+/// Shader defs the source tests or substitutes, in order of first use.
+pub(crate) fn used_shader_defs(source: &str) -> Vec<String> {
+    let mut defs: Vec<String> = Vec::new();
+    let mut push = |name: &str| {
+        if !name.is_empty() && !defs.iter().any(|d| d == name) {
+            defs.push(name.to_owned());
+        }
+    };
+    for line in source.lines() {
+        let t = line.trim_start();
+        let t = t.strip_prefix("#else").map(str::trim_start).unwrap_or(t);
+        for directive in ["#ifdef", "#ifndef", "#if"] {
+            if let Some(rest) = t.strip_prefix(directive) {
+                if rest.starts_with(char::is_whitespace) {
+                    push(identifier(rest.trim_start()));
+                }
+                break;
+            }
+        }
+        let mut rest = line;
+        while let Some(i) = rest.find("#{") {
+            let after = &rest[i + 2..];
+            let end = after.find('}').unwrap_or(after.len());
+            push(after[..end].trim());
+            rest = &after[end..];
+        }
+    }
+    defs
+}
+
+fn identifier(s: &str) -> &str {
+    let end = s
+        .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .unwrap_or(s.len());
+    &s[..end]
+}
+
+/// `///` lines directly above line `index`, joined.
+fn doc_above(lines: &[&str], index: usize) -> String {
+    let mut doc: Vec<&str> = lines[..index]
+        .iter()
+        .rev()
+        .skip_while(|l| l.trim_start().starts_with('@'))
+        .take_while(|l| l.trim_start().starts_with("///"))
+        .map(|l| l.trim_start().trim_start_matches('/').trim())
+        .collect();
+    doc.reverse();
+    doc.join(" ")
+}
+
+fn functions(source: &str, language: Language) -> Vec<FunctionInfo> {
+    let lines: Vec<&str> = source.lines().collect();
+    let mut out = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let name = match language {
+            Language::Wgsl => line
+                .strip_prefix("fn ")
+                .map(|rest| identifier(rest.trim_start())),
+            Language::Glsl => glsl_function_name(line),
+        };
+        let Some(name) = name.filter(|n| !n.is_empty()) else {
+            continue;
+        };
+        let mut signature = String::new();
+        for l in &lines[i..] {
+            let part = l.split('{').next().unwrap_or_default();
+            signature.push_str(part.trim());
+            signature.push(' ');
+            if l.contains('{') || l.contains(';') {
+                break;
+            }
+        }
+        out.push(FunctionInfo {
+            name: name.to_owned(),
+            signature: signature.trim().to_owned(),
+            doc: doc_above(&lines, i),
+        });
+    }
+    out
+}
+
+/// `name` for a file-scope GLSL function definition `type name(...)` starting at column 0.
+fn glsl_function_name(line: &str) -> Option<&str> {
+    if line.starts_with(char::is_whitespace) || line.starts_with('#') || line.starts_with("//") {
+        return None;
+    }
+    let open = line.find('(')?;
+    let mut words = line[..open].split_whitespace();
+    let (ty, name) = (words.next()?, words.next()?);
+    let keyword = matches!(
+        ty,
+        "return" | "if" | "for" | "while" | "struct" | "layout" | "const"
+    );
+    (!keyword && words.next().is_none()).then_some(name)
+}
+
+fn constants(source: &str, language: Language) -> Vec<String> {
+    source
+        .lines()
+        .filter_map(|l| {
+            let rest = l.strip_prefix("const ")?;
+            let name = match language {
+                Language::Wgsl => identifier(rest),
+                Language::Glsl => identifier(rest.split_whitespace().nth(1)?),
+            };
+            Some(name.to_owned())
+        })
+        .collect()
+}
