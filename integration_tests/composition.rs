@@ -415,3 +415,23 @@ fn add_to_composer_lets_a_foreign_composer_import_lodkit() {
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
     assert_eq!(module.entry_points.len(), 2);
 }
+
+#[test]
+fn rust_uniform_mirrors_match_the_wgsl_layout() {
+    use lodkit::gpu::scene::{CameraUniform, DrawUniform};
+    let pass = shaders::find_pass_source("lod_mesh").unwrap();
+    let composed = compose(pass, "lod_mesh.wgsl", SourceLanguage::Wgsl);
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(composed.module.to_ctx()).unwrap();
+    let size_of = |name: &str| {
+        let (handle, _) = composed
+            .module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no struct {name}"));
+        layouter[handle].size as usize
+    };
+    assert_eq!(size_of("Camera"), std::mem::size_of::<CameraUniform>());
+    assert_eq!(size_of("Draw"), std::mem::size_of::<DrawUniform>());
+}

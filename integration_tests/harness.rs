@@ -155,20 +155,32 @@ void main() {{
 
 /// Runs the WGSL probe over `cases` (flattened input words) and returns the output words.
 pub fn run_wgsl(gpu: &GpuContext, probe: &Probe, cases: &[u32]) -> Vec<u32> {
-    let source = wgsl_probe(probe);
-    run(gpu, probe, cases, &source, SourceLanguage::Wgsl)
+    run_with(gpu, probe, cases, SourceLanguage::Wgsl, &[])
 }
 
 /// Runs the GLSL probe (the GLSL twins) over `cases`.
 pub fn run_glsl(gpu: &GpuContext, probe: &Probe, cases: &[u32]) -> Vec<u32> {
-    let source = glsl_probe(probe);
-    run(
-        gpu,
-        probe,
-        cases,
-        &source,
-        SourceLanguage::Glsl(naga::ShaderStage::Compute),
-    )
+    let glsl = SourceLanguage::Glsl(naga::ShaderStage::Compute);
+    run_with(gpu, probe, cases, glsl, &[])
+}
+
+/// Runs the probe in `language` with the boolean shader defs `defs` switched on.
+pub fn run_with(
+    gpu: &GpuContext,
+    probe: &Probe,
+    cases: &[u32],
+    language: SourceLanguage,
+    defs: &[&str],
+) -> Vec<u32> {
+    let source = match language {
+        SourceLanguage::Wgsl => wgsl_probe(probe),
+        SourceLanguage::Glsl(_) => glsl_probe(probe),
+    };
+    let shader_defs = defs
+        .iter()
+        .map(|d| (d.to_string(), lodkit::shaders::ShaderDefValue::Bool(true)))
+        .collect();
+    run(gpu, probe, cases, &source, language, shader_defs)
 }
 
 fn run(
@@ -177,6 +189,7 @@ fn run(
     cases: &[u32],
     source: &str,
     language: SourceLanguage,
+    shader_defs: lodkit::shaders::ShaderDefs,
 ) -> Vec<u32> {
     assert_eq!(
         cases.len() % probe.inputs,
@@ -190,7 +203,7 @@ fn run(
             source,
             file_path: "probe",
             language,
-            ..Default::default()
+            shader_defs,
         })
         .unwrap_or_else(|e| panic!("probe does not compose:\n{}\n{source}", render(&e)));
     let device = &gpu.device;
@@ -236,7 +249,7 @@ fn run(
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(n as u32, 1, 1);
     }
-    let bytes = crate::readback::read_buffer(gpu, encoder, &output, size);
+    let bytes = lodkit::gpu::readback::read_buffer(gpu, encoder, &output, size);
     bytemuck::cast_slice(&bytes).to_vec()
 }
 

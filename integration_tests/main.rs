@@ -6,4 +6,5 @@ mod harness;
 mod cli;
 mod composition;
 mod gpu_twins;
-mod readback;
+mod selection;
+mod single_frame;

@@ -6,7 +6,12 @@
 //!
 //! - [`shaders`]: the embedded module library, composition of your shaders that
 //!   `#import lodkit::...` (or `#include "lodkit/....glsl"`), validation and export.
+//! - [`select`]: which LOD to draw (view-normalized distance, bias, hysteresis, max distance,
+//!   distance- or time-driven transitions), per instance or over batches, configurable in RON.
+//! - [`unpopping`], [`screen_door`]: single-frame transitions without popping (Giegl & Wimmer's
+//!   unpopping render states; complementary screen-door dither).
 //! - [`normal_distance`], [`fullscreen`]: Rust twins of the shader functions of the same names.
+//! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
 //! - [`gpu`] (feature `wgpu`): headless devices and ready-made passes.
 //!
 //! Every pure shader function has a Rust twin with the same name; tests hold the GPU result
@@ -15,8 +20,12 @@
 #![warn(missing_docs)]
 
 pub mod fullscreen;
+pub mod noise;
 pub mod normal_distance;
+pub mod screen_door;
+pub mod select;
 pub mod shaders;
+pub mod unpopping;
 
 #[cfg(feature = "wgpu")]
 pub mod gpu;

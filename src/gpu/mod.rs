@@ -1,5 +1,10 @@
-//! wgpu glue (feature `wgpu`): headless devices, and the passes and buffers of each technique.
+//! wgpu glue (feature `wgpu`): headless devices, readback, and the passes and render states of
+//! each technique.
 
 mod context;
+pub mod readback;
+pub mod scene;
+pub mod transition_scene;
+pub mod unpopping;
 
 pub use context::{GpuContext, GpuError, GpuOptions};

@@ -32,6 +32,12 @@ pub use registry::{
     glsl_twin, import_paths, modules,
 };
 
+/// Source of the pass `shader_lib/passes/<name>.wgsl`, if there is one.
+pub fn find_pass_source(name: &str) -> Option<&'static str> {
+    let path = format!("passes/{name}.wgsl");
+    modules().iter().find(|m| m.path == path).map(|m| m.source)
+}
+
 /// Everything that can go wrong composing, validating or exporting a shader.
 #[derive(Debug, thiserror::Error)]
 pub enum ShaderError {

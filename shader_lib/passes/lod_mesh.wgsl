@@ -1,0 +1,59 @@
+// passes/lod_mesh — a lit mesh drawn as one LOD of a transition: what an engine's forward shader
+// needs for screen-door LOD blending, and the opaque/blended draws of unpopping.
+//
+// The vertex stage transforms by camera and model matrices; the fragment stage shades with one
+// directional light and, when `draw.dither_alpha` is not DITHER_OFF, keeps only the pixels the
+// screen-door pattern gives this LOD (lodkit::screen_door; negative alpha = inverted pattern).
+// Alpha blending for unpopping and cross-fades uses the blend constant, so the shader is the same
+// for every role (lodkit::gpu::unpopping::lod_blend).
+//
+// Entry points:
+//   vs_main   @location(0) position, @location(1) normal (object space)
+//   fs_main   @location(0) color (rgb lit, a = draw.color.a)
+// Bindings: group 0 binding 0 `camera: Camera` (uniform); group 1 binding 0 `draw: Draw`
+// (uniform, dynamic offset).
+// Shader defs: LODKIT_SCREEN_DOOR_BLUE_NOISE (bool, default off) — passed on to lodkit::screen_door.
+#import lodkit::screen_door::screen_door_keep
+
+/// Per-view data.
+struct Camera {
+    view_proj: mat4x4<f32>,
+    /// World-space direction toward the light (w unused).
+    light_dir: vec4<f32>,
+}
+
+/// Per-draw data.
+struct Draw {
+    model: mat4x4<f32>,
+    color: vec4<f32>,
+    /// Screen-door alpha of this LOD, or DITHER_OFF (any value > 1) for no dithering.
+    dither_alpha: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+@group(1) @binding(0) var<uniform> draw: Draw;
+
+struct VertexOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) normal: vec3<f32>,
+}
+
+/// Transforms a vertex to clip space and its normal to world space.
+@vertex
+fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
+    let world = draw.model * vec4<f32>(position, 1.0);
+    return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz);
+}
+
+/// Lambert shading; screen-door discard when dithering is on.
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    if (draw.dither_alpha <= 1.0 && !screen_door_keep(in.position.xy, draw.dither_alpha)) {
+        discard;
+    }
+    let lambert = max(dot(normalize(in.normal), normalize(camera.light_dir.xyz)), 0.0);
+    return vec4<f32>(draw.color.rgb * (0.35 + 0.65 * lambert), draw.color.a);
+}

@@ -1,0 +1,358 @@
+//! A small mesh renderer for the examples, tests and demo: procedural meshes and
+//! `passes/lod_mesh.wgsl` drawn opaque, blended (unpopping, cross-fade) or screen-door dithered.
+//! It is the reference for what an engine's own forward pass needs, not a scene graph.
+
+use std::f32::consts::{PI, TAU};
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3, Vec4};
+use wgpu::util::DeviceExt;
+
+use super::GpuContext;
+use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
+use crate::shaders::{ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source};
+use crate::unpopping::LodRenderState;
+
+/// Depth format of [`RenderTarget`].
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// Color format of [`RenderTarget`].
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// `dither_alpha` meaning "no screen door".
+pub const DITHER_OFF: f32 = 2.0;
+
+/// Triangle mesh: interleaved position and normal, 32-bit indices.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// `[px, py, pz, nx, ny, nz]` per vertex.
+    pub vertices: Vec<[f32; 6]>,
+    /// Counter-clockwise triangles.
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    /// A unit-radius UV sphere; few segments make a coarse LOD.
+    pub fn sphere(rings: u32, segments: u32) -> Self {
+        let (rings, segments) = (rings.max(2), segments.max(3));
+        let mut m = Mesh::default();
+        for r in 0..=rings {
+            let theta = PI * r as f32 / rings as f32;
+            for s in 0..=segments {
+                let phi = TAU * s as f32 / segments as f32;
+                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                m.vertices.push([n.x, n.y, n.z, n.x, n.y, n.z]);
+            }
+        }
+        let row = segments + 1;
+        for r in 0..rings {
+            for s in 0..segments {
+                let (a, b) = (r * row + s, (r + 1) * row + s);
+                m.indices.extend([a, a + 1, b, b, a + 1, b + 1]);
+            }
+        }
+        m
+    }
+
+    /// An axis-aligned cube from -1 to 1 with flat normals.
+    pub fn cube() -> Self {
+        let mut m = Mesh::default();
+        for axis in 0..3 {
+            for sign in [-1.0f32, 1.0] {
+                let mut n = [0.0; 3];
+                n[axis] = sign;
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let base = m.vertices.len() as u32;
+                for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    let mut p = [0.0; 3];
+                    p[axis] = sign;
+                    p[u] = a;
+                    p[v] = b;
+                    m.vertices.push([p[0], p[1], p[2], n[0], n[1], n[2]]);
+                }
+                if sign > 0.0 {
+                    m.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+                } else {
+                    m.indices.extend([base, base + 2, base + 1, base, base + 3, base + 2]);
+                }
+            }
+        }
+        m
+    }
+
+    /// Number of triangles.
+    pub fn triangles(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+/// A mesh on the GPU.
+#[derive(Debug)]
+pub struct GpuMesh {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    count: u32,
+}
+
+/// Rust mirror of `Camera` in `passes/lod_mesh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CameraUniform {
+    /// Projection x view.
+    pub view_proj: [[f32; 4]; 4],
+    /// World-space direction toward the light.
+    pub light_dir: [f32; 4],
+}
+
+/// Rust mirror of `Draw` in `passes/lod_mesh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct DrawUniform {
+    /// Object to world.
+    pub model: [[f32; 4]; 4],
+    /// Base color (rgb) and output alpha.
+    pub color: [f32; 4],
+    /// Screen-door alpha, or [`DITHER_OFF`].
+    pub dither_alpha: f32,
+    /// Padding to the WGSL struct's size.
+    pub pad: [f32; 3],
+}
+
+/// One draw: a mesh, where, its color, and how it takes part in a transition.
+#[derive(Clone, Copy, Debug)]
+pub struct DrawItem<'a> {
+    /// The mesh.
+    pub mesh: &'a GpuMesh,
+    /// Object to world.
+    pub model: Mat4,
+    /// Base color.
+    pub color: Vec4,
+    /// Opaque, or blended with depth test and no writes (unpopping, cross-fade).
+    pub state: LodRenderState,
+    /// Screen-door alpha (negative = inverted pattern), if dithered.
+    pub dither_alpha: Option<f32>,
+}
+
+/// A color and depth target of one size.
+#[derive(Debug)]
+pub struct RenderTarget {
+    /// RGBA8 color, copyable.
+    pub color: wgpu::Texture,
+    /// Depth32Float.
+    pub depth: wgpu::Texture,
+}
+
+impl RenderTarget {
+    /// Allocates both textures.
+    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
+        let make = |format, usage, label| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let color_usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::TEXTURE_BINDING;
+        Self {
+            color: make(COLOR_FORMAT, color_usage, "scene color"),
+            depth: make(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT, "scene depth"),
+        }
+    }
+}
+
+/// Draws [`DrawItem`]s with `passes/lod_mesh.wgsl`.
+#[derive(Debug)]
+pub struct MeshRenderer {
+    opaque: wgpu::RenderPipeline,
+    blended: wgpu::RenderPipeline,
+    camera: wgpu::Buffer,
+    camera_group: wgpu::BindGroup,
+    draws: wgpu::Buffer,
+    draw_group: wgpu::BindGroup,
+    stride: u64,
+    capacity: usize,
+}
+
+impl MeshRenderer {
+    /// Most draws one [`render`](Self::render) call takes.
+    pub const MAX_DRAWS: usize = 256;
+
+    /// Builds the pipelines (`blue_noise` selects the screen-door pattern).
+    pub fn new(gpu: &GpuContext, blue_noise: bool) -> Result<Self, ShaderError> {
+        let mut library = ShaderLibrary::new()?;
+        let mut defs = std::collections::HashMap::new();
+        if blue_noise {
+            defs.insert("LODKIT_SCREEN_DOOR_BLUE_NOISE".to_owned(), ShaderDefValue::Bool(true));
+        }
+        let composed = library.compose(&ComposeDescriptor {
+            source: find_pass_source("lod_mesh").unwrap_or_default(),
+            file_path: "shader_lib/passes/lod_mesh.wgsl",
+            shader_defs: defs,
+            ..Default::default()
+        })?;
+        let module = gpu.shader_module("lod_mesh", &composed);
+        let device = &gpu.device;
+        let stride = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(std::mem::size_of::<DrawUniform>() as u64);
+        let uniform_layout = |dynamic| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: None,
+                entries: &[wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: dynamic,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                }],
+            })
+        };
+        let (camera_layout, draw_layout) = (uniform_layout(false), uniform_layout(true));
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lod_mesh"),
+            bind_group_layouts: &[Some(&camera_layout), Some(&draw_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |state: LodRenderState| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("lod_mesh"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: 24,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                    })],
+                },
+                primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
+                depth_stencil: Some(lod_depth_stencil(&state, DEPTH_FORMAT, wgpu::CompareFunction::Less)),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: COLOR_FORMAT,
+                        blend: lod_blend(&state),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let opaque_state = LodRenderState { alpha: 1.0, depth_test: true, depth_write: true, blend: false };
+        let blended_state = LodRenderState { alpha: 0.5, depth_test: true, depth_write: false, blend: true };
+        let camera = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("camera"),
+            size: std::mem::size_of::<CameraUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let draws = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("draws"),
+            size: stride * Self::MAX_DRAWS as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group = |layout, buffer: &wgpu::Buffer, size| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(size),
+                    }),
+                }],
+            })
+        };
+        Ok(Self {
+            opaque: pipeline(opaque_state),
+            blended: pipeline(blended_state),
+            camera_group: group(&camera_layout, &camera, std::mem::size_of::<CameraUniform>() as u64),
+            draw_group: group(&draw_layout, &draws, std::mem::size_of::<DrawUniform>() as u64),
+            camera,
+            draws,
+            stride,
+            capacity: Self::MAX_DRAWS,
+        })
+    }
+
+    /// Uploads a mesh.
+    pub fn upload(&self, gpu: &GpuContext, mesh: &Mesh) -> GpuMesh {
+        let make = |contents: &[u8], usage| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage })
+        };
+        GpuMesh {
+            vertices: make(bytemuck::cast_slice(&mesh.vertices), wgpu::BufferUsages::VERTEX),
+            indices: make(bytemuck::cast_slice(&mesh.indices), wgpu::BufferUsages::INDEX),
+            count: mesh.indices.len() as u32,
+        }
+    }
+
+    /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]; the
+    /// rest are dropped), lit from `light_dir`.
+    pub fn render(&self, gpu: &GpuContext, target: &RenderTarget, clear: wgpu::Color, view_proj: Mat4, light_dir: Vec3, items: &[DrawItem]) {
+        let items = &items[..items.len().min(self.capacity)];
+        let camera = CameraUniform { view_proj: view_proj.to_cols_array_2d(), light_dir: light_dir.extend(0.0).to_array() };
+        gpu.queue.write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+        let mut data = vec![0u8; self.stride as usize * items.len()];
+        for (i, item) in items.iter().enumerate() {
+            let u = DrawUniform {
+                model: item.model.to_cols_array_2d(),
+                color: item.color.to_array(),
+                dither_alpha: item.dither_alpha.unwrap_or(DITHER_OFF),
+                pad: [0.0; 3],
+            };
+            let at = i * self.stride as usize;
+            data[at..at + std::mem::size_of::<DrawUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        if !data.is_empty() {
+            gpu.queue.write_buffer(&self.draws, 0, &data);
+        }
+        let color_view = target.color.create_view(&Default::default());
+        let depth_view = target.depth.create_view(&Default::default());
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("lod_mesh"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &color_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, &self.camera_group, &[]);
+            for (i, item) in items.iter().enumerate() {
+                pass.set_pipeline(if item.state.blend { &self.blended } else { &self.opaque });
+                pass.set_blend_constant(lod_blend_constant(&item.state));
+                pass.set_bind_group(1, &self.draw_group, &[(i as u64 * self.stride) as u32]);
+                pass.set_vertex_buffer(0, item.mesh.vertices.slice(..));
+                pass.set_index_buffer(item.mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..item.mesh.count, 0, 0..1);
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
+}

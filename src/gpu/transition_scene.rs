@@ -1,0 +1,185 @@
+//! A reference scene for single-frame LOD transitions: an object with two LODs (a fine sphere and
+//! a coarse one) in front of a contrasting object, rendered at any point of a transition with any
+//! technique. The examples, the tests and the demo measure the techniques on it.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::GpuContext;
+use super::readback::read_texture_rgba8;
+use super::scene::{DrawItem, GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use crate::screen_door::DitherPattern;
+use crate::select::LodSelection;
+use crate::shaders::ShaderError;
+use crate::unpopping::{LodRenderState, LodRole, TransitionPlan, cross_fade_plan, unpopping_plan};
+
+/// How a single-frame transition is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SingleFrameTechnique {
+    /// The new LOD replaces the old at t = 0.5.
+    HardSwitch,
+    /// Conventional (1 - t, t) alpha cross-fade, no depth writes.
+    CrossFade,
+    /// Complementary screen-door dither (DigitalRune).
+    Dither(DitherPattern),
+    /// Giegl & Wimmer's unpopping.
+    Unpopping,
+}
+
+impl SingleFrameTechnique {
+    /// Every technique, for comparisons.
+    pub const ALL: [SingleFrameTechnique; 5] = [
+        Self::HardSwitch,
+        Self::CrossFade,
+        Self::Dither(DitherPattern::Bayer4x4),
+        Self::Dither(DitherPattern::BlueNoise16x16),
+        Self::Unpopping,
+    ];
+
+    /// Short name for tables and file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::HardSwitch => "hard-switch",
+            Self::CrossFade => "cross-fade",
+            Self::Dither(DitherPattern::Bayer4x4) => "dither-bayer",
+            Self::Dither(DitherPattern::BlueNoise16x16) => "dither-blue-noise",
+            Self::Unpopping => "unpopping",
+        }
+    }
+}
+
+/// Color of the fine LOD (no red, so any red in its pixels came from behind).
+pub const FINE_COLOR: Vec4 = Vec4::new(0.0, 0.9, 0.3, 1.0);
+/// Color of the coarse LOD.
+pub const COARSE_COLOR: Vec4 = Vec4::new(0.0, 0.45, 1.0, 1.0);
+/// Color of the object behind (pure red).
+pub const BACKDROP_COLOR: Vec4 = Vec4::new(1.0, 0.0, 0.0, 1.0);
+
+const OPAQUE: LodRenderState = LodRenderState { alpha: 1.0, depth_test: true, depth_write: true, blend: false };
+
+/// The scene, on the GPU, ready to render at any t.
+#[derive(Debug)]
+pub struct TransitionScene {
+    renderers: [MeshRenderer; 2],
+    fine: GpuMesh,
+    coarse: GpuMesh,
+    backdrop: GpuMesh,
+    target: RenderTarget,
+    size: (u32, u32),
+}
+
+/// Which parts of the scene to draw.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneParts {
+    /// Backdrop and the LOD object in transition.
+    All,
+    /// Only the fine LOD, opaque (for masks).
+    FineOnly,
+    /// Only the coarse LOD, opaque (for masks).
+    CoarseOnly,
+}
+
+impl TransitionScene {
+    /// Builds meshes, pipelines and a `width` x `height` target.
+    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, ShaderError> {
+        let bayer = MeshRenderer::new(gpu, false)?;
+        let blue = MeshRenderer::new(gpu, true)?;
+        let fine = bayer.upload(gpu, &Mesh::sphere(24, 48));
+        let coarse = bayer.upload(gpu, &Mesh::sphere(3, 6));
+        let backdrop = bayer.upload(gpu, &Mesh::cube());
+        Ok(Self {
+            renderers: [bayer, blue],
+            fine,
+            coarse,
+            backdrop,
+            target: RenderTarget::new(gpu, width, height),
+            size: (width, height),
+        })
+    }
+
+    /// Size of the images.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    fn view_proj(&self) -> Mat4 {
+        let aspect = self.size.0 as f32 / self.size.1 as f32;
+        let proj = glam::camera::rh::proj::directx::perspective(0.9, aspect, 0.1, 50.0);
+        let view = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.4, 4.0), Vec3::ZERO, Vec3::Y);
+        proj * view
+    }
+
+    /// Renders the scene with `technique` at transition progress `t` (fine -> coarse) and returns
+    /// RGBA8 pixels, rows top to bottom.
+    pub fn render(&self, gpu: &GpuContext, technique: SingleFrameTechnique, t: f32, parts: SceneParts) -> Vec<u8> {
+        let model = Mat4::from_scale(Vec3::splat(1.1));
+        let lod = |role: LodRole| match role {
+            LodRole::Outgoing => (&self.fine, FINE_COLOR),
+            LodRole::Incoming => (&self.coarse, COARSE_COLOR),
+        };
+        let item = |role, state, dither_alpha| {
+            let (mesh, color) = lod(role);
+            DrawItem { mesh, model, color, state, dither_alpha }
+        };
+        let mut items = Vec::new();
+        if parts == SceneParts::All {
+            items.push(DrawItem {
+                mesh: &self.backdrop,
+                model: Mat4::from_translation(Vec3::new(0.0, 0.0, -3.0)) * Mat4::from_scale(Vec3::new(2.5, 2.5, 0.2)),
+                color: BACKDROP_COLOR,
+                state: OPAQUE,
+                dither_alpha: None,
+            });
+        }
+        let mut pattern = DitherPattern::Bayer4x4;
+        match parts {
+            SceneParts::FineOnly => items.push(item(LodRole::Outgoing, OPAQUE, None)),
+            SceneParts::CoarseOnly => items.push(item(LodRole::Incoming, OPAQUE, None)),
+            SceneParts::All => match technique {
+                SingleFrameTechnique::HardSwitch => {
+                    let role = if t < 0.5 { LodRole::Outgoing } else { LodRole::Incoming };
+                    items.push(item(role, OPAQUE, None));
+                }
+                SingleFrameTechnique::Dither(p) => {
+                    pattern = p;
+                    let selection = LodSelection { current: 0, next: Some(1), transition: t, fade: 1.0, visible: true };
+                    let (current, next) = selection.screen_door_alphas();
+                    items.push(item(LodRole::Outgoing, OPAQUE, Some(current)));
+                    items.push(item(LodRole::Incoming, OPAQUE, next));
+                }
+                SingleFrameTechnique::CrossFade | SingleFrameTechnique::Unpopping => {
+                    let plan: TransitionPlan =
+                        if technique == SingleFrameTechnique::Unpopping { unpopping_plan(t) } else { cross_fade_plan(t) };
+                    for role in plan.order {
+                        items.push(item(role, plan.state(role), None));
+                    }
+                }
+            },
+        }
+        let renderer = &self.renderers[usize::from(pattern == DitherPattern::BlueNoise16x16)];
+        let clear = wgpu::Color { r: 0.02, g: 0.02, b: 0.05, a: 1.0 };
+        renderer.render(gpu, &self.target, clear, self.view_proj(), Vec3::new(0.4, 0.8, 0.6), &items);
+        read_texture_rgba8(gpu, &self.target.color)
+    }
+}
+
+/// See-through of a transition image: among the pixels both LODs cover (`fine_mask` and
+/// `coarse_mask` rendered with [`SceneParts`]), the share where the red backdrop contributes
+/// (red above 2/255), and the mean red there (0..1).
+pub fn see_through(image: &[u8], fine_mask: &[u8], coarse_mask: &[u8]) -> (f32, f32) {
+    let covered = |mask: &[u8], i: usize| mask[i * 4 + 1] > 20 || mask[i * 4 + 2] > 20;
+    let (mut interior, mut seen, mut red) = (0usize, 0usize, 0.0f32);
+    for i in 0..image.len() / 4 {
+        if covered(fine_mask, i) && covered(coarse_mask, i) {
+            interior += 1;
+            let r = image[i * 4];
+            if r > 2 {
+                seen += 1;
+            }
+            red += f32::from(r) / 255.0;
+        }
+    }
+    if interior == 0 {
+        return (0.0, 0.0);
+    }
+    (seen as f32 / interior as f32, red / interior as f32)
+}
