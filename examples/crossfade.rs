@@ -7,12 +7,16 @@
 
 use std::path::PathBuf;
 
-use lodkit::gpu::transition_scene::{SceneParts, SingleFrameTechnique, TransitionScene, see_through};
+use lodkit::gpu::transition_scene::{
+    SceneParts, SingleFrameTechnique, TransitionScene, see_through,
+};
 use lodkit::gpu::{GpuContext, GpuOptions};
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
-    args.iter().position(|a| a == name).and_then(|i| args.get(i + 1).cloned())
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1).cloned())
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -21,11 +25,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let gpu = GpuContext::new_headless(&GpuOptions::default())?;
     println!("adapter: {}", gpu.adapter_summary());
     let scene = TransitionScene::new(&gpu, size, size)?;
-    let fine = scene.render(&gpu, SingleFrameTechnique::Unpopping, 0.0, SceneParts::FineOnly);
-    let coarse = scene.render(&gpu, SingleFrameTechnique::Unpopping, 0.0, SceneParts::CoarseOnly);
+    let fine = scene.render(
+        &gpu,
+        SingleFrameTechnique::Unpopping,
+        0.0,
+        SceneParts::FineOnly,
+    );
+    let coarse = scene.render(
+        &gpu,
+        SingleFrameTechnique::Unpopping,
+        0.0,
+        SceneParts::CoarseOnly,
+    );
     std::fs::create_dir_all(&out)?;
     let frames = 9u32;
-    println!("{:<18} {}", "technique", "see-through of the object's interior at t = 0.25 / 0.5 / 0.75");
+    println!(
+        "{:<18} see-through of the object's interior at t = 0.25 / 0.5 / 0.75",
+        "technique"
+    );
     for technique in SingleFrameTechnique::ALL {
         let mut strip = image::RgbaImage::new(size * frames, size);
         for f in 0..frames {
@@ -39,11 +56,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let shares: Vec<String> = [0.25, 0.5, 0.75]
             .iter()
             .map(|&t| {
-                let (share, _) = see_through(&scene.render(&gpu, technique, t, SceneParts::All), &fine, &coarse);
+                let (share, _) = see_through(
+                    &scene.render(&gpu, technique, t, SceneParts::All),
+                    &fine,
+                    &coarse,
+                );
                 format!("{:5.1}%", share * 100.0)
             })
             .collect();
-        println!("{:<18} {}   -> {}", technique.name(), shares.join(" / "), file.display());
+        println!(
+            "{:<18} {}   -> {}",
+            technique.name(),
+            shares.join(" / "),
+            file.display()
+        );
     }
     Ok(())
 }

@@ -14,11 +14,15 @@ use plotters::prelude::*;
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
-    args.iter().position(|a| a == name).and_then(|i| args.get(i + 1).cloned())
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1).cloned())
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let config_path = arg("--config").unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/examples/data/lod_groups.ron").to_owned());
+    let config_path = arg("--config").unwrap_or_else(|| {
+        concat!(env!("CARGO_MANIFEST_DIR"), "/examples/data/lod_groups.ron").to_owned()
+    });
     let out = PathBuf::from(arg("--out").unwrap_or_else(|| "lodkit-out/selection".to_owned()));
     let text = std::fs::read_to_string(&config_path)?;
     let config = LodConfig::from_ron(&text).map_err(|e| format!("{config_path}:{e}"))?;
@@ -30,16 +34,37 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(other) => return Err(format!("unknown mode `{other}`").into()),
     }
     let named = config.groups()?;
-    let group_of = |name: &str| named.iter().position(|(n, _)| n == name).ok_or(format!("no group `{name}` in {config_path}"));
+    let group_of = |name: &str| {
+        named
+            .iter()
+            .position(|(n, _)| n == name)
+            .ok_or(format!("no group `{name}` in {config_path}"))
+    };
     let groups: Vec<LodGroup> = named.iter().map(|(_, g)| g.clone()).collect();
     // Three objects along -z. The camera walks out 120 m, comes back to where tree A is 81 m away
     // (inside the band around its 80 m level), stands still there for a second, and walks home.
-    let objects = [("tree A", "tree", Vec3::new(0.0, 0.0, -10.0)), ("tree B", "tree", Vec3::new(4.0, 0.0, -40.0)), ("rock", "rock", Vec3::new(-3.0, 0.0, -5.0))];
+    let objects = [
+        ("tree A", "tree", Vec3::new(0.0, 0.0, -10.0)),
+        ("tree B", "tree", Vec3::new(4.0, 0.0, -40.0)),
+        ("rock", "rock", Vec3::new(-3.0, 0.0, -5.0)),
+    ];
     let positions: Vec<Vec3> = objects.iter().map(|o| o.2).collect();
-    let ids: Vec<u32> = objects.iter().map(|o| group_of(o.1).map(|g| g as u32)).collect::<Result<_, _>>()?;
+    let ids: Vec<u32> = objects
+        .iter()
+        .map(|o| group_of(o.1).map(|g| g as u32))
+        .collect::<Result<_, _>>()?;
     let scales = vec![1.0; objects.len()];
-    let batch = InstanceBatch { positions: &positions, max_scales: &scales, groups: &ids };
-    let proj = glam::camera::rh::proj::directx::perspective(std::f32::consts::FRAC_PI_2, 16.0 / 9.0, 0.1, 1000.0);
+    let batch = InstanceBatch {
+        positions: &positions,
+        max_scales: &scales,
+        groups: &ids,
+    };
+    let proj = glam::camera::rh::proj::directx::perspective(
+        std::f32::consts::FRAC_PI_2,
+        16.0 / 9.0,
+        0.1,
+        1000.0,
+    );
     let dt = 1.0 / 30.0;
     let path: Vec<f32> = (0..=120)
         .chain((61..120).rev())
@@ -50,10 +75,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut states = vec![LodState::NEW; objects.len()];
     let mut out_sel = vec![LodSelection::default(); objects.len()];
     let mut series: Vec<Vec<(f32, f32)>> = vec![Vec::new(); objects.len()];
-    println!("frame  camera-z  {}", objects.iter().map(|o| format!("{:<28}", o.0)).collect::<String>());
+    println!(
+        "frame  camera-z  {}",
+        objects
+            .iter()
+            .map(|o| format!("{:<28}", o.0))
+            .collect::<String>()
+    );
     for (frame, z) in path.iter().enumerate() {
         let camera = LodCamera::new(Vec3::new(0.0, 1.5, 10.0 + z), proj);
-        select_batch(&camera, &settings, &groups, &batch, dt, &mut states, &mut out_sel)?;
+        select_batch(
+            &camera,
+            &settings,
+            &groups,
+            &batch,
+            dt,
+            &mut states,
+            &mut out_sel,
+        )?;
         let mut row = format!("{frame:>5}  {:>8.1}  ", 10.0 + z);
         for (i, s) in out_sel.iter().enumerate() {
             // Effective level: current + transition toward next (fractional during a blend).
@@ -83,21 +122,37 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = SVGBackend::new(&file, (960, 420)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
-        .caption(format!("LOD per object along the camera path ({:?})", settings.transition), ("sans-serif", 18))
+        .caption(
+            format!(
+                "LOD per object along the camera path ({:?})",
+                settings.transition
+            ),
+            ("sans-serif", 18),
+        )
         .margin(12)
         .x_label_area_size(36)
         .y_label_area_size(48)
         .build_cartesian_2d(0f32..path.len() as f32, -0.1f32..2.2f32)?;
-    chart.configure_mesh().x_desc("frame").y_desc("level (fractional while blending)").draw()?;
+    chart
+        .configure_mesh()
+        .x_desc("frame")
+        .y_desc("level (fractional while blending)")
+        .draw()?;
     for (i, points) in series.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
         let visible: Vec<(f32, f32)> = points.iter().copied().filter(|p| p.1.is_finite()).collect();
         chart
             .draw_series(LineSeries::new(visible, color.stroke_width(2)))?
             .label(objects[i].0)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+            });
     }
-    chart.configure_series_labels().border_style(BLACK).background_style(WHITE).draw()?;
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE)
+        .draw()?;
     root.present()?;
     println!("wrote {}", file.display());
     Ok(())

@@ -6,7 +6,11 @@ use lodkit::select::*;
 use proptest::prelude::*;
 
 fn settings(h: f32, transition: TransitionMode) -> LodSettings {
-    LodSettings { hysteresis: h, transition, ..Default::default() }
+    LodSettings {
+        hysteresis: h,
+        transition,
+        ..Default::default()
+    }
 }
 
 #[test]
@@ -75,7 +79,10 @@ fn time_transition_runs_for_its_duration_and_turns_back_smoothly() {
 
 #[test]
 fn max_distance_fades_then_hides() {
-    let g = LodGroup::from_distances(&[0.0, 50.0]).unwrap().with_max_distance(200.0).unwrap();
+    let g = LodGroup::from_distances(&[0.0, 50.0])
+        .unwrap()
+        .with_max_distance(200.0)
+        .unwrap();
     let s = settings(10.0, TransitionMode::Distance);
     let mut st = LodState::NEW;
     assert_eq!(g.select(150.0, &s, 0.0, &mut st).fade, 1.0);
@@ -90,12 +97,25 @@ fn bias_zero_forces_lod0_and_infinity_the_last() {
     let proj = glam::camera::rh::proj::directx::perspective(1.0, 1.0, 0.1, 100.0);
     let groups = [LodGroup::from_distances(&[0.0, 10.0, 20.0]).unwrap()];
     let positions = [Vec3::new(0.0, 0.0, -1.0), Vec3::new(0.0, 0.0, -1000.0)];
-    let batch = InstanceBatch { positions: &positions, max_scales: &[1.0, 1.0], groups: &[0, 0] };
+    let batch = InstanceBatch {
+        positions: &positions,
+        max_scales: &[1.0, 1.0],
+        groups: &[0, 0],
+    };
     for (bias, want) in [(0.0, [0, 0]), (f32::INFINITY, [2, 2])] {
         let camera = LodCamera::new(Vec3::ZERO, proj).with_bias(bias);
         let mut states = [LodState::NEW; 2];
         let mut out = [LodSelection::default(); 2];
-        select_batch(&camera, &LodSettings::default(), &groups, &batch, 0.0, &mut states, &mut out).unwrap();
+        select_batch(
+            &camera,
+            &LodSettings::default(),
+            &groups,
+            &batch,
+            0.0,
+            &mut states,
+            &mut out,
+        )
+        .unwrap();
         assert_eq!(out.map(|s| s.current), want, "bias {bias}");
     }
 }
@@ -111,10 +131,16 @@ fn orthographic_cameras_select_by_view_height() {
 #[test]
 fn lod_camera_is_the_main_camera_for_shadow_passes() {
     // A shadow pass selects with the main camera's LodCamera: the same result as the main pass.
-    let main = LodCamera::new(Vec3::ZERO, glam::camera::rh::proj::directx::perspective(1.2, 1.0, 0.1, 100.0));
+    let main = LodCamera::new(
+        Vec3::ZERO,
+        glam::camera::rh::proj::directx::perspective(1.2, 1.0, 0.1, 100.0),
+    );
     let d_main = main.lod_distance(Vec3::new(0.0, 0.0, -30.0), 1.0, 1.0);
     let light = LodCamera::new(Vec3::new(0.0, 100.0, 0.0), Mat4::IDENTITY);
-    assert_ne!(d_main, light.lod_distance(Vec3::new(0.0, 0.0, -30.0), 1.0, 1.0));
+    assert_ne!(
+        d_main,
+        light.lod_distance(Vec3::new(0.0, 0.0, -30.0), 1.0, 1.0)
+    );
 }
 
 #[test]
@@ -122,12 +148,46 @@ fn batch_reports_length_mismatch_and_bad_group_ids() {
     let camera = LodCamera::new(Vec3::ZERO, Mat4::IDENTITY);
     let groups = [LodGroup::from_distances(&[0.0]).unwrap()];
     let positions = [Vec3::ZERO; 2];
-    let batch = InstanceBatch { positions: &positions, max_scales: &[1.0], groups: &[0, 0] };
-    let err = select_batch(&camera, &LodSettings::default(), &groups, &batch, 0.0, &mut [LodState::NEW; 2], &mut [LodSelection::default(); 2]);
-    assert!(matches!(err, Err(LodError::LengthMismatch { what: "max_scales", .. })), "{err:?}");
-    let batch = InstanceBatch { positions: &positions, max_scales: &[1.0; 2], groups: &[0, 7] };
+    let batch = InstanceBatch {
+        positions: &positions,
+        max_scales: &[1.0],
+        groups: &[0, 0],
+    };
+    let err = select_batch(
+        &camera,
+        &LodSettings::default(),
+        &groups,
+        &batch,
+        0.0,
+        &mut [LodState::NEW; 2],
+        &mut [LodSelection::default(); 2],
+    );
+    assert!(
+        matches!(
+            err,
+            Err(LodError::LengthMismatch {
+                what: "max_scales",
+                ..
+            })
+        ),
+        "{err:?}"
+    );
+    let batch = InstanceBatch {
+        positions: &positions,
+        max_scales: &[1.0; 2],
+        groups: &[0, 7],
+    };
     let mut out = [LodSelection::default(); 2];
-    select_batch(&camera, &LodSettings::default(), &groups, &batch, 0.0, &mut [LodState::NEW; 2], &mut out).unwrap();
+    select_batch(
+        &camera,
+        &LodSettings::default(),
+        &groups,
+        &batch,
+        0.0,
+        &mut [LodState::NEW; 2],
+        &mut out,
+    )
+    .unwrap();
     assert!(out[0].visible && !out[1].visible);
 }
 
@@ -136,13 +196,28 @@ fn odd_inputs_have_documented_results() {
     let g = LodGroup::from_distances(&[0.0, 10.0, 10.0, 20.0]).unwrap();
     let s = LodSettings::default();
     let mut st = LodState::NEW;
-    assert_eq!(g.select(f32::NAN, &s, 0.0, &mut st).current, 3, "NaN counts as +inf");
+    assert_eq!(
+        g.select(f32::NAN, &s, 0.0, &mut st).current,
+        3,
+        "NaN counts as +inf"
+    );
     let mut st = LodState::NEW;
-    assert_eq!(g.select(-5.0, &s, 0.0, &mut st).current, 0, "negative counts as 0");
+    assert_eq!(
+        g.select(-5.0, &s, 0.0, &mut st).current,
+        0,
+        "negative counts as 0"
+    );
     let mut st = LodState::NEW;
-    assert_eq!(g.select(15.0, &s, 0.0, &mut st).current, 2, "of equal distances, the later wins");
+    assert_eq!(
+        g.select(15.0, &s, 0.0, &mut st).current,
+        2,
+        "of equal distances, the later wins"
+    );
     assert_eq!(LodGroup::new([]), Err(LodError::NoLevels));
-    assert!(matches!(LodGroup::from_distances(&[0.0, f32::NAN]), Err(LodError::BadDistance { index: 1, .. })));
+    assert!(matches!(
+        LodGroup::from_distances(&[0.0, f32::NAN]),
+        Err(LodError::BadDistance { index: 1, .. })
+    ));
     assert!(LodSettings { bias: -1.0, ..s }.validate().is_err());
 }
 
@@ -165,10 +240,17 @@ LodConfig(
 fn config_loads_from_ron() {
     let config = LodConfig::from_ron(CONFIG).unwrap();
     let s = config.settings().unwrap();
-    assert_eq!((s.bias, s.hysteresis, s.transition), (1.5, 10.0, TransitionMode::Time { seconds: 0.4 }));
+    assert_eq!(
+        (s.bias, s.hysteresis, s.transition),
+        (1.5, 10.0, TransitionMode::Time { seconds: 0.4 })
+    );
     let groups = config.groups().unwrap();
     assert_eq!(groups[1].0, "tree");
-    assert_eq!(groups[1].1.levels()[0].mesh, "tree_lod0", "levels sorted by distance");
+    assert_eq!(
+        groups[1].1.levels()[0].mesh,
+        "tree_lod0",
+        "levels sorted by distance"
+    );
     assert_eq!(groups[1].1.max_distance(), Some(300.0));
 }
 
@@ -176,7 +258,12 @@ fn config_loads_from_ron() {
 fn bad_ron_names_line_column_and_field() {
     let typo = CONFIG.replace("max_distance", "max_distnace");
     match LodConfig::from_ron(&typo).unwrap_err() {
-        ConfigError::Ron { line, column, field, message } => {
+        ConfigError::Ron {
+            line,
+            column,
+            field,
+            message,
+        } => {
             assert_eq!(line, 9, "{message}");
             assert!(column > 1);
             assert_eq!(field.as_deref(), Some("max_distnace"));
@@ -186,14 +273,22 @@ fn bad_ron_names_line_column_and_field() {
     }
     let negative = CONFIG.replace("distance: 40.0", "distance: -4.0");
     let err = LodConfig::from_ron(&negative).unwrap_err();
-    assert_eq!(err.to_string(), "groups[\"tree\"].levels[0].distance: level 0: distance -4 must be finite and >= 0");
+    assert_eq!(
+        err.to_string(),
+        "groups[\"tree\"].levels[0].distance: level 0: distance -4 must be finite and >= 0"
+    );
     let missing = "LodConfig(bias: 1.0)";
     match LodConfig::from_ron(missing).unwrap_err() {
         ConfigError::Ron { field, .. } => assert_eq!(field.as_deref(), Some("groups")),
         other => panic!("{other}"),
     }
     let bad_duration = CONFIG.replace("seconds: 0.4", "seconds: 0.0");
-    assert!(LodConfig::from_ron(&bad_duration).unwrap_err().to_string().starts_with("transition:"));
+    assert!(
+        LodConfig::from_ron(&bad_duration)
+            .unwrap_err()
+            .to_string()
+            .starts_with("transition:")
+    );
 }
 
 fn arb_group() -> impl Strategy<Value = LodGroup> {

@@ -68,10 +68,14 @@ pub fn void_and_cluster(size: usize, seed: u64) -> Vec<u32> {
     }
     // Relax: move the tightest cluster into the largest void until that changes nothing.
     for _ in 0..(4 * n) {
-        let Some(cluster) = tightest(&pattern, &energy) else { break };
+        let Some(cluster) = tightest(&pattern, &energy) else {
+            break;
+        };
         pattern[cluster] = false;
         toggle(&mut energy, cluster, -1.0);
-        let Some(void) = largest_void(&pattern, &energy) else { break };
+        let Some(void) = largest_void(&pattern, &energy) else {
+            break;
+        };
         pattern[void] = true;
         toggle(&mut energy, void, 1.0);
         if void == cluster {
@@ -90,7 +94,9 @@ pub fn void_and_cluster(size: usize, seed: u64) -> Vec<u32> {
     // Phases 2 and 3: fill the largest void. (The tightest cluster of zeros is the zero with the
     // least energy of ones, so both phases are the same step.)
     for rank in ones..n {
-        let Some(v) = largest_void(&pattern, &energy) else { break };
+        let Some(v) = largest_void(&pattern, &energy) else {
+            break;
+        };
         pattern[v] = true;
         toggle(&mut energy, v, 1.0);
         ranks[v] = rank as u32;
@@ -135,6 +141,12 @@ pub fn radial_power_spectrum(values: &[f32], size: usize) -> Vec<f32> {
         }
     }
     (1..=half)
-        .map(|r| if count[r] > 0 { (power[r] / count[r] as f64) as f32 } else { 0.0 })
+        .map(|r| {
+            if count[r] > 0 {
+                (power[r] / count[r] as f64) as f32
+            } else {
+                0.0
+            }
+        })
         .collect()
 }

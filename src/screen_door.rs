@@ -39,7 +39,11 @@ pub fn pack_ranks(ranks: &[u32], bits: u32) -> Vec<u32> {
     let per_word = (32 / bits) as usize;
     ranks
         .chunks(per_word)
-        .map(|c| c.iter().enumerate().fold(0, |w, (i, r)| w | (r << (i as u32 * bits))))
+        .map(|c| {
+            c.iter()
+                .enumerate()
+                .fold(0, |w, (i, r)| w | (r << (i as u32 * bits)))
+        })
         .collect()
 }
 

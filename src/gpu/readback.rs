@@ -12,7 +12,8 @@ pub fn read_texture_rgba8(gpu: &GpuContext, texture: &wgpu::Texture) -> Vec<u8> 
 pub fn read_texture(gpu: &GpuContext, texture: &wgpu::Texture, bytes_per_pixel: u32) -> Vec<u8> {
     let (w, h) = (texture.width(), texture.height());
     let row = w * bytes_per_pixel;
-    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("lodkit readback"),
         size: u64::from(padded) * u64::from(h),
@@ -56,7 +57,12 @@ pub fn map_read(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
 
 /// Submits `encoder` with a copy of `size` bytes of `buffer` (which needs `COPY_SRC`) appended
 /// and returns them.
-pub fn read_buffer(gpu: &GpuContext, mut encoder: wgpu::CommandEncoder, buffer: &wgpu::Buffer, size: u64) -> Vec<u8> {
+pub fn read_buffer(
+    gpu: &GpuContext,
+    mut encoder: wgpu::CommandEncoder,
+    buffer: &wgpu::Buffer,
+    size: u64,
+) -> Vec<u8> {
     let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("lodkit readback"),
         size,

@@ -10,7 +10,9 @@ use wgpu::util::DeviceExt;
 
 use super::GpuContext;
 use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
-use crate::shaders::{ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source};
+use crate::shaders::{
+    ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
+};
 use crate::unpopping::LodRenderState;
 
 /// Depth format of [`RenderTarget`].
@@ -38,7 +40,11 @@ impl Mesh {
             let theta = PI * r as f32 / rings as f32;
             for s in 0..=segments {
                 let phi = TAU * s as f32 / segments as f32;
-                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                let n = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                );
                 m.vertices.push([n.x, n.y, n.z, n.x, n.y, n.z]);
             }
         }
@@ -69,9 +75,11 @@ impl Mesh {
                     m.vertices.push([p[0], p[1], p[2], n[0], n[1], n[2]]);
                 }
                 if sign > 0.0 {
-                    m.indices.extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+                    m.indices
+                        .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
                 } else {
-                    m.indices.extend([base, base + 2, base + 1, base, base + 3, base + 2]);
+                    m.indices
+                        .extend([base, base + 2, base + 1, base, base + 3, base + 2]);
                 }
             }
         }
@@ -146,7 +154,11 @@ impl RenderTarget {
         let make = |format, usage, label| {
             gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -160,7 +172,11 @@ impl RenderTarget {
             | wgpu::TextureUsages::TEXTURE_BINDING;
         Self {
             color: make(COLOR_FORMAT, color_usage, "scene color"),
-            depth: make(DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT, "scene depth"),
+            depth: make(
+                DEPTH_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+                "scene depth",
+            ),
         }
     }
 }
@@ -187,7 +203,10 @@ impl MeshRenderer {
         let mut library = ShaderLibrary::new()?;
         let mut defs = std::collections::HashMap::new();
         if blue_noise {
-            defs.insert("LODKIT_SCREEN_DOOR_BLUE_NOISE".to_owned(), ShaderDefValue::Bool(true));
+            defs.insert(
+                "LODKIT_SCREEN_DOOR_BLUE_NOISE".to_owned(),
+                ShaderDefValue::Bool(true),
+            );
         }
         let composed = library.compose(&ComposeDescriptor {
             source: find_pass_source("lod_mesh").unwrap_or_default(),
@@ -197,7 +216,8 @@ impl MeshRenderer {
         })?;
         let module = gpu.shader_module("lod_mesh", &composed);
         let device = &gpu.device;
-        let stride = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(std::mem::size_of::<DrawUniform>() as u64);
+        let stride = u64::from(device.limits().min_uniform_buffer_offset_alignment)
+            .max(std::mem::size_of::<DrawUniform>() as u64);
         let uniform_layout = |dynamic| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: None,
@@ -233,8 +253,15 @@ impl MeshRenderer {
                         attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
                     })],
                 },
-                primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
-                depth_stencil: Some(lod_depth_stencil(&state, DEPTH_FORMAT, wgpu::CompareFunction::Less)),
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: Some(wgpu::Face::Back),
+                    ..Default::default()
+                },
+                depth_stencil: Some(lod_depth_stencil(
+                    &state,
+                    DEPTH_FORMAT,
+                    wgpu::CompareFunction::Less,
+                )),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
@@ -250,8 +277,18 @@ impl MeshRenderer {
                 cache: None,
             })
         };
-        let opaque_state = LodRenderState { alpha: 1.0, depth_test: true, depth_write: true, blend: false };
-        let blended_state = LodRenderState { alpha: 0.5, depth_test: true, depth_write: false, blend: true };
+        let opaque_state = LodRenderState {
+            alpha: 1.0,
+            depth_test: true,
+            depth_write: true,
+            blend: false,
+        };
+        let blended_state = LodRenderState {
+            alpha: 0.5,
+            depth_test: true,
+            depth_write: false,
+            blend: true,
+        };
         let camera = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("camera"),
             size: std::mem::size_of::<CameraUniform>() as u64,
@@ -281,8 +318,16 @@ impl MeshRenderer {
         Ok(Self {
             opaque: pipeline(opaque_state),
             blended: pipeline(blended_state),
-            camera_group: group(&camera_layout, &camera, std::mem::size_of::<CameraUniform>() as u64),
-            draw_group: group(&draw_layout, &draws, std::mem::size_of::<DrawUniform>() as u64),
+            camera_group: group(
+                &camera_layout,
+                &camera,
+                std::mem::size_of::<CameraUniform>() as u64,
+            ),
+            draw_group: group(
+                &draw_layout,
+                &draws,
+                std::mem::size_of::<DrawUniform>() as u64,
+            ),
             camera,
             draws,
             stride,
@@ -293,21 +338,44 @@ impl MeshRenderer {
     /// Uploads a mesh.
     pub fn upload(&self, gpu: &GpuContext, mesh: &Mesh) -> GpuMesh {
         let make = |contents: &[u8], usage| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents, usage })
+            gpu.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: None,
+                    contents,
+                    usage,
+                })
         };
         GpuMesh {
-            vertices: make(bytemuck::cast_slice(&mesh.vertices), wgpu::BufferUsages::VERTEX),
-            indices: make(bytemuck::cast_slice(&mesh.indices), wgpu::BufferUsages::INDEX),
+            vertices: make(
+                bytemuck::cast_slice(&mesh.vertices),
+                wgpu::BufferUsages::VERTEX,
+            ),
+            indices: make(
+                bytemuck::cast_slice(&mesh.indices),
+                wgpu::BufferUsages::INDEX,
+            ),
             count: mesh.indices.len() as u32,
         }
     }
 
     /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]; the
     /// rest are dropped), lit from `light_dir`.
-    pub fn render(&self, gpu: &GpuContext, target: &RenderTarget, clear: wgpu::Color, view_proj: Mat4, light_dir: Vec3, items: &[DrawItem]) {
+    pub fn render(
+        &self,
+        gpu: &GpuContext,
+        target: &RenderTarget,
+        clear: wgpu::Color,
+        view_proj: Mat4,
+        light_dir: Vec3,
+        items: &[DrawItem],
+    ) {
         let items = &items[..items.len().min(self.capacity)];
-        let camera = CameraUniform { view_proj: view_proj.to_cols_array_2d(), light_dir: light_dir.extend(0.0).to_array() };
-        gpu.queue.write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+        let camera = CameraUniform {
+            view_proj: view_proj.to_cols_array_2d(),
+            light_dir: light_dir.extend(0.0).to_array(),
+        };
+        gpu.queue
+            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
         let mut data = vec![0u8; self.stride as usize * items.len()];
         for (i, item) in items.iter().enumerate() {
             let u = DrawUniform {
@@ -317,7 +385,8 @@ impl MeshRenderer {
                 pad: [0.0; 3],
             };
             let at = i * self.stride as usize;
-            data[at..at + std::mem::size_of::<DrawUniform>()].copy_from_slice(bytemuck::bytes_of(&u));
+            data[at..at + std::mem::size_of::<DrawUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
         }
         if !data.is_empty() {
             gpu.queue.write_buffer(&self.draws, 0, &data);
@@ -332,11 +401,17 @@ impl MeshRenderer {
                     view: &color_view,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(clear),
+                        store: wgpu::StoreOp::Store,
+                    },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
@@ -345,7 +420,11 @@ impl MeshRenderer {
             });
             pass.set_bind_group(0, &self.camera_group, &[]);
             for (i, item) in items.iter().enumerate() {
-                pass.set_pipeline(if item.state.blend { &self.blended } else { &self.opaque });
+                pass.set_pipeline(if item.state.blend {
+                    &self.blended
+                } else {
+                    &self.opaque
+                });
                 pass.set_blend_constant(lod_blend_constant(&item.state));
                 pass.set_bind_group(1, &self.draw_group, &[(i as u64 * self.stride) as u32]);
                 pass.set_vertex_buffer(0, item.mesh.vertices.slice(..));

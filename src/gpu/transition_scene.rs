@@ -54,7 +54,12 @@ pub const COARSE_COLOR: Vec4 = Vec4::new(0.0, 0.45, 1.0, 1.0);
 /// Color of the object behind (pure red).
 pub const BACKDROP_COLOR: Vec4 = Vec4::new(1.0, 0.0, 0.0, 1.0);
 
-const OPAQUE: LodRenderState = LodRenderState { alpha: 1.0, depth_test: true, depth_write: true, blend: false };
+const OPAQUE: LodRenderState = LodRenderState {
+    alpha: 1.0,
+    depth_test: true,
+    depth_write: true,
+    blend: false,
+};
 
 /// The scene, on the GPU, ready to render at any t.
 #[derive(Debug)]
@@ -104,13 +109,20 @@ impl TransitionScene {
     fn view_proj(&self) -> Mat4 {
         let aspect = self.size.0 as f32 / self.size.1 as f32;
         let proj = glam::camera::rh::proj::directx::perspective(0.9, aspect, 0.1, 50.0);
-        let view = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.4, 4.0), Vec3::ZERO, Vec3::Y);
+        let view =
+            glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.4, 4.0), Vec3::ZERO, Vec3::Y);
         proj * view
     }
 
     /// Renders the scene with `technique` at transition progress `t` (fine -> coarse) and returns
     /// RGBA8 pixels, rows top to bottom.
-    pub fn render(&self, gpu: &GpuContext, technique: SingleFrameTechnique, t: f32, parts: SceneParts) -> Vec<u8> {
+    pub fn render(
+        &self,
+        gpu: &GpuContext,
+        technique: SingleFrameTechnique,
+        t: f32,
+        parts: SceneParts,
+    ) -> Vec<u8> {
         let model = Mat4::from_scale(Vec3::splat(1.1));
         let lod = |role: LodRole| match role {
             LodRole::Outgoing => (&self.fine, FINE_COLOR),
@@ -118,13 +130,20 @@ impl TransitionScene {
         };
         let item = |role, state, dither_alpha| {
             let (mesh, color) = lod(role);
-            DrawItem { mesh, model, color, state, dither_alpha }
+            DrawItem {
+                mesh,
+                model,
+                color,
+                state,
+                dither_alpha,
+            }
         };
         let mut items = Vec::new();
         if parts == SceneParts::All {
             items.push(DrawItem {
                 mesh: &self.backdrop,
-                model: Mat4::from_translation(Vec3::new(0.0, 0.0, -3.0)) * Mat4::from_scale(Vec3::new(2.5, 2.5, 0.2)),
+                model: Mat4::from_translation(Vec3::new(0.0, 0.0, -3.0))
+                    * Mat4::from_scale(Vec3::new(2.5, 2.5, 0.2)),
                 color: BACKDROP_COLOR,
                 state: OPAQUE,
                 dither_alpha: None,
@@ -136,19 +155,32 @@ impl TransitionScene {
             SceneParts::CoarseOnly => items.push(item(LodRole::Incoming, OPAQUE, None)),
             SceneParts::All => match technique {
                 SingleFrameTechnique::HardSwitch => {
-                    let role = if t < 0.5 { LodRole::Outgoing } else { LodRole::Incoming };
+                    let role = if t < 0.5 {
+                        LodRole::Outgoing
+                    } else {
+                        LodRole::Incoming
+                    };
                     items.push(item(role, OPAQUE, None));
                 }
                 SingleFrameTechnique::Dither(p) => {
                     pattern = p;
-                    let selection = LodSelection { current: 0, next: Some(1), transition: t, fade: 1.0, visible: true };
+                    let selection = LodSelection {
+                        current: 0,
+                        next: Some(1),
+                        transition: t,
+                        fade: 1.0,
+                        visible: true,
+                    };
                     let (current, next) = selection.screen_door_alphas();
                     items.push(item(LodRole::Outgoing, OPAQUE, Some(current)));
                     items.push(item(LodRole::Incoming, OPAQUE, next));
                 }
                 SingleFrameTechnique::CrossFade | SingleFrameTechnique::Unpopping => {
-                    let plan: TransitionPlan =
-                        if technique == SingleFrameTechnique::Unpopping { unpopping_plan(t) } else { cross_fade_plan(t) };
+                    let plan: TransitionPlan = if technique == SingleFrameTechnique::Unpopping {
+                        unpopping_plan(t)
+                    } else {
+                        cross_fade_plan(t)
+                    };
                     for role in plan.order {
                         items.push(item(role, plan.state(role), None));
                     }
@@ -156,8 +188,20 @@ impl TransitionScene {
             },
         }
         let renderer = &self.renderers[usize::from(pattern == DitherPattern::BlueNoise16x16)];
-        let clear = wgpu::Color { r: 0.02, g: 0.02, b: 0.05, a: 1.0 };
-        renderer.render(gpu, &self.target, clear, self.view_proj(), Vec3::new(0.4, 0.8, 0.6), &items);
+        let clear = wgpu::Color {
+            r: 0.02,
+            g: 0.02,
+            b: 0.05,
+            a: 1.0,
+        };
+        renderer.render(
+            gpu,
+            &self.target,
+            clear,
+            self.view_proj(),
+            Vec3::new(0.4, 0.8, 0.6),
+            &items,
+        );
         read_texture_rgba8(gpu, &self.target.color)
     }
 }

@@ -42,5 +42,10 @@ pub fn lod_blend(state: &LodRenderState) -> Option<wgpu::BlendState> {
 /// The blend constant to set before drawing a LOD in `state` (its alpha in every channel).
 pub fn lod_blend_constant(state: &LodRenderState) -> wgpu::Color {
     let a = f64::from(state.alpha.clamp(0.0, 1.0));
-    wgpu::Color { r: a, g: a, b: a, a }
+    wgpu::Color {
+        r: a,
+        g: a,
+        b: a,
+        a,
+    }
 }

@@ -66,7 +66,10 @@ pub fn select_batch(
     let p11 = camera.projection.y_axis.y.abs();
     let ortho = is_orthographic(&camera.projection);
     let dt = if dt > 0.0 { dt } else { 0.0 };
-    let bands: Vec<Vec<(f32, f32)>> = groups.iter().map(|g| g.bands(settings.hysteresis)).collect();
+    let bands: Vec<Vec<(f32, f32)>> = groups
+        .iter()
+        .map(|g| g.bands(settings.hysteresis))
+        .collect();
     // distance x factor / scale, with the bias folded into the factor; a zero bias is LOD0 even
     // for infinite distances (0 x inf would be NaN).
     let factor = bias / p11;
@@ -78,7 +81,9 @@ pub fn select_batch(
         .zip(states.iter_mut())
         .zip(out.iter_mut());
     for ((((position, scale), &group_id), state), out) in instances {
-        let (Some(group), Some(bands)) = (groups.get(group_id as usize), bands.get(group_id as usize)) else {
+        let (Some(group), Some(bands)) =
+            (groups.get(group_id as usize), bands.get(group_id as usize))
+        else {
             *out = LodSelection {
                 visible: false,
                 fade: 0.0,

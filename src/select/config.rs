@@ -139,7 +139,9 @@ impl LodConfig {
                     source,
                 };
                 let group = LodGroup::new(g.levels.iter().cloned()).map_err(|e| match e {
-                    LodError::BadDistance { index, .. } => invalid(format!("levels[{index}].distance"), e),
+                    LodError::BadDistance { index, .. } => {
+                        invalid(format!("levels[{index}].distance"), e)
+                    }
                     e => invalid("levels".to_owned(), e),
                 })?;
                 let group = match g.max_distance {

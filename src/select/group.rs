@@ -102,7 +102,10 @@ impl LodSelection {
     /// `fade` of the pixels. Without a transition: (fade, None).
     pub fn screen_door_alphas(&self) -> (f32, Option<f32>) {
         match self.next {
-            Some(_) => (-(1.0 - self.transition) * self.fade, Some(self.transition * self.fade)),
+            Some(_) => (
+                -(1.0 - self.transition) * self.fade,
+                Some(self.transition * self.fade),
+            ),
             None => (self.fade, None),
         }
     }
@@ -215,7 +218,10 @@ impl LodGroup {
     /// NaN counts as +inf, negative as 0.
     pub fn level_at(&self, distance: f32) -> usize {
         let d = sanitize(distance);
-        self.levels[1..].iter().take_while(|l| l.distance <= d).count()
+        self.levels[1..]
+            .iter()
+            .take_while(|l| l.distance <= d)
+            .count()
     }
 
     /// Half-width of the band around boundary `i` (between levels i-1 and i): h/2, shrunk so
@@ -223,7 +229,10 @@ impl LodGroup {
     fn half_band(&self, i: usize, h: f32) -> f32 {
         let d = self.levels[i].distance;
         let below = d - self.levels[i - 1].distance;
-        let above = self.levels.get(i + 1).map_or(f32::INFINITY, |l| l.distance - d);
+        let above = self
+            .levels
+            .get(i + 1)
+            .map_or(f32::INFINITY, |l| l.distance - d);
         (h.min(below).min(above)) * 0.5
     }
 
@@ -236,7 +245,10 @@ impl LodGroup {
                     return (f32::NEG_INFINITY, f32::NEG_INFINITY);
                 }
                 let half = self.half_band(i, h);
-                (self.levels[i].distance - half, self.levels[i].distance + half)
+                (
+                    self.levels[i].distance - half,
+                    self.levels[i].distance + half,
+                )
             })
             .collect()
     }
@@ -258,11 +270,20 @@ impl LodGroup {
     /// assert_eq!(g.select(96.0, &s, 0.0, &mut state).current, 1);  // stays until d - h/2
     /// assert_eq!(g.select(94.9, &s, 0.0, &mut state).current, 0);
     /// ```
-    pub fn select(&self, distance: f32, settings: &LodSettings, dt: f32, state: &mut LodState) -> LodSelection {
+    pub fn select(
+        &self,
+        distance: f32,
+        settings: &LodSettings,
+        dt: f32,
+        state: &mut LodState,
+    ) -> LodSelection {
         let h = settings.hysteresis.max(0.0);
         self.select_banded(distance, settings, dt, state, |i| {
             let half = self.half_band(i, h);
-            (self.levels[i].distance - half, self.levels[i].distance + half)
+            (
+                self.levels[i].distance - half,
+                self.levels[i].distance + half,
+            )
         })
     }
 
@@ -292,9 +313,21 @@ impl LodGroup {
         // Fast path: settled on a level and outside every band around it.
         let s = state.level as usize;
         if s < n && state.target == state.level && d < fade_from {
-            let above = if s + 1 < n { band(s + 1) } else { (f32::INFINITY, f32::INFINITY) };
-            let below = if s > 0 { band(s) } else { (f32::NEG_INFINITY, f32::NEG_INFINITY) };
-            let (from, to) = if hard { (below.0, above.1) } else { (below.1, above.0) };
+            let above = if s + 1 < n {
+                band(s + 1)
+            } else {
+                (f32::INFINITY, f32::INFINITY)
+            };
+            let below = if s > 0 {
+                band(s)
+            } else {
+                (f32::NEG_INFINITY, f32::NEG_INFINITY)
+            };
+            let (from, to) = if hard {
+                (below.0, above.1)
+            } else {
+                (below.1, above.0)
+            };
             if d >= from && d < to {
                 return LodSelection {
                     current: state.level,
@@ -346,7 +379,13 @@ impl LodGroup {
     }
 
     /// Time-driven transition toward `desired`.
-    fn timed(&self, state: &mut LodState, desired: usize, seconds: f32, dt: f32) -> (usize, Option<usize>, f32) {
+    fn timed(
+        &self,
+        state: &mut LodState,
+        desired: usize,
+        seconds: f32,
+        dt: f32,
+    ) -> (usize, Option<usize>, f32) {
         let desired = desired as u8;
         if state.target != state.level {
             if desired == state.level {
@@ -376,23 +415,40 @@ impl LodGroup {
         if state.target == state.level {
             (state.level as usize, None, 0.0)
         } else {
-            (state.level as usize, Some(state.target as usize), state.progress)
+            (
+                state.level as usize,
+                Some(state.target as usize),
+                state.progress,
+            )
         }
     }
 }
 
 /// Distance-driven blend toward the neighbour of `level` whose band `d` is in.
-fn band_blend(level: usize, n: usize, d: f32, band: &impl Fn(usize) -> (f32, f32)) -> (usize, Option<usize>, f32) {
+fn band_blend(
+    level: usize,
+    n: usize,
+    d: f32,
+    band: &impl Fn(usize) -> (f32, f32),
+) -> (usize, Option<usize>, f32) {
     if level + 1 < n {
         let (lo, hi) = band(level + 1);
         if hi > lo && d >= lo {
-            return (level, Some(level + 1), ((d - lo) / (hi - lo)).clamp(0.0, 1.0));
+            return (
+                level,
+                Some(level + 1),
+                ((d - lo) / (hi - lo)).clamp(0.0, 1.0),
+            );
         }
     }
     if level > 0 {
         let (lo, hi) = band(level);
         if hi > lo && d < hi {
-            return (level, Some(level - 1), ((hi - d) / (hi - lo)).clamp(0.0, 1.0));
+            return (
+                level,
+                Some(level - 1),
+                ((hi - d) / (hi - lo)).clamp(0.0, 1.0),
+            );
         }
     }
     (level, None, 0.0)
@@ -400,5 +456,9 @@ fn band_blend(level: usize, n: usize, d: f32, band: &impl Fn(usize) -> (f32, f32
 
 /// NaN -> +inf, negative -> 0.
 fn sanitize(d: f32) -> f32 {
-    if d.is_nan() { f32::INFINITY } else { d.max(0.0) }
+    if d.is_nan() {
+        f32::INFINITY
+    } else {
+        d.max(0.0)
+    }
 }

@@ -152,8 +152,16 @@ impl LodCamera {
     /// View-normalized, biased distance of an object at `position` with largest world-scale
     /// component `max_scale`, under the extra `global_bias`.
     pub fn lod_distance(&self, position: Vec3, max_scale: f32, global_bias: f32) -> f32 {
-        let d = view_normalized_distance(position.distance(self.position), &self.projection, max_scale);
-        let bias = if self.bias == 0.0 || global_bias == 0.0 { 0.0 } else { self.bias * global_bias };
+        let d = view_normalized_distance(
+            position.distance(self.position),
+            &self.projection,
+            max_scale,
+        );
+        let bias = if self.bias == 0.0 || global_bias == 0.0 {
+            0.0
+        } else {
+            self.bias * global_bias
+        };
         biased_distance(d, bias)
     }
 }
