@@ -266,7 +266,12 @@ fn every_glsl_twin_composes_through_naga() {
             .iter()
             .filter_map(|(_, f)| f.name.as_deref())
             .collect();
-        for f in &twin.functions {
+        // Macros (GLSL twins that take textures) leave no function behind; the GPU tests use them.
+        for f in twin
+            .functions
+            .iter()
+            .filter(|f| !f.signature.starts_with("#define"))
+        {
             assert!(
                 names.contains(&f.name.as_str()),
                 "{}: {} missing after compose",

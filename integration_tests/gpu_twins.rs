@@ -61,6 +61,7 @@ fn foreshortened_normal_distance_wgsl_matches_rust_twin() {
                out_f(0u, foreshortened_normal_distance(a, b));",
         inputs: 6,
         outputs: 1,
+        texture: None,
     };
     let got = floats(&run_wgsl(gpu, &probe, &normal_inputs(&pairs)));
     let want: Vec<f32> = pairs
@@ -86,6 +87,7 @@ fn foreshortened_normal_distance_glsl_matches_rust_twin() {
                out_f(0u, lodkit_foreshortened_normal_distance(a, b));",
         inputs: 6,
         outputs: 1,
+        texture: None,
     };
     let got = floats(&run_glsl(gpu, &probe, &normal_inputs(&pairs)));
     let want: Vec<f32> = pairs
@@ -127,6 +129,7 @@ fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
                out_f(3u, v.position.w); out_f(4u, v.uv.x); out_f(5u, v.uv.y);",
         inputs: 1,
         outputs: 6,
+        texture: None,
     };
     let glsl = Probe {
         header: "#include \"lodkit/fullscreen.glsl\"",
@@ -135,6 +138,7 @@ fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
                out_f(3u, v.position.w); out_f(4u, v.uv.x); out_f(5u, v.uv.y);",
         inputs: 1,
         outputs: 6,
+        texture: None,
     };
     let want = fullscreen_want();
     assert_eq!(
@@ -161,6 +165,7 @@ fn probe_detects_a_wrong_twin() {
                out_f(0u, distance(a, b));",
         inputs: 6,
         outputs: 1,
+        texture: None,
     };
     let got = floats(&run_wgsl(gpu, &probe, &normal_inputs(&pairs)));
     let want: Vec<f32> = pairs

@@ -102,11 +102,20 @@ pub struct Probe<'a> {
     pub inputs: usize,
     /// Output words per case.
     pub outputs: usize,
+    /// An R32Float texture (size, row-major texels) bound as `probe_tex` (WGSL `texture_2d<f32>`;
+    /// GLSL `texture2D`, with `probe_sampler` to make a `sampler2D`).
+    pub texture: Option<(u32, &'a [f32])>,
 }
 
 fn wgsl_probe(p: &Probe) -> String {
+    let texture = if p.texture.is_some() {
+        "@group(0) @binding(2) var probe_tex: texture_2d<f32>;"
+    } else {
+        ""
+    };
     format!(
         "{header}
+{texture}
 @group(0) @binding(0) var<storage, read> probe_in: array<u32>;
 @group(0) @binding(1) var<storage, read_write> probe_out: array<u32>;
 var<private> probe_case: u32;
@@ -129,12 +138,18 @@ fn main(@builtin(workgroup_id) id: vec3<u32>) {{
 
 /// The GLSL probe shader (compute, `#include`s resolved against the library).
 pub fn glsl_probe(p: &Probe) -> String {
+    let texture = if p.texture.is_some() {
+        "layout(set = 0, binding = 2) uniform texture2D probe_tex;\nlayout(set = 0, binding = 3) uniform sampler probe_sampler;"
+    } else {
+        ""
+    };
     format!(
         "#version 450
 #extension GL_GOOGLE_include_directive : require
 layout(local_size_x = 1) in;
 layout(std430, set = 0, binding = 0) readonly buffer ProbeIn {{ uint probe_in[]; }};
 layout(std430, set = 0, binding = 1) buffer ProbeOut {{ uint probe_out[]; }};
+{texture}
 {header}
 uint probe_case;
 uint inp_u(uint k) {{ return probe_in[probe_case * {inputs}u + k]; }}
@@ -228,19 +243,48 @@ fn run(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
+    let mut entries = vec![
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: input.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 1,
+            resource: output.as_entire_binding(),
+        },
+    ];
+    let view = probe.texture.map(|(size, texels)| {
+        let texture = device.create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("probe texture"),
+                size: wgpu::Extent3d {
+                    width: size,
+                    height: size,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::R32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(texels),
+        );
+        texture.create_view(&Default::default())
+    });
+    if let Some(view) = &view {
+        entries.push(wgpu::BindGroupEntry {
+            binding: 2,
+            resource: wgpu::BindingResource::TextureView(view),
+        });
+    }
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("probe"),
         layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: output.as_entire_binding(),
-            },
-        ],
+        entries: &entries,
     });
     let mut encoder = device.create_command_encoder(&Default::default());
     {

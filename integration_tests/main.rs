@@ -5,6 +5,7 @@
 mod harness;
 mod cli;
 mod composition;
+mod frame_sequential;
 mod gpu_twins;
 mod selection;
 mod single_frame;

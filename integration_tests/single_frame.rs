@@ -95,6 +95,7 @@ fn screen_door_twins_are_complementary_on_the_gpu() {
                out_u(0u, w[0]); out_u(1u, w[1]); out_u(2u, w[2]); out_u(3u, w[3]);",
         inputs: 2,
         outputs: 4,
+        texture: None,
     };
     let glsl = Probe {
         header: "#include \"lodkit/screen_door.glsl\"",
@@ -108,6 +109,7 @@ fn screen_door_twins_are_complementary_on_the_gpu() {
                out_u(0u, w[0]); out_u(1u, w[1]); out_u(2u, w[2]); out_u(3u, w[3]);",
         inputs: 2,
         outputs: 4,
+        texture: None,
     };
     for (pattern, defs) in [
         (DitherPattern::Bayer4x4, &[][..]),
@@ -152,6 +154,7 @@ fn unpopping_twins_match_on_the_gpu() {
                out_u(2u, u32(unpopping_is_opaque(t, false))); out_u(3u, u32(unpopping_is_opaque(t, true)));",
         inputs: 1,
         outputs: 4,
+        texture: None,
     };
     let glsl = Probe {
         header: "#include \"lodkit/unpopping.glsl\"",
@@ -160,6 +163,7 @@ fn unpopping_twins_match_on_the_gpu() {
                out_u(2u, uint(lodkit_unpopping_is_opaque(t, false))); out_u(3u, uint(lodkit_unpopping_is_opaque(t, true)));",
         inputs: 1,
         outputs: 4,
+        texture: None,
     };
     let want: Vec<u32> = ts
         .iter()

@@ -11,6 +11,9 @@
 //! - [`unpopping`], [`screen_door`]: single-frame transitions without popping (Giegl & Wimmer's
 //!   unpopping render states; complementary screen-door dither).
 //! - [`normal_distance`], [`fullscreen`]: Rust twins of the shader functions of the same names.
+//! - [`frame_sequential`] with [`visibility`], [`lod_buffer`], [`reproject`], [`combine`]:
+//!   frame-sequential LOD interpolation (Scherzer & Wimmer 2008): the transition scheduler, the
+//!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders.
 //! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
 //! - [`gpu`] (feature `wgpu`): headless devices and ready-made passes.
 //!
@@ -19,13 +22,18 @@
 
 #![warn(missing_docs)]
 
+pub mod combine;
+pub mod frame_sequential;
 pub mod fullscreen;
+pub mod lod_buffer;
 pub mod noise;
 pub mod normal_distance;
+pub mod reproject;
 pub mod screen_door;
 pub mod select;
 pub mod shaders;
 pub mod unpopping;
+pub mod visibility;
 
 #[cfg(feature = "wgpu")]
 pub mod gpu;

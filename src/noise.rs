@@ -33,12 +33,28 @@ pub fn void_and_cluster(size: usize, seed: u64) -> Vec<u32> {
             (-(dx * dx + dy * dy) / (2.0 * SIGMA * SIGMA)).exp()
         })
         .collect();
+    // The Gaussian is below 1e-3 of its peak beyond 4 sigma: update only that window (the whole
+    // array when it is smaller), which keeps a 64x64 array fast.
+    let reach = ((4.0 * SIGMA).ceil() as usize).min(size / 2);
     let toggle = |energy: &mut [f32], p: usize, sign: f32| {
         let (px, py) = (p % size, p / size);
-        for (q, e) in energy.iter_mut().enumerate() {
-            let dx = (q % size + size - px) % size;
-            let dy = (q / size + size - py) % size;
-            *e += sign * kernel[dy * size + dx];
+        let span = if size < 32 { 0..size } else { 0..2 * reach + 1 };
+        for oy in span.clone() {
+            let dy = if span.len() == size {
+                oy
+            } else {
+                (oy + size - reach) % size
+            };
+            let qy = (py + dy) % size;
+            for ox in span.clone() {
+                let dx = if span.len() == size {
+                    ox
+                } else {
+                    (ox + size - reach) % size
+                };
+                let qx = (px + dx) % size;
+                energy[qy * size + qx] += sign * kernel[dy * size + dx];
+            }
         }
     };
     let tightest = |pattern: &[bool], energy: &[f32]| {
@@ -115,21 +131,39 @@ pub fn white_noise(count: usize, seed: u64) -> Vec<f32> {
 /// Radially averaged power spectrum of a `size` x `size` pattern (mean removed), in `size / 2`
 /// rings of integer radius 1..=size/2. Blue noise has little power in the low rings.
 pub fn radial_power_spectrum(values: &[f32], size: usize) -> Vec<f32> {
-    let mean = values.iter().sum::<f32>() / values.len() as f32;
+    let mean = values.iter().map(|&v| f64::from(v)).sum::<f64>() / values.len() as f64;
+    let tau = std::f64::consts::TAU;
+    let (cos, sin): (Vec<f64>, Vec<f64>) = (0..size)
+        .map(|k| {
+            let a = tau * k as f64 / size as f64;
+            (a.cos(), a.sin())
+        })
+        .unzip();
+    // Separable DFT: rows, then columns.
+    let mut rows = vec![(0.0f64, 0.0f64); size * size];
+    for y in 0..size {
+        for u in 0..size {
+            let (mut re, mut im) = (0.0, 0.0);
+            for x in 0..size {
+                let s = f64::from(values[y * size + x]) - mean;
+                let k = (u * x) % size;
+                re += s * cos[k];
+                im -= s * sin[k];
+            }
+            rows[y * size + u] = (re, im);
+        }
+    }
     let half = size / 2;
     let mut power = vec![0.0f64; half + 1];
     let mut count = vec![0usize; half + 1];
-    let tau = std::f64::consts::TAU;
-    for v in 0..size {
-        for u in 0..size {
-            let (mut re, mut im) = (0.0f64, 0.0f64);
+    for u in 0..size {
+        for v in 0..size {
+            let (mut re, mut im) = (0.0, 0.0);
             for y in 0..size {
-                for x in 0..size {
-                    let a = tau * ((u * x) as f64 + (v * y) as f64) / size as f64;
-                    let s = (values[y * size + x] - mean) as f64;
-                    re += s * a.cos();
-                    im -= s * a.sin();
-                }
+                let (a, b) = rows[y * size + u];
+                let k = (v * y) % size;
+                re += a * cos[k] + b * sin[k];
+                im += b * cos[k] - a * sin[k];
             }
             let fu = u.min(size - u) as f64;
             let fv = v.min(size - v) as f64;

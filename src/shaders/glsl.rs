@@ -76,7 +76,7 @@ pub(crate) fn expand_includes(
         },
         seen: vec![file.to_owned()],
     };
-    expander.expand(file, Arc::from(source))?;
+    expander.expand(file, Arc::from(source), false)?;
     Ok(expander.out)
 }
 
@@ -92,7 +92,7 @@ impl Expander<'_> {
         self.out.text.push_str(&source[range]);
     }
 
-    fn expand(&mut self, file: &str, source: Arc<str>) -> Result<(), ShaderError> {
+    fn expand(&mut self, file: &str, source: Arc<str>, embedded: bool) -> Result<(), ShaderError> {
         let mut copied = 0;
         let mut line_start = 0;
         for line in source.split_inclusive('\n') {
@@ -115,11 +115,11 @@ impl Expander<'_> {
                 .trim()
                 .trim_matches(|c| c == '"' || c == '<' || c == '>');
             let name_at = start + line.find(name).unwrap_or(0);
-            let (key, path, text) =
-                self.resolve(file, &source, name, name_at..name_at + name.len())?;
+            let (key, path, text, is_embedded) =
+                self.resolve(file, &source, name, name_at..name_at + name.len(), embedded)?;
             if !self.seen.contains(&key) {
                 self.seen.push(key);
-                self.expand(&path, text)?;
+                self.expand(&path, text, is_embedded)?;
             }
             self.out.text.push('\n');
         }
@@ -133,8 +133,13 @@ impl Expander<'_> {
         source: &Arc<str>,
         name: &str,
         at: Range<usize>,
-    ) -> Result<(String, String, Arc<str>), ShaderError> {
-        let parent = Path::new(file).parent().map(Path::to_path_buf);
+        embedded: bool,
+    ) -> Result<(String, String, Arc<str>, bool), ShaderError> {
+        // An embedded lodkit file has no folder on disk: its includes come from the library.
+        let parent = Path::new(file)
+            .parent()
+            .filter(|_| !embedded)
+            .map(Path::to_path_buf);
         for dir in parent.iter().chain(self.include_dirs) {
             let candidate = dir.join(name);
             if candidate.is_file() {
@@ -144,12 +149,12 @@ impl Expander<'_> {
                     .unwrap_or(candidate.clone())
                     .display()
                     .to_string();
-                return Ok((key, candidate.display().to_string(), Arc::from(text)));
+                return Ok((key, candidate.display().to_string(), Arc::from(text), false));
             }
         }
         if let Some(module) = registry::find_glsl_include(name) {
             let path = format!("shader_lib/{}", module.path);
-            return Ok((path.clone(), path, Arc::from(module.source)));
+            return Ok((path.clone(), path, Arc::from(module.source), true));
         }
         let mut d = Diagnostic::new(
             DiagnosticKind::UnknownImport,

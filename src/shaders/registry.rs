@@ -282,9 +282,9 @@ fn functions(source: &str, language: Language) -> Vec<FunctionInfo> {
         let mut signature = String::new();
         for l in &lines[i..] {
             let part = l.split('{').next().unwrap_or_default();
-            signature.push_str(part.trim());
+            signature.push_str(part.trim().trim_end_matches('\\').trim_end());
             signature.push(' ');
-            if l.contains('{') || l.contains(';') {
+            if l.contains('{') || l.contains(';') || l.starts_with("#define") {
                 break;
             }
         }
@@ -297,8 +297,13 @@ fn functions(source: &str, language: Language) -> Vec<FunctionInfo> {
     out
 }
 
-/// `name` for a file-scope GLSL function definition `type name(...)` starting at column 0.
+/// `name` for a file-scope GLSL function definition `type name(...)` starting at column 0, or a
+/// function-like macro `#define name(...)` (how GLSL twins take textures).
 fn glsl_function_name(line: &str) -> Option<&str> {
+    if let Some(rest) = line.strip_prefix("#define ") {
+        let name = identifier(rest);
+        return rest[name.len()..].starts_with('(').then_some(name);
+    }
     if line.starts_with(char::is_whitespace) || line.starts_with('#') || line.starts_with("//") {
         return None;
     }

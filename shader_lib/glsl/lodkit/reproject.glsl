@@ -1,0 +1,30 @@
+// lodkit::reproject — back-projection of a pixel of the newer LOD buffer into the older one
+// (Scherzer & Wimmer 2008, sec. 3.4, eq. 2).
+//
+// GLSL twin of shader_lib/wgsl/lodkit/reproject.wgsl; same semantics, `lodkit_` prefix. uv is in
+// texture space with (0,0) at the top-left (Vulkan); on OpenGL flip y before and after.
+//
+// Exports:
+//   lodkit_reproject(uv, depth, new_to_old) -> vec3   (old uv, old depth); uv (-1,-1) if behind
+//   lodkit_in_viewport(uv) -> bool
+// Shader defs: none.
+#ifndef LODKIT_REPROJECT_GLSL
+#define LODKIT_REPROJECT_GLSL
+
+/// Position in the older LOD buffer of the newer buffer's pixel at `uv` with clip `depth`.
+vec3 lodkit_reproject(vec2 uv, float depth, mat4 new_to_old) {
+    vec4 ndc = vec4(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    vec4 old = new_to_old * ndc;
+    if (old.w <= 0.0) {
+        return vec3(-1.0, -1.0, depth);
+    }
+    vec3 p = old.xyz / old.w;
+    return vec3(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5, p.z);
+}
+
+/// Whether `uv` lies inside the older buffer ([0, 1] on both axes).
+bool lodkit_in_viewport(vec2 uv) {
+    return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+}
+
+#endif // LODKIT_REPROJECT_GLSL

@@ -1,0 +1,59 @@
+// passes/combine — the frame-sequential combination pass (Scherzer & Wimmer 2008, sec. 3.4):
+// merges the LOD buffer rendered this frame with the one from the frame before, reprojected.
+//
+// For each pixel: read the newer color and id/depth; reproject (uv, depth) into the older buffer;
+// outside it -> newer color; else combine_samples(newer with its reprojected depth, older texel).
+// Built only from lodkit::fullscreen, lodkit::lod_buffer, lodkit::reproject, lodkit::combine.
+//
+// Entry points:
+//   vs_main   fullscreen triangle, draw(0..3)
+//   fs_main   @location(0) combined color
+// Bindings (group 0): 0 newer_color texture_2d<f32>, 1 newer_id_depth texture_2d<u32>,
+//   2 older_color texture_2d<f32>, 3 older_id_depth texture_2d<u32>, 4 params: CombineParams.
+// Shader defs: LODKIT_REVERSE_Z (bool, default off) — passed on to lodkit::combine.
+#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+#import lodkit::lod_buffer::{lod_buffer_id, lod_buffer_depth}
+#import lodkit::reproject::{reproject, in_viewport}
+#import lodkit::combine::{LodSample, combine_samples}
+
+/// Per-frame parameters.
+struct CombineParams {
+    /// P_old V_old V_new^-1 P_new^-1.
+    new_to_old: mat4x4<f32>,
+}
+
+@group(0) @binding(0) var newer_color: texture_2d<f32>;
+@group(0) @binding(1) var newer_id_depth: texture_2d<u32>;
+@group(0) @binding(2) var older_color: texture_2d<f32>;
+@group(0) @binding(3) var older_id_depth: texture_2d<u32>;
+@group(0) @binding(4) var<uniform> params: CombineParams;
+
+/// Fullscreen triangle.
+@vertex
+fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
+    return fullscreen_vertex(vertex_index);
+}
+
+/// Combines the two LOD buffers at this pixel.
+@fragment
+fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
+    let size = textureDimensions(newer_color, 0);
+    let pixel = vec2<u32>(v.position.xy);
+    let newer_texel = textureLoad(newer_id_depth, pixel, 0).xy;
+    let newer_depth = lod_buffer_depth(newer_texel);
+    let color = textureLoad(newer_color, pixel, 0);
+    let uv = (vec2<f32>(pixel) + 0.5) / vec2<f32>(size);
+    let old = reproject(uv, newer_depth, params.new_to_old);
+    if (!in_viewport(old.xy)) {
+        return color;
+    }
+    let old_pixel = min(vec2<u32>(old.xy * vec2<f32>(size)), size - vec2<u32>(1u));
+    let older_texel = textureLoad(older_id_depth, old_pixel, 0).xy;
+    let newer = LodSample(color, lod_buffer_id(newer_texel), old.z);
+    let older = LodSample(
+        textureLoad(older_color, old_pixel, 0),
+        lod_buffer_id(older_texel),
+        lod_buffer_depth(older_texel),
+    );
+    return combine_samples(newer, older);
+}

@@ -1,0 +1,31 @@
+// lodkit::reproject — back-projection of a pixel of the newer LOD buffer into the older one
+// (Scherzer & Wimmer 2008, sec. 3.4, eq. 2: p_old = P_old V_old V_new^-1 P_new^-1 p_new).
+//
+// uv is texture space ((0,0) top-left), depth the clip depth stored in the LOD buffer. The host
+// builds `new_to_old` (lodkit::reproject::new_to_old_matrix). Works for standard and reversed Z
+// and for infinite far planes: the chain stays homogeneous until the final divide, so a sky pixel
+// (a point at infinity) reprojects by the rotation alone.
+//
+// Exports:
+//   reproject(uv, depth, new_to_old) -> vec3<f32>   (old uv, old depth); uv = (-1, -1) when the
+//                                                   point is behind the older camera
+//   in_viewport(uv) -> bool   whether an old uv lies inside the older buffer
+// Shader defs: none (LODKIT_REVERSE_Z matters only where depths are compared: lodkit::combine).
+#define_import_path lodkit::reproject
+
+/// Position in the older LOD buffer of the newer buffer's pixel at `uv` with clip `depth`:
+/// (old uv, old clip depth). A point behind the older camera gets uv (-1, -1).
+fn reproject(uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>) -> vec3<f32> {
+    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let old = new_to_old * ndc;
+    if (old.w <= 0.0) {
+        return vec3<f32>(-1.0, -1.0, depth);
+    }
+    let p = old.xyz / old.w;
+    return vec3<f32>(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5, p.z);
+}
+
+/// Whether `uv` lies inside the older buffer ([0, 1] on both axes).
+fn in_viewport(uv: vec2<f32>) -> bool {
+    return all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0));
+}

@@ -1,0 +1,45 @@
+// lodkit::visibility — object-space visibility textures for frame-sequential LOD
+// (Scherzer & Wimmer 2008, sec. 3.3, eq. 1, Fig. 2).
+//
+// A t-instance's fragments are kept where the visibility texture at the fragment's object-space
+// position is at most tau (eq. 1 discards visTex(p) > tau). Texel values lie in (0, 1), so
+// tau = 0 keeps nothing and tau = 1 keeps everything. The lookup uses textureLoad (no sampler, no
+// derivatives), so it also works in depth-only and shadow passes.
+//
+// Exports:
+//   visibility_coord(object_pos) -> vec2<f32>   (p.x + p.z, p.y + p.z); use the position BEFORE
+//                                               animation/skinning so the pattern sticks to the object
+//   visibility_threshold(progress, incoming) -> f32   Fig. 2: incoming 0 -> 1 over the first half,
+//                                                      outgoing 1 -> 0 over the second
+//   visibility_texel(size, object_pos) -> vec2<u32>   texel looked up (repeat addressing, nearest)
+//   check_visibility(vis_tex, object_pos, tau) -> bool   true = keep the fragment
+// The texture repeats once per object-space unit: scale object_pos to change the pattern's size.
+// Shader defs: none.
+#define_import_path lodkit::visibility
+#import lodkit::unpopping::unpopping_alpha
+
+/// Lookup coordinate of an object-space position: (p.x + p.z, p.y + p.z).
+fn visibility_coord(object_pos: vec3<f32>) -> vec2<f32> {
+    return object_pos.xy + vec2<f32>(object_pos.z);
+}
+
+/// Visibility threshold tau of one LOD of a t-instance at transition `progress` in [0, 1]
+/// (Fig. 2): the incoming LOD min(2 progress, 1), the outgoing min(2 (1 - progress), 1). Both are 1
+/// at progress 0.5 (every fragment of both LODs drawn). The same schedule as unpopping's alpha.
+fn visibility_threshold(progress: f32, incoming: bool) -> f32 {
+    return unpopping_alpha(progress, incoming);
+}
+
+/// The texel of a `size` visibility texture that `object_pos` looks up: repeat addressing,
+/// nearest texel.
+fn visibility_texel(size: vec2<u32>, object_pos: vec3<f32>) -> vec2<u32> {
+    let uv = fract(visibility_coord(object_pos));
+    return min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
+}
+
+/// Whether to keep a fragment at object-space position `object_pos` for threshold `tau`: keeps
+/// it where the texel (repeat addressing, nearest) is at most tau.
+fn check_visibility(vis_tex: texture_2d<f32>, object_pos: vec3<f32>, tau: f32) -> bool {
+    let texel = visibility_texel(textureDimensions(vis_tex, 0), object_pos);
+    return textureLoad(vis_tex, texel, 0).r <= tau;
+}

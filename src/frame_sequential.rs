@@ -1,0 +1,294 @@
+//! The frame-sequential transition scheduler (Scherzer & Wimmer 2008, sec. 3.2, 3.5, 4.1).
+//!
+//! Instances are n-instances (no transition: drawn normally, id 0) or t-instances (in a
+//! transition between two LODs). A t-instance is drawn with ONE of its two LODs per frame,
+//! alternating with the frame parity: even frames draw the outgoing LOD, odd frames the incoming,
+//! each with its visibility threshold tau (Fig. 2) and the instance's id. The combine pass merges
+//! this frame's LOD buffer with last frame's. Pure math, no wgpu.
+//!
+//! ```
+//! use lodkit::frame_sequential::{Drive, TransitionScheduler};
+//! let mut s = TransitionScheduler::new();
+//! let tree = s.insert(0);
+//! s.begin_transition(tree, 1, Drive::Time { seconds: 0.5 }).unwrap();
+//! s.advance(1.0 / 60.0);
+//! let draw = s.draw(tree).unwrap();
+//! assert!(draw.id != 0); // a t-instance
+//! ```
+
+/// Frames an id waits after its transition ends before it is handed out again: the older LOD
+/// buffer still holds it for one frame, and one more keeps a margin.
+pub const ID_QUARANTINE_FRAMES: u64 = 2;
+
+/// Handle of an instance in a [`TransitionScheduler`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct InstanceKey {
+    index: u32,
+    generation: u32,
+}
+
+/// What drives a transition's progress.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drive {
+    /// Progress grows by dt / seconds each frame; the transition ends at 1.
+    Time {
+        /// Duration in seconds.
+        seconds: f32,
+    },
+    /// The caller sets progress (e.g. from distance, `LodSelection::transition`) with
+    /// [`TransitionScheduler::set_progress`]; the transition ends when it reaches 1.
+    Progress,
+}
+
+/// Why a scheduler call was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScheduleError {
+    /// The key names no live instance (removed, or from another scheduler).
+    #[error("no such instance (removed or stale key)")]
+    UnknownInstance,
+    /// The instance is already in a transition.
+    #[error("the instance is already in a transition")]
+    AlreadyInTransition,
+    /// A duration that is not finite and positive.
+    #[error("transition duration {0} s must be finite and > 0")]
+    BadDuration(f32),
+    /// Every id in `1..=u32::MAX` is live or quarantined.
+    #[error("out of instance ids")]
+    OutOfIds,
+}
+
+/// How to draw one instance this frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameDraw {
+    /// The LOD to draw.
+    pub lod: u8,
+    /// Instance id to write into the LOD buffer (0 for n-instances).
+    pub id: u32,
+    /// Visibility threshold: keep fragments whose visibility texel is <= tau (1 = all).
+    pub tau: f32,
+    /// Transition progress in [0, 1] (0 for n-instances).
+    pub progress: f32,
+    /// Whether this draw is the incoming LOD of a transition.
+    pub incoming: bool,
+}
+
+#[derive(Clone, Debug)]
+struct Transition {
+    from: u8,
+    to: u8,
+    id: u32,
+    progress: f32,
+    drive: Drive,
+}
+
+#[derive(Clone, Debug)]
+struct Slot {
+    generation: u32,
+    live: bool,
+    lod: u8,
+    transition: Option<Transition>,
+}
+
+/// Tracks instances, their transitions, frame parity and instance ids.
+#[derive(Clone, Debug, Default)]
+pub struct TransitionScheduler {
+    frame: u64,
+    slots: Vec<Slot>,
+    free_slots: Vec<u32>,
+    next_id: u32,
+    free_ids: std::collections::VecDeque<(u64, u32)>,
+}
+
+impl TransitionScheduler {
+    /// An empty scheduler at frame 0.
+    pub fn new() -> Self {
+        Self {
+            next_id: 1,
+            ..Default::default()
+        }
+    }
+
+    /// The current frame number (advanced by [`advance`](Self::advance)).
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Which LOD buffer of the pair this frame renders into (0 or 1); the other is the older one.
+    pub fn buffer_index(&self) -> usize {
+        (self.frame % 2) as usize
+    }
+
+    /// Adds an n-instance at `lod`.
+    pub fn insert(&mut self, lod: u8) -> InstanceKey {
+        let slot = Slot {
+            generation: 0,
+            live: true,
+            lod,
+            transition: None,
+        };
+        match self.free_slots.pop() {
+            Some(index) => {
+                let s = &mut self.slots[index as usize];
+                let generation = s.generation.wrapping_add(1);
+                *s = Slot { generation, ..slot };
+                InstanceKey { index, generation }
+            }
+            None => {
+                self.slots.push(slot);
+                InstanceKey {
+                    index: self.slots.len() as u32 - 1,
+                    generation: 0,
+                }
+            }
+        }
+    }
+
+    fn slot_mut(&mut self, key: InstanceKey) -> Result<&mut Slot, ScheduleError> {
+        self.slots
+            .get_mut(key.index as usize)
+            .filter(|s| s.live && s.generation == key.generation)
+            .ok_or(ScheduleError::UnknownInstance)
+    }
+
+    fn slot(&self, key: InstanceKey) -> Result<&Slot, ScheduleError> {
+        self.slots
+            .get(key.index as usize)
+            .filter(|s| s.live && s.generation == key.generation)
+            .ok_or(ScheduleError::UnknownInstance)
+    }
+
+    /// Removes an instance; a transition it was in ends and its id is quarantined.
+    pub fn remove(&mut self, key: InstanceKey) -> Result<(), ScheduleError> {
+        let frame = self.frame;
+        let slot = self.slot_mut(key)?;
+        slot.live = false;
+        let released = slot.transition.take().map(|t| t.id);
+        if let Some(id) = released {
+            self.free_ids.push_back((frame, id));
+        }
+        self.free_slots.push(key.index);
+        Ok(())
+    }
+
+    fn allocate_id(&mut self) -> Result<u32, ScheduleError> {
+        if let Some(&(released, id)) = self.free_ids.front()
+            && self.frame >= released + ID_QUARANTINE_FRAMES
+        {
+            self.free_ids.pop_front();
+            return Ok(id);
+        }
+        if self.next_id == 0 {
+            return Err(ScheduleError::OutOfIds);
+        }
+        let id = self.next_id;
+        self.next_id = self.next_id.wrapping_add(1);
+        Ok(id)
+    }
+
+    /// Starts a transition of `key` from its LOD to `to`. A transition to the LOD it already has
+    /// is a no-op.
+    pub fn begin_transition(
+        &mut self,
+        key: InstanceKey,
+        to: u8,
+        drive: Drive,
+    ) -> Result<(), ScheduleError> {
+        if let Drive::Time { seconds } = drive
+            && !(seconds.is_finite() && seconds > 0.0)
+        {
+            return Err(ScheduleError::BadDuration(seconds));
+        }
+        let slot = self.slot(key)?;
+        if slot.transition.is_some() {
+            return Err(ScheduleError::AlreadyInTransition);
+        }
+        if slot.lod == to {
+            return Ok(());
+        }
+        let id = self.allocate_id()?;
+        let slot = self.slot_mut(key)?;
+        slot.transition = Some(Transition {
+            from: slot.lod,
+            to,
+            id,
+            progress: 0.0,
+            drive,
+        });
+        Ok(())
+    }
+
+    /// Sets the progress of a [`Drive::Progress`] transition (clamped to [0, 1]; NaN counts as 0).
+    /// At 1 the transition ends at the next [`advance`](Self::advance).
+    pub fn set_progress(&mut self, key: InstanceKey, progress: f32) -> Result<(), ScheduleError> {
+        let slot = self.slot_mut(key)?;
+        if let Some(t) = slot.transition.as_mut() {
+            t.progress = if progress.is_nan() {
+                0.0
+            } else {
+                progress.clamp(0.0, 1.0)
+            };
+        }
+        Ok(())
+    }
+
+    /// Starts the next frame: flips the parity, moves time-driven transitions on by `dt` seconds,
+    /// and ends transitions that reached 1 (the instance becomes an n-instance at the new LOD and
+    /// its id goes into quarantine).
+    pub fn advance(&mut self, dt: f32) {
+        self.frame += 1;
+        let dt = if dt > 0.0 { dt } else { 0.0 };
+        let frame = self.frame;
+        for slot in self.slots.iter_mut().filter(|s| s.live) {
+            let Some(t) = slot.transition.as_mut() else {
+                continue;
+            };
+            if t.progress >= 1.0 {
+                slot.lod = t.to;
+                self.free_ids.push_back((frame, t.id));
+                slot.transition = None;
+                continue;
+            }
+            if let Drive::Time { seconds } = t.drive {
+                t.progress = (t.progress + dt / seconds).min(1.0);
+            }
+        }
+    }
+
+    /// How to draw `key` this frame.
+    pub fn draw(&self, key: InstanceKey) -> Result<FrameDraw, ScheduleError> {
+        let slot = self.slot(key)?;
+        Ok(match &slot.transition {
+            None => FrameDraw {
+                lod: slot.lod,
+                id: 0,
+                tau: 1.0,
+                progress: 0.0,
+                incoming: false,
+            },
+            Some(t) => {
+                let incoming = self.frame % 2 == 1;
+                FrameDraw {
+                    lod: if incoming { t.to } else { t.from },
+                    id: t.id,
+                    tau: crate::visibility::visibility_threshold(t.progress, incoming),
+                    progress: t.progress,
+                    incoming,
+                }
+            }
+        })
+    }
+
+    /// Whether `key` is a t-instance.
+    pub fn in_transition(&self, key: InstanceKey) -> bool {
+        self.slot(key).is_ok_and(|s| s.transition.is_some())
+    }
+
+    /// Ids of live t-instances.
+    pub fn live_ids(&self) -> Vec<u32> {
+        self.slots
+            .iter()
+            .filter(|s| s.live)
+            .filter_map(|s| s.transition.as_ref().map(|t| t.id))
+            .collect()
+    }
+}

@@ -1,0 +1,43 @@
+//! Back-projection between the two LOD buffers (Scherzer & Wimmer 2008, eq. 2): Rust twins of
+//! `lodkit::reproject` and the matrix the combine pass needs.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+/// P_old V_old V_new^-1 P_new^-1: maps the newer buffer's NDC (with its stored depth) to the older
+/// buffer's clip space. Works for standard, reversed and infinite projections (glam's inverse of
+/// an infinite perspective is finite).
+///
+/// ```
+/// # use lodkit::reproject::{new_to_old_matrix, reproject};
+/// # use glam::{Mat4, Vec2, Vec3};
+/// let p = glam::camera::rh::proj::directx::perspective(1.0, 1.0, 0.1, 100.0);
+/// let v = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y);
+/// let m = new_to_old_matrix(&v, &p, &v, &p); // camera did not move
+/// let r = reproject(Vec2::new(0.3, 0.7), 0.9, &m);
+/// assert!((r - Vec3::new(0.3, 0.7, 0.9)).abs().max_element() < 1e-5);
+/// ```
+pub fn new_to_old_matrix(
+    view_new: &Mat4,
+    proj_new: &Mat4,
+    view_old: &Mat4,
+    proj_old: &Mat4,
+) -> Mat4 {
+    *proj_old * *view_old * view_new.inverse() * proj_new.inverse()
+}
+
+/// Position in the older buffer of the newer buffer's pixel at texture-space `uv` with clip
+/// `depth`: (old uv, old depth); uv (-1, -1) when the point is behind the older camera.
+pub fn reproject(uv: Vec2, depth: f32, new_to_old: &Mat4) -> Vec3 {
+    let ndc = Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let old = *new_to_old * ndc;
+    if old.w <= 0.0 {
+        return Vec3::new(-1.0, -1.0, depth);
+    }
+    let p = old.truncate() / old.w;
+    Vec3::new(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5, p.z)
+}
+
+/// Whether `uv` lies inside the older buffer ([0, 1] on both axes).
+pub fn in_viewport(uv: Vec2) -> bool {
+    uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all()
+}

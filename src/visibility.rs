@@ -1,0 +1,115 @@
+//! Object-space visibility textures for frame-sequential LOD (Scherzer & Wimmer 2008, sec. 3.3):
+//! Rust twins of `lodkit::visibility` and the generators of the textures themselves.
+
+use glam::{UVec2, Vec2, Vec3};
+
+/// Lookup coordinate of an object-space position: (p.x + p.z, p.y + p.z).
+///
+/// ```
+/// # use lodkit::visibility::visibility_coord;
+/// assert_eq!(visibility_coord(glam::Vec3::new(1.0, 2.0, 3.0)), glam::Vec2::new(4.0, 5.0));
+/// ```
+pub fn visibility_coord(object_pos: Vec3) -> Vec2 {
+    Vec2::new(object_pos.x + object_pos.z, object_pos.y + object_pos.z)
+}
+
+/// Threshold tau of one LOD of a t-instance at `progress` (Fig. 2): incoming min(2p, 1),
+/// outgoing min(2(1 - p), 1). The same schedule as [`unpopping_alpha`](crate::unpopping::unpopping_alpha).
+///
+/// ```
+/// # use lodkit::visibility::visibility_threshold;
+/// assert_eq!((visibility_threshold(0.0, true), visibility_threshold(0.0, false)), (0.0, 1.0));
+/// assert_eq!((visibility_threshold(0.5, true), visibility_threshold(0.5, false)), (1.0, 1.0));
+/// assert_eq!((visibility_threshold(1.0, true), visibility_threshold(1.0, false)), (1.0, 0.0));
+/// ```
+pub fn visibility_threshold(progress: f32, incoming: bool) -> f32 {
+    crate::unpopping::unpopping_alpha(progress, incoming)
+}
+
+/// A square visibility texture: `size` x `size` values in (0, 1), row-major (upload as R32Float
+/// or R8Unorm/R16Unorm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VisibilityTexture {
+    /// Width and height.
+    pub size: u32,
+    /// Texel values, all strictly between 0 and 1.
+    pub texels: Vec<f32>,
+}
+
+/// How fragments of a t-instance appear and vanish.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VisibilityPattern {
+    /// Uniform white noise: the paper's choice (64x64).
+    WhiteNoise,
+    /// Void-and-cluster blue noise: the same share of fragments, spread evenly, without the
+    /// clumps and holes of white noise.
+    BlueNoise,
+    /// Decreasing from the center outward: fragments appear from the rim inward (and the outgoing
+    /// LOD vanishes from the center out).
+    Radial,
+}
+
+/// Generates a visibility texture, deterministic for `seed` (the radial pattern ignores it).
+///
+/// ```
+/// # use lodkit::visibility::{visibility_texture, VisibilityPattern};
+/// let t = visibility_texture(VisibilityPattern::BlueNoise, 16, 3);
+/// assert!(t.texels.iter().all(|&v| v > 0.0 && v < 1.0));
+/// ```
+pub fn visibility_texture(pattern: VisibilityPattern, size: u32, seed: u64) -> VisibilityTexture {
+    let n = (size * size) as usize;
+    let texels = match pattern {
+        VisibilityPattern::WhiteNoise => crate::noise::white_noise(n, seed)
+            .into_iter()
+            .map(|v| v.max(0.5 / (1 << 24) as f32))
+            .collect(),
+        VisibilityPattern::BlueNoise => crate::noise::void_and_cluster(size as usize, seed)
+            .into_iter()
+            .map(|r| (r as f32 + 0.5) / n as f32)
+            .collect(),
+        VisibilityPattern::Radial => {
+            let c = size as f32 / 2.0;
+            let max = c * std::f32::consts::SQRT_2;
+            (0..n)
+                .map(|i| {
+                    let p = Vec2::new(
+                        (i as u32 % size) as f32 + 0.5,
+                        (i as u32 / size) as f32 + 0.5,
+                    );
+                    let r = p.distance(Vec2::splat(c)) / max;
+                    (1.0 - r).clamp(0.5 / n as f32, 1.0 - 0.5 / n as f32)
+                })
+                .collect()
+        }
+    };
+    VisibilityTexture { size, texels }
+}
+
+/// The texel of a `size` visibility texture that `object_pos` looks up: repeat addressing,
+/// nearest texel.
+///
+/// ```
+/// # use lodkit::visibility::visibility_texel;
+/// # use glam::{UVec2, Vec3};
+/// assert_eq!(visibility_texel(UVec2::splat(64), Vec3::new(0.25, 0.5, 1.0)), UVec2::new(16, 32));
+/// ```
+pub fn visibility_texel(size: UVec2, object_pos: Vec3) -> UVec2 {
+    let c = visibility_coord(object_pos);
+    let uv = c - c.floor();
+    let texel = UVec2::new((uv.x * size.x as f32) as u32, (uv.y * size.y as f32) as u32);
+    texel.min(size - UVec2::ONE)
+}
+
+impl VisibilityTexture {
+    /// The texel value an object-space position looks up, as the shader does.
+    pub fn lookup(&self, object_pos: Vec3) -> f32 {
+        let t = visibility_texel(UVec2::splat(self.size), object_pos);
+        self.texels[(t.y * self.size + t.x) as usize]
+    }
+}
+
+/// Whether a fragment at `object_pos` is kept for threshold `tau` (texel <= tau): the Rust twin
+/// of `check_visibility`, with the texture given as data.
+pub fn check_visibility(vis_tex: &VisibilityTexture, object_pos: Vec3, tau: f32) -> bool {
+    vis_tex.lookup(object_pos) <= tau
+}
