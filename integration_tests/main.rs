@@ -6,6 +6,7 @@ mod harness;
 mod cli;
 mod composition;
 mod frame_sequential;
+mod frame_sequential_render;
 mod gpu_twins;
 mod selection;
 mod single_frame;

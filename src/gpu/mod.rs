@@ -2,6 +2,8 @@
 //! each technique.
 
 mod context;
+pub mod frame_sequential;
+pub mod lod_buffer_scene;
 pub mod readback;
 pub mod scene;
 pub mod transition_scene;

@@ -100,6 +100,47 @@ pub struct GpuMesh {
     count: u32,
 }
 
+impl GpuMesh {
+    /// Uploads `mesh`.
+    pub fn new(gpu: &GpuContext, mesh: &Mesh) -> Self {
+        let make = |contents: &[u8], usage| {
+            gpu.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: None,
+                    contents,
+                    usage,
+                })
+        };
+        GpuMesh {
+            vertices: make(
+                bytemuck::cast_slice(&mesh.vertices),
+                wgpu::BufferUsages::VERTEX,
+            ),
+            indices: make(
+                bytemuck::cast_slice(&mesh.indices),
+                wgpu::BufferUsages::INDEX,
+            ),
+            count: mesh.indices.len() as u32,
+        }
+    }
+
+    /// Triangles drawn per draw call.
+    pub fn triangles(&self) -> u32 {
+        self.count / 3
+    }
+
+    /// Binds the buffers and draws one instance (vertex layout: position, normal).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.count, 0, 0..1);
+    }
+}
+
+/// Vertex layout of [`Mesh`]: position at location 0, normal at location 1.
+pub const MESH_VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 2] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+
 /// Rust mirror of `Camera` in `passes/lod_mesh.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -250,7 +291,7 @@ impl MeshRenderer {
                     buffers: &[Some(wgpu::VertexBufferLayout {
                         array_stride: 24,
                         step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3],
+                        attributes: &MESH_VERTEX_ATTRIBUTES,
                     })],
                 },
                 primitive: wgpu::PrimitiveState {
@@ -427,9 +468,7 @@ impl MeshRenderer {
                 });
                 pass.set_blend_constant(lod_blend_constant(&item.state));
                 pass.set_bind_group(1, &self.draw_group, &[(i as u64 * self.stride) as u32]);
-                pass.set_vertex_buffer(0, item.mesh.vertices.slice(..));
-                pass.set_index_buffer(item.mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..item.mesh.count, 0, 0..1);
+                item.mesh.draw(&mut pass);
             }
         }
         gpu.queue.submit([encoder.finish()]);

@@ -1,0 +1,64 @@
+// passes/lod_buffer_mesh — a lit mesh drawn into a LOD buffer for frame-sequential LOD: what an
+// engine adds to its forward shader (Scherzer & Wimmer 2008, sec. 4.1).
+//
+// The vertex stage passes the object-space position on (before any animation, so the visibility
+// pattern sticks to the object); the fragment stage discards t-instance fragments whose
+// visibility texel exceeds tau (lodkit::visibility) and writes color and id/depth
+// (lodkit::lod_buffer). n-instances use id 0 and tau 1.
+//
+// Entry points:
+//   vs_main   @location(0) position, @location(1) normal (object space)
+//   fs_main   LodBufferOutput (location 0 color, location 1 rg32uint id/depth)
+// Bindings: group 0: 0 `camera: Camera` (uniform), 1 `vis_tex: texture_2d<f32>`;
+//   group 1: 0 `draw: LodDraw` (uniform, dynamic offset).
+// Shader defs: none.
+#import lodkit::visibility::check_visibility
+#import lodkit::lod_buffer::{LodBufferOutput, lod_buffer_output}
+
+/// Per-view data.
+struct Camera {
+    view_proj: mat4x4<f32>,
+    /// World-space direction toward the light (w unused).
+    light_dir: vec4<f32>,
+}
+
+/// Per-draw data.
+struct LodDraw {
+    model: mat4x4<f32>,
+    color: vec4<f32>,
+    /// 0 for n-instances.
+    instance_id: u32,
+    /// Visibility threshold (1 keeps every fragment).
+    tau: f32,
+    /// Visibility texture repeats per object-space unit.
+    vis_scale: f32,
+    _pad: f32,
+}
+
+@group(0) @binding(0) var<uniform> camera: Camera;
+@group(0) @binding(1) var vis_tex: texture_2d<f32>;
+@group(1) @binding(0) var<uniform> draw: LodDraw;
+
+struct VertexOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) normal: vec3<f32>,
+    @location(1) object_pos: vec3<f32>,
+}
+
+/// Transforms to clip space; hands the object-space position to the fragment stage.
+@vertex
+fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
+    let world = draw.model * vec4<f32>(position, 1.0);
+    return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz, position);
+}
+
+/// Visibility test, Lambert shading, LOD buffer output.
+@fragment
+fn fs_main(in: VertexOut) -> LodBufferOutput {
+    if (draw.tau < 1.0 && !check_visibility(vis_tex, in.object_pos * draw.vis_scale, draw.tau)) {
+        discard;
+    }
+    let lambert = max(dot(normalize(in.normal), normalize(camera.light_dir.xyz)), 0.0);
+    let color = vec4<f32>(draw.color.rgb * (0.35 + 0.65 * lambert), 1.0);
+    return lod_buffer_output(color, draw.instance_id, in.position.z);
+}

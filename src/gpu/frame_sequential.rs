@@ -1,0 +1,281 @@
+//! wgpu glue for frame-sequential LOD: the LOD buffer pair (ping-pong) and the combine pass.
+//!
+//! Each frame the engine renders its scene into LOD buffer `scheduler.buffer_index()` (color at
+//! location 0, id/depth at location 1, see `lodkit::lod_buffer`), then calls
+//! [`CombinePass::encode`] with the matrix from [`new_to_old_matrix`](crate::reproject::new_to_old_matrix)
+//! to write the final image into its own target.
+
+use glam::Mat4;
+
+use super::GpuContext;
+use crate::lod_buffer::ID_DEPTH_FORMAT;
+use crate::shaders::{
+    ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
+};
+
+/// Depth format of the pair's shared depth buffer.
+pub const LOD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Two LOD buffers (color + id/depth each) and a depth buffer to render them with.
+#[derive(Debug)]
+pub struct LodBuffers {
+    color_format: wgpu::TextureFormat,
+    size: (u32, u32),
+    colors: [wgpu::Texture; 2],
+    id_depths: [wgpu::Texture; 2],
+    depth: wgpu::Texture,
+}
+
+impl LodBuffers {
+    /// Allocates both buffers at `width` x `height` with color format `color_format`.
+    pub fn new(
+        gpu: &GpuContext,
+        width: u32,
+        height: u32,
+        color_format: wgpu::TextureFormat,
+    ) -> Self {
+        let texture = |format, usage, label| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: width.max(1),
+                    height: height.max(1),
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        Self {
+            color_format,
+            size: (width.max(1), height.max(1)),
+            colors: [
+                texture(color_format, usage, "lod buffer color 0"),
+                texture(color_format, usage, "lod buffer color 1"),
+            ],
+            id_depths: [
+                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 0"),
+                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 1"),
+            ],
+            depth: texture(
+                LOD_DEPTH_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+                "lod buffer depth",
+            ),
+        }
+    }
+
+    /// Reallocates at a new size (a no-op at the same size). The old textures are destroyed at
+    /// once rather than left to the allocator.
+    pub fn resize(&mut self, gpu: &GpuContext, width: u32, height: u32) {
+        if (width.max(1), height.max(1)) == self.size {
+            return;
+        }
+        let old = std::mem::replace(self, Self::new(gpu, width, height, self.color_format));
+        for t in old.colors.iter().chain(&old.id_depths).chain([&old.depth]) {
+            t.destroy();
+        }
+    }
+
+    /// Width and height.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// Color texture of buffer `index` (0 or 1).
+    pub fn color(&self, index: usize) -> &wgpu::Texture {
+        &self.colors[index % 2]
+    }
+
+    /// Id/depth texture of buffer `index`.
+    pub fn id_depth(&self, index: usize) -> &wgpu::Texture {
+        &self.id_depths[index % 2]
+    }
+
+    /// The shared depth texture used while rendering either buffer.
+    pub fn depth(&self) -> &wgpu::Texture {
+        &self.depth
+    }
+
+    /// Begins a render pass into buffer `index` that clears color to `clear`, id to 0 and the
+    /// stored depth and the depth buffer to `far_depth` (1 for standard Z, 0 for reversed).
+    pub fn begin_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        index: usize,
+        clear: wgpu::Color,
+        far_depth: f32,
+    ) -> wgpu::RenderPass<'e> {
+        let color = self.colors[index % 2].create_view(&Default::default());
+        let id_depth = self.id_depths[index % 2].create_view(&Default::default());
+        let depth = self.depth.create_view(&Default::default());
+        let id_clear = wgpu::Color {
+            r: 0.0,
+            g: f64::from(far_depth.to_bits()),
+            b: 0.0,
+            a: 0.0,
+        };
+        let attachment = |view, clear| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("lod buffer"),
+            color_attachments: &[attachment(&color, clear), attachment(&id_depth, id_clear)],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(far_depth),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+}
+
+/// Rust mirror of `CombineParams` in `passes/combine.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CombineParams {
+    /// P_old V_old V_new^-1 P_new^-1, column-major.
+    pub new_to_old: [[f32; 4]; 4],
+}
+
+/// The combine pass (`passes/combine.wgsl`) as a ready object: create once per target format,
+/// call [`encode`](Self::encode) once per frame.
+#[derive(Debug)]
+pub struct CombinePass {
+    pipeline: wgpu::RenderPipeline,
+    params: wgpu::Buffer,
+}
+
+impl CombinePass {
+    /// Builds the pipeline for targets of `target_format`; `reverse_z` selects the depth
+    /// convention of the LOD buffers (`LODKIT_REVERSE_Z`).
+    pub fn new(
+        gpu: &GpuContext,
+        target_format: wgpu::TextureFormat,
+        reverse_z: bool,
+    ) -> Result<Self, ShaderError> {
+        let mut defs = std::collections::HashMap::new();
+        if reverse_z {
+            defs.insert("LODKIT_REVERSE_Z".to_owned(), ShaderDefValue::Bool(true));
+        }
+        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+            source: find_pass_source("combine").unwrap_or_default(),
+            file_path: "shader_lib/passes/combine.wgsl",
+            shader_defs: defs,
+            ..Default::default()
+        })?;
+        let module = gpu.shader_module("combine", &composed);
+        let pipeline = gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("lodkit combine"),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(target_format.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+        let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("combine params"),
+            size: std::mem::size_of::<CombineParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self { pipeline, params })
+    }
+
+    /// Records the combination of buffer `newer` with the other one (reprojected through
+    /// `new_to_old`) into `target`, which must be as large as the buffers.
+    pub fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        buffers: &LodBuffers,
+        newer: usize,
+        new_to_old: Mat4,
+        target: &wgpu::TextureView,
+    ) {
+        let params = CombineParams {
+            new_to_old: new_to_old.to_cols_array_2d(),
+        };
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let views = [
+            view(buffers.color(newer)),
+            view(buffers.id_depth(newer)),
+            view(buffers.color(newer + 1)),
+            view(buffers.id_depth(newer + 1)),
+        ];
+        let mut entries: Vec<wgpu::BindGroupEntry> = views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: wgpu::BindingResource::TextureView(v),
+            })
+            .collect();
+        entries.push(wgpu::BindGroupEntry {
+            binding: 4,
+            resource: self.params.as_entire_binding(),
+        });
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lodkit combine"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("lodkit combine"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

@@ -1,0 +1,268 @@
+//! Drawing meshes into LOD buffers with `passes/lod_buffer_mesh.wgsl`: the reference for an
+//! engine's forward pass under frame-sequential LOD, used by the examples, tests and demo.
+
+use glam::{Mat4, Vec3, Vec4};
+use wgpu::util::DeviceExt;
+
+use super::GpuContext;
+use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
+use super::scene::{CameraUniform, GpuMesh, MESH_VERTEX_ATTRIBUTES};
+use crate::lod_buffer::ID_DEPTH_FORMAT;
+use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
+use crate::visibility::VisibilityTexture;
+
+/// Rust mirror of `LodDraw` in `passes/lod_buffer_mesh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LodDrawUniform {
+    /// Object to world.
+    pub model: [[f32; 4]; 4],
+    /// Base color.
+    pub color: [f32; 4],
+    /// 0 for n-instances.
+    pub instance_id: u32,
+    /// Visibility threshold.
+    pub tau: f32,
+    /// Visibility texture repeats per object-space unit.
+    pub vis_scale: f32,
+    /// Padding.
+    pub pad: f32,
+}
+
+/// One draw into a LOD buffer.
+#[derive(Clone, Copy, Debug)]
+pub struct LodDrawItem<'a> {
+    /// The mesh.
+    pub mesh: &'a GpuMesh,
+    /// Object to world.
+    pub model: Mat4,
+    /// Base color.
+    pub color: Vec4,
+    /// Instance id (0 = n-instance).
+    pub id: u32,
+    /// Visibility threshold (1 = every fragment).
+    pub tau: f32,
+}
+
+/// Draws [`LodDrawItem`]s into one buffer of a [`LodBuffers`] pair (standard Z).
+#[derive(Debug)]
+pub struct LodBufferRenderer {
+    pipeline: wgpu::RenderPipeline,
+    camera: wgpu::Buffer,
+    camera_group: wgpu::BindGroup,
+    draws: wgpu::Buffer,
+    draw_group: wgpu::BindGroup,
+    stride: u64,
+    vis_scale: f32,
+}
+
+impl LodBufferRenderer {
+    /// Most draws per [`render`](Self::render).
+    pub const MAX_DRAWS: usize = 1024;
+
+    /// Builds the pipeline for color format `color_format`, with visibility texture `vis`
+    /// repeating `vis_scale` times per object-space unit.
+    pub fn new(
+        gpu: &GpuContext,
+        color_format: wgpu::TextureFormat,
+        vis: &VisibilityTexture,
+        vis_scale: f32,
+    ) -> Result<Self, ShaderError> {
+        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+            source: find_pass_source("lod_buffer_mesh").unwrap_or_default(),
+            file_path: "shader_lib/passes/lod_buffer_mesh.wgsl",
+            ..Default::default()
+        })?;
+        let module = gpu.shader_module("lod_buffer_mesh", &composed);
+        let device = &gpu.device;
+        let uniform = |binding, dynamic| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: dynamic,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lod_buffer_mesh view"),
+            entries: &[
+                uniform(0, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lod_buffer_mesh draw"),
+            entries: &[uniform(0, true)],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lod_buffer_mesh"),
+            bind_group_layouts: &[Some(&view_layout), Some(&draw_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("lod_buffer_mesh"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 24,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &MESH_VERTEX_ATTRIBUTES,
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: Some(wgpu::Face::Back),
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: LOD_DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let vis_texture = device.create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("visibility texture"),
+                size: wgpu::Extent3d {
+                    width: vis.size,
+                    height: vis.size,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::R32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(&vis.texels),
+        );
+        let camera = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("camera"),
+            size: std::mem::size_of::<CameraUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let stride = u64::from(device.limits().min_uniform_buffer_offset_alignment)
+            .max(std::mem::size_of::<LodDrawUniform>() as u64);
+        let draws = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lod draws"),
+            size: stride * Self::MAX_DRAWS as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let vis_view = vis_texture.create_view(&Default::default());
+        let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &view_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&vis_view),
+                },
+            ],
+        });
+        let draw_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &draw_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &draws,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<LodDrawUniform>() as u64),
+                }),
+            }],
+        });
+        Ok(Self {
+            pipeline,
+            camera,
+            camera_group,
+            draws,
+            draw_group,
+            stride,
+            vis_scale,
+        })
+    }
+
+    /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers`, cleared to
+    /// `clear`. Returns the number of triangles drawn.
+    pub fn render(
+        &self,
+        gpu: &GpuContext,
+        buffers: &LodBuffers,
+        index: usize,
+        view_proj: Mat4,
+        items: &[LodDrawItem],
+        clear: wgpu::Color,
+    ) -> u64 {
+        let items = &items[..items.len().min(Self::MAX_DRAWS)];
+        let camera = CameraUniform {
+            view_proj: view_proj.to_cols_array_2d(),
+            light_dir: Vec3::new(0.4, 0.8, 0.6).extend(0.0).to_array(),
+        };
+        gpu.queue
+            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+        let mut data = vec![0u8; self.stride as usize * items.len()];
+        for (i, item) in items.iter().enumerate() {
+            let u = LodDrawUniform {
+                model: item.model.to_cols_array_2d(),
+                color: item.color.to_array(),
+                instance_id: item.id,
+                tau: item.tau,
+                vis_scale: self.vis_scale,
+                pad: 0.0,
+            };
+            let at = i * self.stride as usize;
+            data[at..at + std::mem::size_of::<LodDrawUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&u));
+        }
+        if !data.is_empty() {
+            gpu.queue.write_buffer(&self.draws, 0, &data);
+        }
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let mut triangles = 0u64;
+        {
+            let mut pass = buffers.begin_pass(&mut encoder, index, clear, 1.0);
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.camera_group, &[]);
+            for (i, item) in items.iter().enumerate() {
+                pass.set_bind_group(1, &self.draw_group, &[(i as u64 * self.stride) as u32]);
+                item.mesh.draw(&mut pass);
+                triangles += u64::from(item.mesh.triangles());
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+        triangles
+    }
+}
