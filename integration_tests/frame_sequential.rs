@@ -424,7 +424,7 @@ proptest! {
         prop_assert_eq!((visibility_threshold(1.0, true), visibility_threshold(1.0, false)), (1.0, 0.0));
         // With texels in (0, 1), tau 0 keeps nothing and tau 1 everything.
         let tex = visibility_texture(VisibilityPattern::WhiteNoise, 8, 3);
-        prop_assert!(tex.texels.iter().all(|&v| !(v <= 0.0) && v <= 1.0));
+        prop_assert!(tex.texels.iter().all(|&v| v > 0.0 && v < 1.0));
     }
 
     #[test]
@@ -459,5 +459,17 @@ proptest! {
                 }
             }
         }
+    }
+}
+
+#[test]
+fn no_history_matrix_sends_every_pixel_to_the_newer_buffer() {
+    let m = lodkit::gpu::frame_sequential::CombinePass::NO_HISTORY;
+    for (uv, d) in [
+        (Vec2::new(0.5, 0.5), 0.5),
+        (Vec2::ZERO, 0.0),
+        (Vec2::ONE, 1.0),
+    ] {
+        assert!(!in_viewport(reproject(uv, d, &m).truncate()));
     }
 }

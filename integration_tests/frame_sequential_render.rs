@@ -1,14 +1,14 @@
 //! Two rendered frames of a small scene through the real LOD buffers and combine pass, compared
 //! pixel by pixel with the combine rule applied on the CPU to the read-back LOD buffers.
 
-use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
-use lodkit::combine::{DepthConvention, LodSample, combine_samples};
+use glam::{Mat4, Vec3, Vec4};
+use lodkit::combine::{DepthConvention, PixelSource, combine_images};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
-use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
-use lodkit::gpu::readback::{read_texture, read_texture_rgba8};
+use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
-use lodkit::reproject::{in_viewport, new_to_old_matrix, reproject};
+use lodkit::reproject::new_to_old_matrix;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 use crate::harness::say;
@@ -115,56 +115,31 @@ fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
     gpu.queue.submit([encoder.finish()]);
 
     let got = read_texture_rgba8(gpu, &target);
-    let colors = [
-        read_texture_rgba8(gpu, buffers.color(0)),
-        read_texture_rgba8(gpu, buffers.color(1)),
-    ];
-    let id_depths: Vec<Vec<u32>> = (0..2)
-        .map(|i| bytemuck::cast_slice(&read_texture(gpu, buffers.id_depth(i), 8)).to_vec())
-        .collect();
-    let texel = |b: usize, p: usize| LodSample {
-        color: Vec4::from_array(std::array::from_fn(|c| {
-            f32::from(colors[b][p * 4 + c]) / 255.0
-        })),
-        id: id_depths[b][p * 2],
-        depth: f32::from_bits(id_depths[b][p * 2 + 1]),
-    };
-    let (mut compared, mut ambiguous, mut outside, mut averaged, mut older_won) = (0, 0, 0, 0, 0);
-    for y in 0..H {
-        for x in 0..W {
-            let p = (y * W + x) as usize;
-            let mut n = texel(newer, p);
-            let uv = (Vec2::new(x as f32, y as f32) + 0.5) / Vec2::new(W as f32, H as f32);
-            let old = reproject(uv, n.depth, &m);
-            let want = if !in_viewport(old.truncate()) {
-                outside += 1;
-                n.color
-            } else {
-                let f = old.truncate() * Vec2::new(W as f32, H as f32);
-                let frac = f - f.floor();
-                if frac.min_element() < 1e-3 || frac.max_element() > 1.0 - 1e-3 {
-                    ambiguous += 1;
-                    continue;
-                }
-                let op = f.as_uvec2().min(UVec2::new(W - 1, H - 1));
-                let o = texel(1 - newer, (op.y * W + op.x) as usize);
-                n.depth = old.z;
-                if n.id == o.id && n.id != 0 {
-                    averaged += 1;
-                } else if n.id != o.id && o.depth < n.depth {
-                    older_won += 1;
-                }
-                combine_samples(n, o, DepthConvention::Standard)
-            };
-            compared += 1;
-            for c in 0..4 {
-                let w = (want[c] * 255.0).round() as i32;
-                let g = i32::from(got[p * 4 + c]);
-                assert!(
-                    (w - g).abs() <= 1,
-                    "pixel ({x}, {y}) channel {c}: GPU {g} vs CPU {w}"
-                );
-            }
+    let newer_image = read_lod_image(gpu, &buffers, newer);
+    let older_image = read_lod_image(gpu, &buffers, 1 - newer);
+    let want = combine_images(&newer_image, &older_image, &m, DepthConvention::Standard);
+    let (mut compared, mut ambiguous) = (0, 0);
+    let count = |s: PixelSource| want.iter().filter(|p| p.source == s).count();
+    let (averaged, older_won, outside) = (
+        count(PixelSource::Average),
+        count(PixelSource::Older),
+        count(PixelSource::OutsideOlder),
+    );
+    for (p, w) in want.iter().enumerate() {
+        if w.on_texel_edge {
+            ambiguous += 1;
+            continue;
+        }
+        compared += 1;
+        for c in 0..4 {
+            let wc = (w.color[c] * 255.0).round() as i32;
+            let g = i32::from(got[p * 4 + c]);
+            assert!(
+                (wc - g).abs() <= 1,
+                "pixel ({}, {}) channel {c}: GPU {g} vs CPU {wc}",
+                p as u32 % W,
+                p as u32 / W
+            );
         }
     }
     say(&format!(

@@ -55,3 +55,107 @@ pub fn combine_samples(newer: LodSample, older: LodSample, convention: DepthConv
         newer.color
     }
 }
+
+/// A LOD buffer read back to the CPU.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LodImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Colors, row-major, top row first.
+    pub colors: Vec<Vec4>,
+    /// Instance ids.
+    pub ids: Vec<u32>,
+    /// Clip depths.
+    pub depths: Vec<f32>,
+}
+
+impl LodImage {
+    /// The texel at pixel index `p`.
+    pub fn sample(&self, p: usize) -> LodSample {
+        LodSample {
+            color: self.colors[p],
+            id: self.ids[p],
+            depth: self.depths[p],
+        }
+    }
+}
+
+/// Where a combined pixel came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelSource {
+    /// The newer buffer (both n-instances, or the newer fragment was closer).
+    Newer,
+    /// The older buffer (its fragment was closer).
+    Older,
+    /// The average of both (two LODs of one t-instance).
+    Average,
+    /// The newer buffer, because the pixel reprojects outside the older one.
+    OutsideOlder,
+}
+
+/// One pixel of the CPU reference of the combine pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CombinedPixel {
+    /// The combined color.
+    pub color: Vec4,
+    /// Which rule produced it.
+    pub source: PixelSource,
+    /// Whether the reprojected position lies within 1e-3 texel of a texel edge, where a GPU may
+    /// round to the neighbouring texel.
+    pub on_texel_edge: bool,
+}
+
+/// The combine pass on the CPU: every pixel of `newer` reprojected into `older` through
+/// `new_to_old` and combined with [`combine_samples`], as `passes/combine.wgsl` does.
+pub fn combine_images(
+    newer: &LodImage,
+    older: &LodImage,
+    new_to_old: &glam::Mat4,
+    convention: DepthConvention,
+) -> Vec<CombinedPixel> {
+    use glam::Vec2;
+    let size = Vec2::new(newer.width as f32, newer.height as f32);
+    (0..newer.colors.len())
+        .map(|p| {
+            let mut n = newer.sample(p);
+            let (x, y) = (
+                (p as u32 % newer.width) as f32,
+                (p as u32 / newer.width) as f32,
+            );
+            let uv = (Vec2::new(x, y) + 0.5) / size;
+            let old = crate::reproject::reproject(uv, n.depth, new_to_old);
+            if !crate::reproject::in_viewport(old.truncate()) {
+                return CombinedPixel {
+                    color: n.color,
+                    source: PixelSource::OutsideOlder,
+                    on_texel_edge: false,
+                };
+            }
+            let f = old.truncate() * size;
+            let frac = f - f.floor();
+            let on_texel_edge = frac.min_element() < 1e-3 || frac.max_element() > 1.0 - 1e-3;
+            let op = f
+                .as_uvec2()
+                .min(glam::UVec2::new(newer.width - 1, newer.height - 1));
+            let o = older.sample((op.y * newer.width + op.x) as usize);
+            n.depth = old.z;
+            let color = combine_samples(n, o, convention);
+            let source = if n.id == 0 && o.id == 0 {
+                PixelSource::Newer
+            } else if n.id == o.id {
+                PixelSource::Average
+            } else if depth_closer(o.depth, n.depth, convention) {
+                PixelSource::Older
+            } else {
+                PixelSource::Newer
+            };
+            CombinedPixel {
+                color,
+                source,
+                on_texel_edge,
+            }
+        })
+        .collect()
+}

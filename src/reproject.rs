@@ -28,8 +28,17 @@ pub fn new_to_old_matrix(
 /// Position in the older buffer of the newer buffer's pixel at texture-space `uv` with clip
 /// `depth`: (old uv, old depth); uv (-1, -1) when the point is behind the older camera.
 pub fn reproject(uv: Vec2, depth: f32, new_to_old: &Mat4) -> Vec3 {
-    let ndc = Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
-    let old = *new_to_old * ndc;
+    reproject_from_base(reproject_base(uv, new_to_old), depth, new_to_old)
+}
+
+/// new_to_old x (ndc.x, ndc.y, 0, 1): the depth-independent part of [`reproject`], affine in uv.
+pub fn reproject_base(uv: Vec2, new_to_old: &Mat4) -> Vec4 {
+    *new_to_old * Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.0, 1.0)
+}
+
+/// Finishes [`reproject`] from `base` = [`reproject_base`]`(uv, new_to_old)`.
+pub fn reproject_from_base(base: Vec4, depth: f32, new_to_old: &Mat4) -> Vec3 {
+    let old = base + depth * new_to_old.z_axis;
     if old.w <= 0.0 {
         return Vec3::new(-1.0, -1.0, depth);
     }

@@ -1,7 +1,8 @@
 // passes/combine — the frame-sequential combination pass (Scherzer & Wimmer 2008, sec. 3.4):
 // merges the LOD buffer rendered this frame with the one from the frame before, reprojected.
 //
-// For each pixel: read the newer color and id/depth; reproject (uv, depth) into the older buffer;
+// For each pixel: read the newer color and id/depth; reproject (uv, depth) into the older buffer
+// (the depth-independent part interpolated from the vertex stage);
 // outside it -> newer color; else combine_samples(newer with its reprojected depth, older texel).
 // Built only from lodkit::fullscreen, lodkit::lod_buffer, lodkit::reproject, lodkit::combine.
 //
@@ -11,9 +12,9 @@
 // Bindings (group 0): 0 newer_color texture_2d<f32>, 1 newer_id_depth texture_2d<u32>,
 //   2 older_color texture_2d<f32>, 3 older_id_depth texture_2d<u32>, 4 params: CombineParams.
 // Shader defs: LODKIT_REVERSE_Z (bool, default off) — passed on to lodkit::combine.
-#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+#import lodkit::fullscreen::fullscreen_vertex
 #import lodkit::lod_buffer::{lod_buffer_id, lod_buffer_depth}
-#import lodkit::reproject::{reproject, in_viewport}
+#import lodkit::reproject::{reproject_base, reproject_from_base, in_viewport}
 #import lodkit::combine::{LodSample, combine_samples}
 
 /// Per-frame parameters.
@@ -28,22 +29,29 @@ struct CombineParams {
 @group(0) @binding(3) var older_id_depth: texture_2d<u32>;
 @group(0) @binding(4) var<uniform> params: CombineParams;
 
-/// Fullscreen triangle.
+/// Fullscreen triangle, plus the depth-independent part of the reprojection (affine in uv, so it
+/// interpolates exactly and the fragment stage only adds depth x one column).
+struct CombineVertex {
+    @builtin(position) position: vec4<f32>,
+    @location(0) old_base: vec4<f32>,
+}
+
+/// Fullscreen triangle with the interpolated reprojection base.
 @vertex
-fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
-    return fullscreen_vertex(vertex_index);
+fn vs_main(@builtin(vertex_index) vertex_index: u32) -> CombineVertex {
+    let v = fullscreen_vertex(vertex_index);
+    return CombineVertex(v.position, reproject_base(v.uv, params.new_to_old));
 }
 
 /// Combines the two LOD buffers at this pixel.
 @fragment
-fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
+fn fs_main(v: CombineVertex) -> @location(0) vec4<f32> {
     let size = textureDimensions(newer_color, 0);
     let pixel = vec2<u32>(v.position.xy);
     let newer_texel = textureLoad(newer_id_depth, pixel, 0).xy;
     let newer_depth = lod_buffer_depth(newer_texel);
     let color = textureLoad(newer_color, pixel, 0);
-    let uv = (vec2<f32>(pixel) + 0.5) / vec2<f32>(size);
-    let old = reproject(uv, newer_depth, params.new_to_old);
+    let old = reproject_from_base(v.old_base, newer_depth, params.new_to_old);
     if (!in_viewport(old.xy)) {
         return color;
     }

@@ -168,6 +168,11 @@ pub struct CombinePass {
 }
 
 impl CombinePass {
+    /// The `new_to_old` matrix for a frame with no usable older buffer (the first frame, after a
+    /// resize or a camera cut): every pixel reprojects behind the older camera, so the newer
+    /// buffer is shown as it is.
+    pub const NO_HISTORY: Mat4 = Mat4::ZERO;
+
     /// Builds the pipeline for targets of `target_format`; `reverse_z` selects the depth
     /// convention of the LOD buffers (`LODKIT_REVERSE_Z`).
     pub fn new(
@@ -277,5 +282,35 @@ impl CombinePass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);
+    }
+}
+
+/// Reads buffer `index` of `buffers` back to the CPU (an RGBA8 color format is expected).
+pub fn read_lod_image(
+    gpu: &GpuContext,
+    buffers: &LodBuffers,
+    index: usize,
+) -> crate::combine::LodImage {
+    let colors = super::readback::read_texture_rgba8(gpu, buffers.color(index));
+    let id_depth = super::readback::read_texture(gpu, buffers.id_depth(index), 8);
+    let words: Vec<u32> = id_depth
+        .chunks(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    let (width, height) = buffers.size();
+    crate::combine::LodImage {
+        width,
+        height,
+        colors: colors
+            .chunks(4)
+            .map(|c| glam::Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
+            .collect(),
+        ids: words.iter().step_by(2).copied().collect(),
+        depths: words
+            .iter()
+            .skip(1)
+            .step_by(2)
+            .map(|w| f32::from_bits(*w))
+            .collect(),
     }
 }

@@ -9,20 +9,34 @@
 // Exports:
 //   reproject(uv, depth, new_to_old) -> vec3<f32>   (old uv, old depth); uv = (-1, -1) when the
 //                                                   point is behind the older camera
+//   reproject_base(uv, new_to_old) -> vec4<f32>   the depth-independent part, linear in uv: a
+//                                                 vertex stage can compute it and let it interpolate
+//   reproject_from_base(base, depth, new_to_old) -> vec3<f32>   reproject() given that part
 //   in_viewport(uv) -> bool   whether an old uv lies inside the older buffer
 // Shader defs: none (LODKIT_REVERSE_Z matters only where depths are compared: lodkit::combine).
 #define_import_path lodkit::reproject
 
-/// Position in the older LOD buffer of the newer buffer's pixel at `uv` with clip `depth`:
-/// (old uv, old clip depth). A point behind the older camera gets uv (-1, -1).
-fn reproject(uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>) -> vec3<f32> {
-    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
-    let old = new_to_old * ndc;
+/// new_to_old x (ndc.x, ndc.y, 0, 1) for texture-space `uv`: affine in uv, so it interpolates
+/// exactly across a fullscreen triangle.
+fn reproject_base(uv: vec2<f32>, new_to_old: mat4x4<f32>) -> vec4<f32> {
+    return new_to_old * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 0.0, 1.0);
+}
+
+/// Finishes `reproject` from `base` = reproject_base(uv, new_to_old): adds depth times the third
+/// column, divides, maps to texture space.
+fn reproject_from_base(base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>) -> vec3<f32> {
+    let old = base + depth * new_to_old[2];
     if (old.w <= 0.0) {
         return vec3<f32>(-1.0, -1.0, depth);
     }
     let p = old.xyz / old.w;
     return vec3<f32>(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5, p.z);
+}
+
+/// Position in the older LOD buffer of the newer buffer's pixel at `uv` with clip `depth`:
+/// (old uv, old clip depth). A point behind the older camera gets uv (-1, -1).
+fn reproject(uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>) -> vec3<f32> {
+    return reproject_from_base(reproject_base(uv, new_to_old), depth, new_to_old);
 }
 
 /// Whether `uv` lies inside the older buffer ([0, 1] on both axes).

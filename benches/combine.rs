@@ -1,0 +1,187 @@
+//! GPU cost of the frame-sequential combine pass against a plain fullscreen pass that reads the
+//! same four textures (two colors, two id/depth) and writes one: the pass's own overhead.
+//! Wall time per pass including submit and wait, so read the ratio, not the absolute figures,
+//! on a software GPU.
+//!
+//! `cargo bench --bench combine`
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::{Mat4, Vec3, Vec4};
+use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::scene::{GpuMesh, Mesh};
+use lodkit::gpu::{GpuContext, GpuOptions};
+use lodkit::reproject::new_to_old_matrix;
+use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
+use lodkit::visibility::{VisibilityPattern, visibility_texture};
+
+const SIZE: u32 = 512;
+
+const COPY4: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+@group(0) @binding(0) var a: texture_2d<f32>;
+@group(0) @binding(1) var b: texture_2d<u32>;
+@group(0) @binding(2) var c: texture_2d<f32>;
+@group(0) @binding(3) var d: texture_2d<u32>;
+@vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
+@fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
+    let p = vec2<u32>(v.position.xy);
+    let ids = textureLoad(b, p, 0).xy ^ textureLoad(d, p, 0).xy;
+    return textureLoad(a, p, 0) + textureLoad(c, p, 0) + vec4<f32>(f32(ids.x & 1u), f32(ids.y & 1u), 0.0, 0.0);
+}
+";
+
+fn benches(c: &mut Criterion) {
+    let gpu = match GpuContext::new_headless(&GpuOptions::default()) {
+        Ok(g) => g,
+        Err(e) => {
+            eprintln!("combine bench skipped: {e}");
+            return;
+        }
+    };
+    eprintln!("adapter: {}", gpu.adapter_summary());
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let buffers = LodBuffers::new(&gpu, SIZE, SIZE, format);
+    let renderer = LodBufferRenderer::new(
+        &gpu,
+        format,
+        &visibility_texture(VisibilityPattern::WhiteNoise, 64, 1),
+        0.25,
+    )
+    .unwrap();
+    let meshes = [
+        GpuMesh::new(&gpu, &Mesh::sphere(16, 24)),
+        GpuMesh::new(&gpu, &Mesh::cube()),
+    ];
+    let proj = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 0.1, 100.0);
+    let views = [0.0f32, 0.1]
+        .map(|x| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 3.0, 7.0), Vec3::ZERO, Vec3::Y));
+    for (i, view) in views.iter().enumerate() {
+        let items: Vec<LodDrawItem> = (0..15)
+            .map(|k| LodDrawItem {
+                mesh: &meshes[(k + i) % 2],
+                model: Mat4::from_translation(Vec3::new(
+                    (k % 5) as f32 * 2.0 - 4.0,
+                    0.0,
+                    -((k / 5) as f32) * 2.0,
+                )),
+                color: Vec4::new(0.8, 0.2, 0.2, 1.0),
+                id: if k % 3 == 0 { k as u32 + 1 } else { 0 },
+                tau: if k % 3 == 0 { 0.5 } else { 1.0 },
+            })
+            .collect();
+        renderer.render(&gpu, &buffers, i, proj * *view, &items, wgpu::Color::BLACK);
+    }
+    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d {
+            width: SIZE,
+            height: SIZE,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let target_view = target.create_view(&Default::default());
+    let combine = CombinePass::new(&gpu, format, false).unwrap();
+    let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
+
+    let composed = ShaderLibrary::new()
+        .unwrap()
+        .compose(&ComposeDescriptor {
+            source: COPY4,
+            file_path: "copy4.wgsl",
+            ..Default::default()
+        })
+        .unwrap();
+    let module = gpu.shader_module("copy4", &composed);
+    let copy4 = gpu
+        .device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("copy4"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+    let views4 = [
+        buffers.color(1),
+        buffers.id_depth(1),
+        buffers.color(0),
+        buffers.id_depth(0),
+    ]
+    .map(|t| t.create_view(&Default::default()));
+    let entries: Vec<wgpu::BindGroupEntry> = views4
+        .iter()
+        .enumerate()
+        .map(|(i, v)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: wgpu::BindingResource::TextureView(v),
+        })
+        .collect();
+    let copy_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &copy4.get_bind_group_layout(0),
+        entries: &entries,
+    });
+
+    let mut g = c.benchmark_group(format!("fullscreen pass {SIZE}x{SIZE}"));
+    g.sample_size(30);
+    g.bench_function("combine (lodkit)", |b| {
+        b.iter(|| {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            combine.encode(&gpu, &mut encoder, &buffers, 1, m, &target_view);
+            gpu.queue.submit([encoder.finish()]);
+            gpu.wait_idle();
+        })
+    });
+    g.bench_function("plain copy of the same 4 textures", |b| {
+        b.iter(|| {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: None,
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &target_view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&copy4);
+                pass.set_bind_group(0, &copy_group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            gpu.queue.submit([encoder.finish()]);
+            gpu.wait_idle();
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(combine_benches, benches);
+criterion_main!(combine_benches);
