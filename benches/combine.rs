@@ -6,6 +6,7 @@
 //! `cargo bench --bench combine`
 
 use criterion::{Criterion, criterion_group, criterion_main};
+
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
@@ -142,46 +143,81 @@ fn benches(c: &mut Criterion) {
         entries: &entries,
     });
 
-    let mut g = c.benchmark_group(format!("fullscreen pass {SIZE}x{SIZE}"));
-    g.sample_size(30);
-    g.bench_function("combine (lodkit)", |b| {
-        b.iter(|| {
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            combine.encode(&gpu, &mut encoder, &buffers, 1, m, &target_view);
-            gpu.queue.submit([encoder.finish()]);
-            gpu.wait_idle();
-        })
-    });
-    g.bench_function("plain copy of the same 4 textures", |b| {
-        b.iter(|| {
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: None,
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &target_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&copy4);
-                pass.set_bind_group(0, &copy_group, &[]);
-                pass.draw(0..3, 0..1);
-            }
-            gpu.queue.submit([encoder.finish()]);
-            gpu.wait_idle();
-        })
-    });
-    g.finish();
+    let run_combine = || {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        combine.encode(&gpu, &mut encoder, &buffers, 1, m, &target_view);
+        gpu.queue.submit([encoder.finish()]);
+        gpu.wait_idle();
+    };
+    let run_copy = || {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: None,
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&copy4);
+            pass.set_bind_group(0, &copy_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        gpu.wait_idle();
+    };
+    // Interleaved pairs (alternating which goes first), so machine noise hits both alike; the
+    // figure to read is the median of the per-pair ratios.
+    let time = |f: &dyn Fn()| {
+        let t = std::time::Instant::now();
+        f();
+        t.elapsed().as_secs_f64() * 1e3
+    };
+    for _ in 0..10 {
+        run_combine();
+        run_copy();
+    }
+    let (mut a, mut b, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..PAIRS {
+        let (tc, tp) = if i % 2 == 0 {
+            let tc = time(&run_combine);
+            (tc, time(&run_copy))
+        } else {
+            let tp = time(&run_copy);
+            (time(&run_combine), tp)
+        };
+        a.push(tc);
+        b.push(tp);
+        ratio.push(tc / tp);
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    println!(
+        "fullscreen passes at {SIZE}x{SIZE}, {PAIRS} interleaved pairs, wall time per pass incl. submit + wait"
+    );
+    println!("| pass | median ms |");
+    println!("|---|---|");
+    println!("| combine (lodkit) | {:.3} |", median(&mut a));
+    println!(
+        "| plain copy of the same 4 textures | {:.3} |",
+        median(&mut b)
+    );
+    println!("median combine / copy ratio: {:.3}", median(&mut ratio));
+    let _ = c;
 }
+
+const PAIRS: usize = 200;
 
 criterion_group!(combine_benches, benches);
 criterion_main!(combine_benches);
