@@ -10,6 +10,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::resources::{begin_color_pass, fullscreen_pipeline, texture_2d};
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::gpu::{GpuContext, GpuOptions};
 use lodkit::reproject::new_to_old_matrix;
@@ -72,20 +73,13 @@ fn benches(c: &mut Criterion) {
             .collect();
         renderer.render(&gpu, &buffers, i, proj * *view, &items, wgpu::Color::BLACK);
     }
-    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: None,
-        size: wgpu::Extent3d {
-            width: SIZE,
-            height: SIZE,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
+    let target = texture_2d(
+        &gpu,
+        (SIZE, SIZE),
         format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-        view_formats: &[],
-    });
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+        "target",
+    );
     let target_view = target.create_view(&Default::default());
     let combine = CombinePass::new(&gpu, format, false).unwrap();
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
@@ -99,29 +93,7 @@ fn benches(c: &mut Criterion) {
         })
         .unwrap();
     let module = gpu.shader_module("copy4", &composed);
-    let copy4 = gpu
-        .device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("copy4"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+    let copy4 = fullscreen_pipeline(&gpu, &module, format, "copy4");
     let views4 = [
         buffers.color(1),
         buffers.id_depth(1),
@@ -152,22 +124,8 @@ fn benches(c: &mut Criterion) {
     let run_copy = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: None,
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass =
+                begin_color_pass(&mut encoder, &target_view, wgpu::Color::BLACK, "copy4");
             pass.set_pipeline(&copy4);
             pass.set_bind_group(0, &copy_group, &[]);
             pass.draw(0..3, 0..1);

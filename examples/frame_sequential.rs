@@ -79,20 +79,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         )?;
     }
-    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("combined"),
-        size: wgpu::Extent3d {
-            width: W,
-            height: H,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target = lodkit::gpu::resources::texture_2d(&gpu, (W, H), format, usage, "combined");
     let proj = glam::camera::rh::proj::directx::perspective(0.8, W as f32 / H as f32, 0.1, 100.0);
     let mut previous_view: Option<Mat4> = None;
     let mut strip = image::RgbaImage::new(W * 5, H * 2);

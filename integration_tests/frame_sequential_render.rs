@@ -89,20 +89,8 @@ fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
     }
     let newer = scheduler.buffer_index();
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
-    let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("combined"),
-        size: wgpu::Extent3d {
-            width: W,
-            height: H,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target = lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, "combined");
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     combine.encode(
         gpu,

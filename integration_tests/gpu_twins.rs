@@ -42,6 +42,22 @@ fn normal_pairs() -> Vec<(Vec3, Vec3)> {
     pairs
 }
 
+/// A WGSL probe that evaluates `expr` over normal pairs `a`, `b`.
+fn normal_probe(expr: &str) -> Probe<'static> {
+    let body = format!(
+        "let a = vec3<f32>(inp_f(0u), inp_f(1u), inp_f(2u));
+         let b = vec3<f32>(inp_f(3u), inp_f(4u), inp_f(5u));
+         out_f(0u, {expr});"
+    );
+    Probe {
+        header: "#import lodkit::normal_distance::foreshortened_normal_distance",
+        body: Box::leak(body.into_boxed_str()),
+        inputs: 6,
+        outputs: 1,
+        texture: None,
+    }
+}
+
 fn normal_inputs(pairs: &[(Vec3, Vec3)]) -> Vec<u32> {
     let flat: Vec<f32> = pairs
         .iter()
@@ -54,15 +70,7 @@ fn normal_inputs(pairs: &[(Vec3, Vec3)]) -> Vec<u32> {
 fn foreshortened_normal_distance_wgsl_matches_rust_twin() {
     let gpu = lodkit_test_gpu!();
     let pairs = normal_pairs();
-    let probe = Probe {
-        header: "#import lodkit::normal_distance::foreshortened_normal_distance",
-        body: "let a = vec3<f32>(inp_f(0u), inp_f(1u), inp_f(2u));
-               let b = vec3<f32>(inp_f(3u), inp_f(4u), inp_f(5u));
-               out_f(0u, foreshortened_normal_distance(a, b));",
-        inputs: 6,
-        outputs: 1,
-        texture: None,
-    };
+    let probe = normal_probe("foreshortened_normal_distance(a, b)");
     let got = floats(&run_wgsl(gpu, &probe, &normal_inputs(&pairs)));
     let want: Vec<f32> = pairs
         .iter()
@@ -158,15 +166,7 @@ fn probe_detects_a_wrong_twin() {
     // The harness must be able to fail: a deliberately different expression does not match.
     let gpu = lodkit_test_gpu!();
     let pairs = normal_pairs();
-    let probe = Probe {
-        header: "#import lodkit::normal_distance::foreshortened_normal_distance",
-        body: "let a = vec3<f32>(inp_f(0u), inp_f(1u), inp_f(2u));
-               let b = vec3<f32>(inp_f(3u), inp_f(4u), inp_f(5u));
-               out_f(0u, distance(a, b));",
-        inputs: 6,
-        outputs: 1,
-        texture: None,
-    };
+    let probe = normal_probe("distance(a, b)");
     let got = floats(&run_wgsl(gpu, &probe, &normal_inputs(&pairs)));
     let want: Vec<f32> = pairs
         .iter()

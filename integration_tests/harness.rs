@@ -254,25 +254,7 @@ fn run(
         },
     ];
     let view = probe.texture.map(|(size, texels)| {
-        let texture = device.create_texture_with_data(
-            &gpu.queue,
-            &wgpu::TextureDescriptor {
-                label: Some("probe texture"),
-                size: wgpu::Extent3d {
-                    width: size,
-                    height: size,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::R32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            bytemuck::cast_slice(texels),
-        );
+        let texture = lodkit::gpu::resources::r32float_texture(gpu, size, texels, "probe texture");
         texture.create_view(&Default::default())
     });
     if let Some(view) = &view {

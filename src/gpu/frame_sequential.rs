@@ -8,6 +8,7 @@
 use glam::Mat4;
 
 use super::GpuContext;
+use super::resources::{begin_color_pass, fullscreen_pipeline, texture_2d};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
 use crate::shaders::{
     ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
@@ -34,22 +35,8 @@ impl LodBuffers {
         height: u32,
         color_format: wgpu::TextureFormat,
     ) -> Self {
-        let texture = |format, usage, label| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: width.max(1),
-                    height: height.max(1),
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let size = (width.max(1), height.max(1));
+        let texture = |format, usage, label| texture_2d(gpu, size, format, usage, label);
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
@@ -191,29 +178,7 @@ impl CombinePass {
             ..Default::default()
         })?;
         let module = gpu.shader_module("combine", &composed);
-        let pipeline = gpu
-            .device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("lodkit combine"),
-                layout: None,
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: Default::default(),
-                depth_stencil: None,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(target_format.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
-            });
+        let pipeline = fullscreen_pipeline(gpu, &module, target_format, "lodkit combine");
         let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("combine params"),
             size: std::mem::size_of::<CombineParams>() as u64,
@@ -263,22 +228,7 @@ impl CombinePass {
             layout: &self.pipeline.get_bind_group_layout(0),
             entries: &entries,
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("lodkit combine"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit combine");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);

@@ -2,11 +2,11 @@
 //! engine's forward pass under frame-sequential LOD, used by the examples, tests and demo.
 
 use glam::{Mat4, Vec3, Vec4};
-use wgpu::util::DeviceExt;
 
 use super::GpuContext;
 use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
-use super::scene::{CameraUniform, GpuMesh, MESH_VERTEX_ATTRIBUTES};
+use super::resources::{DrawUniforms, r32float_texture, uniform_buffer, uniform_entry};
+use super::scene::{CameraUniform, GpuMesh, MESH_VERTEX_LAYOUT};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
 use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
 use crate::visibility::VisibilityTexture;
@@ -50,9 +50,8 @@ pub struct LodBufferRenderer {
     pipeline: wgpu::RenderPipeline,
     camera: wgpu::Buffer,
     camera_group: wgpu::BindGroup,
-    draws: wgpu::Buffer,
+    draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
-    stride: u64,
     vis_scale: f32,
 }
 
@@ -75,20 +74,10 @@ impl LodBufferRenderer {
         })?;
         let module = gpu.shader_module("lod_buffer_mesh", &composed);
         let device = &gpu.device;
-        let uniform = |binding, dynamic| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: dynamic,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lod_buffer_mesh view"),
             entries: &[
-                uniform(0, false),
+                uniform_entry(0, false),
                 wgpu::BindGroupLayoutEntry {
                     binding: 1,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -103,7 +92,7 @@ impl LodBufferRenderer {
         });
         let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lod_buffer_mesh draw"),
-            entries: &[uniform(0, true)],
+            entries: &[uniform_entry(0, true)],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lod_buffer_mesh"),
@@ -117,11 +106,7 @@ impl LodBufferRenderer {
                 module: &module,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 24,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &MESH_VERTEX_ATTRIBUTES,
-                })],
+                buffers: &[Some(MESH_VERTEX_LAYOUT)],
             },
             primitive: wgpu::PrimitiveState {
                 cull_mode: Some(wgpu::Face::Back),
@@ -144,39 +129,14 @@ impl LodBufferRenderer {
             multiview_mask: None,
             cache: None,
         });
-        let vis_texture = device.create_texture_with_data(
-            &gpu.queue,
-            &wgpu::TextureDescriptor {
-                label: Some("visibility texture"),
-                size: wgpu::Extent3d {
-                    width: vis.size,
-                    height: vis.size,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::R32Float,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            },
-            wgpu::util::TextureDataOrder::LayerMajor,
-            bytemuck::cast_slice(&vis.texels),
+        let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture");
+        let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera");
+        let draws = DrawUniforms::new(
+            gpu,
+            std::mem::size_of::<LodDrawUniform>(),
+            Self::MAX_DRAWS,
+            "lod draws",
         );
-        let camera = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("camera"),
-            size: std::mem::size_of::<CameraUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let stride = u64::from(device.limits().min_uniform_buffer_offset_alignment)
-            .max(std::mem::size_of::<LodDrawUniform>() as u64);
-        let draws = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("lod draws"),
-            size: stride * Self::MAX_DRAWS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let vis_view = vis_texture.create_view(&Default::default());
         let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
@@ -192,25 +152,13 @@ impl LodBufferRenderer {
                 },
             ],
         });
-        let draw_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &draw_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &draws,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<LodDrawUniform>() as u64),
-                }),
-            }],
-        });
+        let draw_group = draws.bind_group(gpu, &draw_layout);
         Ok(Self {
             pipeline,
             camera,
             camera_group,
             draws,
             draw_group,
-            stride,
             vis_scale,
         })
     }
@@ -226,30 +174,25 @@ impl LodBufferRenderer {
         items: &[LodDrawItem],
         clear: wgpu::Color,
     ) -> u64 {
-        let items = &items[..items.len().min(Self::MAX_DRAWS)];
+        let items = &items[..items.len().min(self.draws.capacity())];
         let camera = CameraUniform {
             view_proj: view_proj.to_cols_array_2d(),
             light_dir: Vec3::new(0.4, 0.8, 0.6).extend(0.0).to_array(),
         };
         gpu.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
-        let mut data = vec![0u8; self.stride as usize * items.len()];
-        for (i, item) in items.iter().enumerate() {
-            let u = LodDrawUniform {
+        let uniforms: Vec<LodDrawUniform> = items
+            .iter()
+            .map(|item| LodDrawUniform {
                 model: item.model.to_cols_array_2d(),
                 color: item.color.to_array(),
                 instance_id: item.id,
                 tau: item.tau,
                 vis_scale: self.vis_scale,
                 pad: 0.0,
-            };
-            let at = i * self.stride as usize;
-            data[at..at + std::mem::size_of::<LodDrawUniform>()]
-                .copy_from_slice(bytemuck::bytes_of(&u));
-        }
-        if !data.is_empty() {
-            gpu.queue.write_buffer(&self.draws, 0, &data);
-        }
+            })
+            .collect();
+        self.draws.write(gpu, &uniforms);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut triangles = 0u64;
         {
@@ -257,7 +200,7 @@ impl LodBufferRenderer {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.camera_group, &[]);
             for (i, item) in items.iter().enumerate() {
-                pass.set_bind_group(1, &self.draw_group, &[(i as u64 * self.stride) as u32]);
+                pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                 item.mesh.draw(&mut pass);
                 triangles += u64::from(item.mesh.triangles());
             }

@@ -5,6 +5,7 @@ mod context;
 pub mod frame_sequential;
 pub mod lod_buffer_scene;
 pub mod readback;
+pub mod resources;
 pub mod scene;
 pub mod transition_scene;
 pub mod unpopping;

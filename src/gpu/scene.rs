@@ -9,6 +9,7 @@ use glam::{Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 use super::GpuContext;
+use super::resources::{DrawUniforms, texture_2d, uniform_buffer, uniform_entry};
 use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
 use crate::shaders::{
     ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
@@ -137,7 +138,14 @@ impl GpuMesh {
     }
 }
 
-/// Vertex layout of [`Mesh`]: position at location 0, normal at location 1.
+/// Vertex buffer layout of [`Mesh`].
+pub const MESH_VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 24,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &MESH_VERTEX_ATTRIBUTES,
+};
+
+/// Vertex attributes of [`Mesh`]: position at location 0, normal at location 1.
 pub const MESH_VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 2] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
 
@@ -192,28 +200,20 @@ pub struct RenderTarget {
 impl RenderTarget {
     /// Allocates both textures.
     pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
-        let make = |format, usage, label| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
         let color_usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::TEXTURE_BINDING;
         Self {
-            color: make(COLOR_FORMAT, color_usage, "scene color"),
-            depth: make(
+            color: texture_2d(
+                gpu,
+                (width, height),
+                COLOR_FORMAT,
+                color_usage,
+                "scene color",
+            ),
+            depth: texture_2d(
+                gpu,
+                (width, height),
                 DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
                 "scene depth",
@@ -229,10 +229,8 @@ pub struct MeshRenderer {
     blended: wgpu::RenderPipeline,
     camera: wgpu::Buffer,
     camera_group: wgpu::BindGroup,
-    draws: wgpu::Buffer,
+    draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
-    stride: u64,
-    capacity: usize,
 }
 
 impl MeshRenderer {
@@ -257,21 +255,10 @@ impl MeshRenderer {
         })?;
         let module = gpu.shader_module("lod_mesh", &composed);
         let device = &gpu.device;
-        let stride = u64::from(device.limits().min_uniform_buffer_offset_alignment)
-            .max(std::mem::size_of::<DrawUniform>() as u64);
         let uniform_layout = |dynamic| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: None,
-                entries: &[wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: dynamic,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                }],
+                entries: &[uniform_entry(0, dynamic)],
             })
         };
         let (camera_layout, draw_layout) = (uniform_layout(false), uniform_layout(true));
@@ -288,11 +275,7 @@ impl MeshRenderer {
                     module: &module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
-                    buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: 24,
-                        step_mode: wgpu::VertexStepMode::Vertex,
-                        attributes: &MESH_VERTEX_ATTRIBUTES,
-                    })],
+                    buffers: &[Some(MESH_VERTEX_LAYOUT)],
                 },
                 primitive: wgpu::PrimitiveState {
                     cull_mode: Some(wgpu::Face::Back),
@@ -330,73 +313,29 @@ impl MeshRenderer {
             depth_write: false,
             blend: true,
         };
-        let camera = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("camera"),
-            size: std::mem::size_of::<CameraUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
+        let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera");
+        let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &camera_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera.as_entire_binding(),
+            }],
         });
-        let draws = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("draws"),
-            size: stride * Self::MAX_DRAWS as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let group = |layout, buffer: &wgpu::Buffer, size| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(size),
-                    }),
-                }],
-            })
-        };
+        let draws = DrawUniforms::new(
+            gpu,
+            std::mem::size_of::<DrawUniform>(),
+            Self::MAX_DRAWS,
+            "draws",
+        );
         Ok(Self {
             opaque: pipeline(opaque_state),
             blended: pipeline(blended_state),
-            camera_group: group(
-                &camera_layout,
-                &camera,
-                std::mem::size_of::<CameraUniform>() as u64,
-            ),
-            draw_group: group(
-                &draw_layout,
-                &draws,
-                std::mem::size_of::<DrawUniform>() as u64,
-            ),
+            camera_group,
+            draw_group: draws.bind_group(gpu, &draw_layout),
             camera,
             draws,
-            stride,
-            capacity: Self::MAX_DRAWS,
         })
-    }
-
-    /// Uploads a mesh.
-    pub fn upload(&self, gpu: &GpuContext, mesh: &Mesh) -> GpuMesh {
-        let make = |contents: &[u8], usage| {
-            gpu.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: None,
-                    contents,
-                    usage,
-                })
-        };
-        GpuMesh {
-            vertices: make(
-                bytemuck::cast_slice(&mesh.vertices),
-                wgpu::BufferUsages::VERTEX,
-            ),
-            indices: make(
-                bytemuck::cast_slice(&mesh.indices),
-                wgpu::BufferUsages::INDEX,
-            ),
-            count: mesh.indices.len() as u32,
-        }
     }
 
     /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]; the
@@ -410,28 +349,23 @@ impl MeshRenderer {
         light_dir: Vec3,
         items: &[DrawItem],
     ) {
-        let items = &items[..items.len().min(self.capacity)];
+        let items = &items[..items.len().min(self.draws.capacity())];
         let camera = CameraUniform {
             view_proj: view_proj.to_cols_array_2d(),
             light_dir: light_dir.extend(0.0).to_array(),
         };
         gpu.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
-        let mut data = vec![0u8; self.stride as usize * items.len()];
-        for (i, item) in items.iter().enumerate() {
-            let u = DrawUniform {
+        let uniforms: Vec<DrawUniform> = items
+            .iter()
+            .map(|item| DrawUniform {
                 model: item.model.to_cols_array_2d(),
                 color: item.color.to_array(),
                 dither_alpha: item.dither_alpha.unwrap_or(DITHER_OFF),
                 pad: [0.0; 3],
-            };
-            let at = i * self.stride as usize;
-            data[at..at + std::mem::size_of::<DrawUniform>()]
-                .copy_from_slice(bytemuck::bytes_of(&u));
-        }
-        if !data.is_empty() {
-            gpu.queue.write_buffer(&self.draws, 0, &data);
-        }
+            })
+            .collect();
+        self.draws.write(gpu, &uniforms);
         let color_view = target.color.create_view(&Default::default());
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -467,7 +401,7 @@ impl MeshRenderer {
                     &self.opaque
                 });
                 pass.set_blend_constant(lod_blend_constant(&item.state));
-                pass.set_bind_group(1, &self.draw_group, &[(i as u64 * self.stride) as u32]);
+                pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                 item.mesh.draw(&mut pass);
             }
         }

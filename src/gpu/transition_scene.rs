@@ -88,9 +88,9 @@ impl TransitionScene {
     pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, ShaderError> {
         let bayer = MeshRenderer::new(gpu, false)?;
         let blue = MeshRenderer::new(gpu, true)?;
-        let fine = bayer.upload(gpu, &Mesh::sphere(24, 48));
-        let coarse = bayer.upload(gpu, &Mesh::sphere(3, 6));
-        let backdrop = bayer.upload(gpu, &Mesh::cube());
+        let fine = GpuMesh::new(gpu, &Mesh::sphere(24, 48));
+        let coarse = GpuMesh::new(gpu, &Mesh::sphere(3, 6));
+        let backdrop = GpuMesh::new(gpu, &Mesh::cube());
         Ok(Self {
             renderers: [bayer, blue],
             fine,

@@ -15,6 +15,7 @@ mod compose;
 mod diagnostic;
 mod export;
 mod glsl;
+mod imports;
 mod registry;
 
 use std::path::{Path, PathBuf};
