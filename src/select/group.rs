@@ -65,6 +65,15 @@ impl Default for LodSettings {
 
 impl LodSettings {
     /// Checks the values: bias >= 0 (not NaN), hysteresis finite and >= 0, duration > 0.
+    ///
+    /// ```
+    /// # use lodkit::select::{LodSettings, TransitionMode};
+    /// assert!(LodSettings::default().validate().is_ok());
+    /// assert!(LodSettings { bias: f32::INFINITY, ..Default::default() }.validate().is_ok());
+    /// assert!(LodSettings { hysteresis: -1.0, ..Default::default() }.validate().is_err());
+    /// let zero = LodSettings { transition: TransitionMode::Time { seconds: 0.0 }, ..Default::default() };
+    /// assert!(zero.validate().is_err());
+    /// ```
     pub fn validate(&self) -> Result<(), LodError> {
         if self.bias.is_nan() || self.bias < 0.0 {
             return Err(LodError::BadBias(self.bias));
@@ -100,6 +109,12 @@ impl LodSelection {
     /// Screen-door alphas (DigitalRune): the current level gets -(1 - t) x fade (negative: the
     /// inverted pattern), the next +t x fade. The two patterns never overlap and together cover
     /// `fade` of the pixels. Without a transition: (fade, None).
+    ///
+    /// ```
+    /// # use lodkit::select::LodSelection;
+    /// let s = LodSelection { current: 0, next: Some(1), transition: 0.25, fade: 1.0, visible: true };
+    /// assert_eq!(s.screen_door_alphas(), (-0.75, Some(0.25)));
+    /// ```
     pub fn screen_door_alphas(&self) -> (f32, Option<f32>) {
         match self.next {
             Some(_) => (
@@ -196,6 +211,13 @@ impl LodGroup {
 
     /// The same group with a max draw distance (beyond it nothing is drawn; within the last h
     /// before it the object fades out).
+    ///
+    /// ```
+    /// # use lodkit::select::LodGroup;
+    /// let g = LodGroup::from_distances(&[0.0, 10.0]).unwrap();
+    /// assert_eq!(g.clone().with_max_distance(50.0).unwrap().max_distance(), Some(50.0));
+    /// assert!(g.with_max_distance(0.0).is_err());
+    /// ```
     pub fn with_max_distance(mut self, max_distance: f32) -> Result<Self, LodError> {
         if max_distance.is_nan() || max_distance <= 0.0 {
             return Err(LodError::BadMaxDistance(max_distance));

@@ -56,6 +56,13 @@ pub enum LodError {
 }
 
 /// Whether `projection` is orthographic (its last row is (0, 0, 0, 1)).
+///
+/// ```
+/// # use lodkit::select::is_orthographic;
+/// use glam::camera::rh::proj::directx::{orthographic, perspective};
+/// assert!(is_orthographic(&orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0)));
+/// assert!(!is_orthographic(&perspective(1.0, 1.0, 0.1, 10.0)));
+/// ```
 pub fn is_orthographic(projection: &Mat4) -> bool {
     projection.x_axis.w == 0.0 && projection.y_axis.w == 0.0 && projection.z_axis.w == 0.0
 }
@@ -150,7 +157,16 @@ impl LodCamera {
     }
 
     /// View-normalized, biased distance of an object at `position` with largest world-scale
-    /// component `max_scale`, under the extra `global_bias`.
+    /// component `max_scale`, under the extra `global_bias`. A zero bias (either one) gives 0.
+    ///
+    /// ```
+    /// # use lodkit::select::LodCamera;
+    /// # use glam::Vec3;
+    /// let p = glam::camera::rh::proj::directx::perspective(std::f32::consts::FRAC_PI_2, 1.0, 0.1, 100.0);
+    /// let cam = LodCamera::new(Vec3::ZERO, p).with_bias(2.0);
+    /// assert!((cam.lod_distance(Vec3::new(0.0, 0.0, -10.0), 1.0, 0.5) - 10.0).abs() < 1e-4);
+    /// assert_eq!(cam.lod_distance(Vec3::new(0.0, 0.0, -10.0), 1.0, 0.0), 0.0);
+    /// ```
     pub fn lod_distance(&self, position: Vec3, max_scale: f32, global_bias: f32) -> f32 {
         let d = view_normalized_distance(
             position.distance(self.position),
