@@ -7,6 +7,7 @@ mod cli;
 mod composition;
 mod frame_sequential;
 mod frame_sequential_render;
+mod framebuffer_lod;
 mod gpu_twins;
 mod selection;
 mod single_frame;

@@ -10,7 +10,9 @@
 //!   distance- or time-driven transitions), per instance or over batches, configurable in RON.
 //! - [`unpopping`], [`screen_door`]: single-frame transitions without popping (Giegl & Wimmer's
 //!   unpopping render states; complementary screen-door dither).
-//! - [`normal_distance`], [`fullscreen`]: Rust twins of the shader functions of the same names.
+//! - [`bilateral`], [`gbuffer`], [`normal_distance`]: geometry-aware framebuffer LOD (Yang et
+//!   al. 2008): Rust twins of the upsampling and low-res buffer shaders.
+//! - [`fullscreen`]: Rust twins of the shader functions of the same names.
 //! - [`frame_sequential`] with [`visibility`], [`lod_buffer`], [`reproject`], [`combine`]:
 //!   frame-sequential LOD interpolation (Scherzer & Wimmer 2008): the transition scheduler, the
 //!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders.
@@ -22,9 +24,11 @@
 
 #![warn(missing_docs)]
 
+pub mod bilateral;
 pub mod combine;
 pub mod frame_sequential;
 pub mod fullscreen;
+pub mod gbuffer;
 pub mod lod_buffer;
 pub mod noise;
 pub mod normal_distance;

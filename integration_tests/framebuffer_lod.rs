@@ -1,0 +1,231 @@
+//! Geometry-aware framebuffer LOD: bilateral upsampling on the GPU (WGSL and GLSL twins) against
+//! the Rust twin on hand-built 2x2 neighbourhoods.
+
+use glam::{Vec2, Vec3, Vec4};
+use lodkit::bilateral::{bilateral_tent, bilateral_upsample};
+use lodkit::shaders::SourceLanguage;
+
+use crate::harness::{Probe, assert_close, floats, run_with, words};
+
+struct Case {
+    name: &'static str,
+    f: Vec2,
+    values: [Vec4; 4],
+    depths: Vec4,
+    normals: [Vec3; 4],
+    depth: f32,
+    normal: Vec3,
+    sigma_z: f32,
+    sigma_n: f32,
+}
+
+fn cases() -> Vec<Case> {
+    let values = [
+        Vec4::new(1.0, 0.0, 0.0, 1.0),
+        Vec4::new(0.0, 1.0, 0.0, 1.0),
+        Vec4::new(0.0, 0.0, 1.0, 1.0),
+        Vec4::new(1.0, 1.0, 1.0, 1.0),
+    ];
+    let flat = [Vec3::Z; 4];
+    let tilted = Vec3::new(0.8, 0.0, 0.6);
+    let inf = f32::INFINITY;
+    vec![
+        Case {
+            name: "flat region",
+            f: Vec2::new(0.3, 0.6),
+            values,
+            depths: Vec4::splat(5.0),
+            normals: flat,
+            depth: 5.0,
+            normal: Vec3::Z,
+            sigma_z: 0.1,
+            sigma_n: 0.3,
+        },
+        Case {
+            name: "depth edge",
+            f: Vec2::new(0.5, 0.5),
+            values,
+            depths: Vec4::new(5.0, 20.0, 5.0, 20.0),
+            normals: flat,
+            depth: 5.0,
+            normal: Vec3::Z,
+            sigma_z: 0.1,
+            sigma_n: 0.3,
+        },
+        Case {
+            name: "normal crease",
+            f: Vec2::new(0.5, 0.25),
+            values,
+            depths: Vec4::splat(5.0),
+            normals: [Vec3::Z, tilted, Vec3::Z, tilted],
+            depth: 5.0,
+            normal: Vec3::Z,
+            sigma_z: 0.1,
+            sigma_n: 0.3,
+        },
+        Case {
+            name: "all weights vanish",
+            f: Vec2::new(0.5, 0.5),
+            values,
+            depths: Vec4::new(9.0, 7.5, 12.0, 30.0),
+            normals: flat,
+            depth: 5.0,
+            normal: Vec3::Z,
+            sigma_z: 0.1,
+            sigma_n: 0.3,
+        },
+        Case {
+            name: "sigma = inf",
+            f: Vec2::new(0.7, 0.2),
+            values,
+            depths: Vec4::new(5.0, 20.0, 1.0, 9.0),
+            normals: [Vec3::Z, tilted, -Vec3::X, Vec3::Z],
+            depth: 5.0,
+            normal: Vec3::Z,
+            sigma_z: inf,
+            sigma_n: inf,
+        },
+        Case {
+            name: "corner",
+            f: Vec2::ZERO,
+            values,
+            depths: Vec4::splat(1.0),
+            normals: flat,
+            depth: 1.0,
+            normal: Vec3::Z,
+            sigma_z: 0.05,
+            sigma_n: 0.1,
+        },
+    ]
+}
+
+fn inputs(cases: &[Case]) -> Vec<u32> {
+    cases
+        .iter()
+        .flat_map(|c| {
+            let mut v = vec![c.f.x, c.f.y];
+            c.values.iter().for_each(|x| v.extend(x.to_array()));
+            v.extend(c.depths.to_array());
+            c.normals.iter().for_each(|n| v.extend(n.to_array()));
+            v.push(c.depth);
+            v.extend(c.normal.to_array());
+            v.extend([c.sigma_z, c.sigma_n]);
+            words(&v)
+        })
+        .collect()
+}
+
+const WGSL: &str = "let f = vec2(inp_f(0u), inp_f(1u));
+    var values: array<vec4<f32>, 4>;
+    var normals: array<vec3<f32>, 4>;
+    for (var i = 0u; i < 4u; i++) {
+        values[i] = vec4(inp_f(2u + 4u * i), inp_f(3u + 4u * i), inp_f(4u + 4u * i), inp_f(5u + 4u * i));
+        normals[i] = vec3(inp_f(22u + 3u * i), inp_f(23u + 3u * i), inp_f(24u + 3u * i));
+    }
+    let depths = vec4(inp_f(18u), inp_f(19u), inp_f(20u), inp_f(21u));
+    let r = bilateral_upsample(f, values, depths, normals, inp_f(34u), vec3(inp_f(35u), inp_f(36u), inp_f(37u)), inp_f(38u), inp_f(39u));
+    out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_f(3u, r.w);";
+
+const GLSL: &str = "vec2 f = vec2(inp_f(0u), inp_f(1u));
+    vec4 values[4];
+    vec3 normals[4];
+    for (uint i = 0u; i < 4u; i++) {
+        values[i] = vec4(inp_f(2u + 4u * i), inp_f(3u + 4u * i), inp_f(4u + 4u * i), inp_f(5u + 4u * i));
+        normals[i] = vec3(inp_f(22u + 3u * i), inp_f(23u + 3u * i), inp_f(24u + 3u * i));
+    }
+    vec4 depths = vec4(inp_f(18u), inp_f(19u), inp_f(20u), inp_f(21u));
+    vec4 r = lodkit_bilateral_upsample(f, values, depths, normals, inp_f(34u), vec3(inp_f(35u), inp_f(36u), inp_f(37u)), inp_f(38u), inp_f(39u));
+    out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_f(3u, r.w);";
+
+#[test]
+fn bilateral_upsample_twins_match_on_hand_built_neighbourhoods() {
+    let gpu = lodkit_test_gpu!();
+    let cases = cases();
+    let want: Vec<f32> = cases
+        .iter()
+        .flat_map(|c| {
+            bilateral_upsample(
+                c.f, &c.values, c.depths, &c.normals, c.depth, c.normal, c.sigma_z, c.sigma_n,
+            )
+            .to_array()
+        })
+        .collect();
+    for (language, header, body) in [
+        (
+            SourceLanguage::Wgsl,
+            "#import lodkit::bilateral::bilateral_upsample",
+            WGSL,
+        ),
+        (
+            SourceLanguage::Glsl(naga::ShaderStage::Compute),
+            "#include \"lodkit/bilateral.glsl\"",
+            GLSL,
+        ),
+    ] {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 40,
+            outputs: 4,
+            texture: None,
+        };
+        let got = floats(&run_with(gpu, &probe, &inputs(&cases), language, &[]));
+        assert_close(
+            &got,
+            &want,
+            1e-5,
+            &format!("{language:?} bilateral_upsample"),
+        );
+    }
+}
+
+#[test]
+fn bilateral_cases_behave_as_the_paper_says() {
+    let bilinear = |c: &Case| {
+        let t = bilateral_tent(c.f);
+        (0..4).fold(Vec4::ZERO, |acc, i| acc + t[i] * c.values[i])
+    };
+    let run = |c: &Case| {
+        bilateral_upsample(
+            c.f, &c.values, c.depths, &c.normals, c.depth, c.normal, c.sigma_z, c.sigma_n,
+        )
+    };
+    let cs = cases();
+    let close = |a: Vec4, b: Vec4| (a - b).abs().max_element() < 1e-5;
+    // "No bleeding": what crosses the edge is below 0.1 % (the Gaussians never reach exactly 0).
+    let no_bleed = |a: Vec4, b: Vec4| (a - b).abs().max_element() < 1e-3;
+    assert!(
+        close(run(&cs[0]), bilinear(&cs[0])),
+        "{}: equals bilinear",
+        cs[0].name
+    );
+    // Depth edge: only the near samples 0 and 2 contribute (equal tent weights -> their mean).
+    assert!(
+        no_bleed(run(&cs[1]), 0.5 * (cs[1].values[0] + cs[1].values[2])),
+        "{}: no bleeding",
+        cs[1].name
+    );
+    // Normal crease: only the facing samples 0 and 2 contribute, in tent proportion 3:1.
+    assert!(
+        no_bleed(run(&cs[2]), 0.75 * cs[2].values[0] + 0.25 * cs[2].values[2]),
+        "{}: no bleeding",
+        cs[2].name
+    );
+    assert_eq!(
+        run(&cs[3]),
+        cs[3].values[1],
+        "{}: the sample closest in depth (7.5)",
+        cs[3].name
+    );
+    assert!(
+        close(run(&cs[4]), bilinear(&cs[4])),
+        "{}: sigma = inf is bilinear",
+        cs[4].name
+    );
+    assert_eq!(
+        run(&cs[5]),
+        cs[5].values[0],
+        "{}: f = 0 is the first sample",
+        cs[5].name
+    );
+}

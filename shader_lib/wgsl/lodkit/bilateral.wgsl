@@ -1,0 +1,73 @@
+// lodkit::bilateral — geometry-aware (joint bilateral) upsampling of a low-resolution buffer
+// (Yang, Sander & Lawrence 2008, sec. 2.2, eq. 1).
+//
+// Each full-resolution pixel is reconstructed from the 2x2 nearest low-resolution samples,
+// weighted by a tent (bilinear) domain filter times Gaussian range filters on the depth difference
+// (sigma_z) and on the foreshortened normal distance (sigma_n, lodkit::normal_distance). With
+// sigma_z = sigma_n = +inf it is exactly bilinear. Where every weight vanishes (fine geometry that
+// is missing from the low-res buffer), the sample closest in depth is used instead of dividing by
+// ~0: the threshold is BILATERAL_MIN_WEIGHT on the sum of weights (the tent alone sums to 1).
+// The value can be a color or any single shading component (fine-grained resizing, sec. 2.3:
+// upsample e.g. a shadow term in .x and multiply by full-res albedo).
+//
+// Sample order everywhere: 0 = (x0, y0), 1 = (x0 + 1, y0), 2 = (x0, y0 + 1), 3 = (x0 + 1, y0 + 1).
+//
+// Exports:
+//   BILATERAL_MIN_WEIGHT: f32   fallback threshold on the sum of weights (1e-4)
+//   bilateral_range(difference, sigma) -> f32   exp(-d^2 / (2 sigma^2)); 1 for sigma = +inf
+//   bilateral_tent(f) -> vec4<f32>   bilinear weights of the 2x2 samples at fraction f
+//   bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> f32   one term of eq. 1
+//   bilateral_upsample(f, values, depths, normals, depth, normal, sigma_z, sigma_n) -> vec4<f32>
+// Shader defs: none.
+#define_import_path lodkit::bilateral
+#import lodkit::normal_distance::foreshortened_normal_distance
+
+/// Sum of weights below which eq. 1 falls back to the sample closest in depth.
+const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
+
+/// Gaussian range filter exp(-difference^2 / (2 sigma^2)); 1 when sigma is +inf.
+fn bilateral_range(difference: f32, sigma: f32) -> f32 {
+    let s = difference / sigma;
+    return exp(-0.5 * s * s);
+}
+
+/// Tent (bilinear) weights of the 2x2 samples for the fractional position `f` in [0, 1]^2.
+fn bilateral_tent(f: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+}
+
+/// One weight of eq. 1: tent x g(depth difference, sigma_z) x g(normal distance, sigma_n).
+fn bilateral_weight(tent: f32, depth_diff: f32, normal_dist: f32, sigma_z: f32, sigma_n: f32) -> f32 {
+    return tent * bilateral_range(depth_diff, sigma_z) * bilateral_range(normal_dist, sigma_n);
+}
+
+/// Eq. 1 over the 2x2 low-res samples (`values`, `depths`, `normals`) for a full-res pixel at
+/// fraction `f` between them with depth `depth` and normal `normal`. Falls back to the sample
+/// closest in depth when the weights sum below BILATERAL_MIN_WEIGHT.
+fn bilateral_upsample(
+    f: vec2<f32>,
+    values: array<vec4<f32>, 4>,
+    depths: vec4<f32>,
+    normals: array<vec3<f32>, 4>,
+    depth: f32,
+    normal: vec3<f32>,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> vec4<f32> {
+    let tent = bilateral_tent(f);
+    var sum = vec4<f32>(0.0);
+    var total = 0.0;
+    var closest = 0u;
+    for (var i = 0u; i < 4u; i++) {
+        let w = bilateral_weight(tent[i], depths[i] - depth, foreshortened_normal_distance(normals[i], normal), sigma_z, sigma_n);
+        sum += w * values[i];
+        total += w;
+        if (abs(depths[i] - depth) < abs(depths[closest] - depth)) {
+            closest = i;
+        }
+    }
+    if (total < BILATERAL_MIN_WEIGHT) {
+        return values[closest];
+    }
+    return sum / total;
+}
