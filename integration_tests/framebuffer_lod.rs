@@ -229,3 +229,126 @@ fn bilateral_cases_behave_as_the_paper_says() {
         cs[5].name
     );
 }
+
+mod controller {
+    use lodkit::framebuffer_lod::*;
+    use proptest::prelude::*;
+
+    const TARGET: f32 = 16.7;
+
+    fn step_workload(f: usize) -> f32 {
+        if f < 60 { 1.0 } else { 2.0 }
+    }
+
+    #[test]
+    fn online_controller_settles_after_a_2x_step_without_noise() {
+        let model = FrameTimeModel {
+            k: 40.0,
+            c: 3.0,
+            noise: 0.0,
+        };
+        let mut c = RlsController::new(TARGET, ResizeLimits::default());
+        let frames = simulate(&mut c, &model, step_workload, 160, 0);
+        let r = step_response(&frames, 60, TARGET, 0.05);
+        let settling = r.settling_frames.expect("settles");
+        assert!(settling <= 10, "settled after {settling} frames");
+        assert!(r.overshoot <= 0.10, "overshoot {}", r.overshoot);
+        // It found the model: r^2 = 2K / (target - C).
+        let want = (80.0f32 / (TARGET - 3.0)).sqrt();
+        assert!(
+            (frames.last().unwrap().r - want).abs() < 0.02,
+            "r {} vs {want}",
+            frames.last().unwrap().r
+        );
+    }
+
+    #[test]
+    fn online_controller_settles_under_noise_in_most_runs() {
+        let model = FrameTimeModel {
+            k: 40.0,
+            c: 3.0,
+            noise: 0.03,
+        };
+        let (mut fast, mut worst_overshoot) = (0, 0.0f32);
+        for seed in 0..50 {
+            let mut c = RlsController::new(TARGET, ResizeLimits::default());
+            let r = step_response(
+                &simulate(&mut c, &model, step_workload, 160, seed),
+                60,
+                TARGET,
+                0.05,
+            );
+            fast += usize::from(r.settling_frames.is_some_and(|s| s <= 10));
+            worst_overshoot = worst_overshoot.max(r.overshoot);
+        }
+        assert!(
+            fast >= 45,
+            "only {fast} of 50 noisy runs settled within 10 frames"
+        );
+        assert!(worst_overshoot <= 0.10, "overshoot {worst_overshoot}");
+    }
+
+    #[test]
+    fn the_papers_controller_overshoots_when_its_calibration_is_stale() {
+        // The comparison the online estimator is for: K calibrated before the workload doubled.
+        let model = FrameTimeModel {
+            k: 40.0,
+            c: 3.0,
+            noise: 0.0,
+        };
+        let mut paper = PaperController::new(TARGET, 40.0, ResizeLimits::default());
+        let r = step_response(
+            &simulate(&mut paper, &model, step_workload, 160, 0),
+            60,
+            TARGET,
+            0.05,
+        );
+        assert!(
+            r.settling_frames.is_none_or(|s| s > 10) || r.overshoot > 0.10,
+            "{r:?}"
+        );
+    }
+
+    fn arb_workload() -> impl Strategy<Value = Vec<f32>> {
+        prop::collection::vec(
+            prop_oneof![0.2f32..4.0, Just(f32::NAN), Just(0.0), Just(-1.0)],
+            1..8,
+        )
+    }
+
+    proptest! {
+        #[test]
+        fn every_controller_keeps_r_in_bounds(levels in arb_workload(), noise in 0.0f32..0.2, r_max in 1.0f32..6.0, seed in any::<u64>()) {
+            let limits = ResizeLimits { r_max, max_step: 0.2 };
+            let mut controllers: Vec<Box<dyn ResizeController>> = vec![
+                Box::new(RlsController::new(TARGET, limits)),
+                Box::new(PaperController::new(TARGET, 40.0, limits)),
+                Box::new(StepController::new(TARGET, limits)),
+            ];
+            let model = FrameTimeModel { k: 40.0, c: 3.0, noise };
+            for c in controllers.iter_mut() {
+                // Workload levels (NaN, 0 and negative ones give NaN/0/negative frame times).
+                let frames = simulate(c.as_mut(), &model, |f| levels[(f / 20) % levels.len()], 160, seed);
+                let mut previous = 1.0f32;
+                for f in &frames {
+                    prop_assert!(f.r >= 1.0 && f.r <= r_max.max(1.0), "r {} out of [1, {}]", f.r, r_max);
+                    prop_assert!((f.r - previous).abs() <= 0.2 + 1e-6, "step {} -> {}", previous, f.r);
+                    previous = f.r;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bad_samples_are_ignored() {
+        let mut c = RlsController::new(TARGET, ResizeLimits::default());
+        for _ in 0..5 {
+            c.update(30.0);
+        }
+        let (r, estimates) = (c.r(), c.estimates());
+        for bad in [f32::NAN, 0.0, -5.0, f32::INFINITY] {
+            assert_eq!(c.update(bad), r);
+        }
+        assert_eq!(c.estimates(), estimates);
+    }
+}

@@ -27,6 +27,7 @@
 pub mod bilateral;
 pub mod combine;
 pub mod frame_sequential;
+pub mod framebuffer_lod;
 pub mod fullscreen;
 pub mod gbuffer;
 pub mod lod_buffer;
