@@ -352,3 +352,98 @@ mod controller {
         assert_eq!(c.estimates(), estimates);
     }
 }
+
+mod rendered {
+    use lodkit::framebuffer_lod::psnr_rgba8;
+    use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+    use lodkit::gpu::gbuffer_scene::EdgeScene;
+    use lodkit::gpu::readback::read_texture_rgba8;
+    use lodkit::gpu::resources::texture_2d;
+
+    use crate::harness::say;
+
+    const W: u32 = 160;
+    const H: u32 = 120;
+
+    #[test]
+    fn bilateral_beats_bilinear_by_3_db_at_r_2() {
+        let gpu = lodkit_test_gpu!();
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let scene = EdgeScene::new(gpu, format, W as f32 / H as f32).unwrap();
+        let full = LowResBuffer::new(gpu, W, H, format);
+        scene.render(gpu, &full, 1.0);
+        let reference = read_texture_rgba8(gpu, full.color());
+        let low = LowResBuffer::new(gpu, W, H, format);
+        let upsample = UpsamplePass::new(gpu, format).unwrap();
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let target = texture_2d(gpu, (W, H), format, usage, "upsampled");
+        let view = target.create_view(&Default::default());
+        let mut rows = Vec::new();
+        let mut gain_at_2 = 0.0;
+        for r in [2.0f32, 4.0] {
+            scene.render(gpu, &low, r);
+            let mut psnr = [0.0f32; 2];
+            for (i, (sz, sn)) in [(f32::INFINITY, f32::INFINITY), (0.25, 0.4)]
+                .into_iter()
+                .enumerate()
+            {
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                upsample.encode(gpu, &mut encoder, &low, r, full.geometry(), sz, sn, &view);
+                gpu.queue.submit([encoder.finish()]);
+                psnr[i] = psnr_rgba8(&read_texture_rgba8(gpu, &target), &reference);
+            }
+            rows.push(format!(
+                "r = {r}: bilinear {:.2} dB, bilateral {:.2} dB, gain {:+.2} dB",
+                psnr[0],
+                psnr[1],
+                psnr[1] - psnr[0]
+            ));
+            if r == 2.0 {
+                gain_at_2 = psnr[1] - psnr[0];
+            }
+            assert!(psnr[1] > psnr[0], "bilateral must beat bilinear at r = {r}");
+        }
+        say(&format!(
+            "edge scene {W}x{H}, PSNR vs full-res reference:\n{}",
+            rows.join("\n")
+        ));
+        assert!(
+            gain_at_2 >= 3.0,
+            "gain at r = 2 is {gain_at_2:.2} dB, target >= 3 dB"
+        );
+    }
+
+    #[test]
+    fn changing_r_does_not_reallocate_the_low_res_buffer() {
+        let _shared = lodkit_test_gpu!();
+        // A device of its own, so that the live-texture count is this test's alone.
+        let gpu = &lodkit::gpu::GpuContext::new_headless(&Default::default()).unwrap();
+        let textures = || {
+            gpu.instance
+                .generate_report()
+                .map(|r| r.hub_report().textures.num_kept_from_user)
+        };
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let scene = EdgeScene::new(gpu, format, 4.0 / 3.0).unwrap();
+        let low = LowResBuffer::new(gpu, 64, 48, format);
+        scene.render(gpu, &low, 1.0);
+        gpu.wait_idle();
+        let before = textures();
+        for r in [1.0f32, 1.2, 1.4, 2.0, 3.7, 4.0] {
+            scene.render(gpu, &low, r);
+            gpu.wait_idle();
+            assert_eq!(
+                textures(),
+                before,
+                "textures were allocated or freed at r = {r}"
+            );
+            let (w, h) = low.viewport(r);
+            assert_eq!((w, h), ((64.0 / r).ceil() as u32, (48.0 / r).ceil() as u32));
+            assert_eq!(
+                (low.color().width(), low.color().height()),
+                (64, 48),
+                "L stays at full size"
+            );
+        }
+    }
+}

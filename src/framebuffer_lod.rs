@@ -417,3 +417,27 @@ pub fn step_response(
         spread,
     }
 }
+
+/// Peak signal-to-noise ratio in dB between two RGBA8 images (RGB channels only); +inf when equal.
+///
+/// ```
+/// # use lodkit::framebuffer_lod::psnr_rgba8;
+/// let a = [10u8, 20, 30, 255];
+/// assert_eq!(psnr_rgba8(&a, &a), f32::INFINITY);
+/// let b = [11u8, 20, 30, 0];
+/// assert!((psnr_rgba8(&a, &b) - 10.0 * (255.0f32 * 255.0 * 3.0).log10()).abs() < 1e-3);
+/// ```
+pub fn psnr_rgba8(a: &[u8], b: &[u8]) -> f32 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (pa, pb) in a.chunks(4).zip(b.chunks(4)) {
+        for c in 0..3 {
+            let d = f64::from(pa[c]) - f64::from(pb[c]);
+            sum += d * d;
+            n += 1;
+        }
+    }
+    if sum == 0.0 || n == 0 {
+        return f32::INFINITY;
+    }
+    (10.0 * (255.0f64 * 255.0 / (sum / n as f64)).log10()) as f32
+}

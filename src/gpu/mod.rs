@@ -3,6 +3,8 @@
 
 mod context;
 pub mod frame_sequential;
+pub mod framebuffer_lod;
+pub mod gbuffer_scene;
 pub mod lod_buffer_scene;
 pub mod readback;
 pub mod resources;

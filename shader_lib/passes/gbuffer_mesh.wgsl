@@ -1,0 +1,58 @@
+// passes/gbuffer_mesh — a mesh drawn into the low-resolution buffer of framebuffer LOD (or into a
+// full-resolution reference or depth/normal prepass): color plus (view depth, screen-space
+// normal) through lodkit::gbuffer.
+//
+// The shading has a high-frequency but smooth term (a procedural stripe pattern in object space
+// over Lambert lighting), the kind of detail resizing blurs and bilateral upsampling keeps from
+// bleeding across silhouettes and creases.
+//
+// Entry points:
+//   vs_main   @location(0) position, @location(1) normal (object space)
+//   fs_main   GBufferOutput (location 0 color, location 1 rgba16float geometry)
+// Bindings: group 0: 0 `camera: GCamera` (uniform); group 1: 0 `draw: GDraw` (uniform, dynamic
+// offset).
+// Shader defs: none.
+#import lodkit::gbuffer::{GBufferOutput, gbuffer_output}
+
+/// Per-view data.
+struct GCamera {
+    view_proj: mat4x4<f32>,
+    view: mat4x4<f32>,
+    /// World-space direction toward the light (w unused).
+    light_dir: vec4<f32>,
+}
+
+/// Per-draw data.
+struct GDraw {
+    model: mat4x4<f32>,
+    color: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> camera: GCamera;
+@group(1) @binding(0) var<uniform> draw: GDraw;
+
+struct VertexOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) world_normal: vec3<f32>,
+    @location(1) view_pos: vec3<f32>,
+    @location(2) object_pos: vec3<f32>,
+}
+
+/// Transforms to clip and view space.
+@vertex
+fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
+    let world = draw.model * vec4<f32>(position, 1.0);
+    let view_pos = (camera.view * world).xyz;
+    return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz, view_pos, position);
+}
+
+/// Stripes over Lambert; writes color, view depth and the screen-space normal.
+@fragment
+fn fs_main(in: VertexOut) -> GBufferOutput {
+    let n = normalize(in.world_normal);
+    let lambert = max(dot(n, normalize(camera.light_dir.xyz)), 0.0);
+    let stripes = 0.5 + 0.5 * sin(18.0 * (in.object_pos.x + in.object_pos.y));
+    let color = draw.color.rgb * (0.3 + 0.7 * lambert) * (0.6 + 0.4 * stripes);
+    let view_normal = normalize((camera.view * vec4<f32>(n, 0.0)).xyz);
+    return gbuffer_output(vec4<f32>(color, 1.0), -in.view_pos.z, view_normal);
+}

@@ -1,0 +1,223 @@
+//! wgpu glue for geometry-aware framebuffer LOD: the low-resolution buffer L, allocated once at
+//! full size and rendered through a viewport that shrinks with r (changing r never reallocates),
+//! and the upsample pass as a ready object.
+
+use super::GpuContext;
+use super::resources::{begin_color_pass, fullscreen_pipeline, texture_2d, uniform_buffer};
+use crate::gbuffer::GEOMETRY_FORMAT;
+use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
+
+/// Depth format of the low-resolution pass.
+pub const LOW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// The low-resolution buffer L: color, geometry (view depth, normal) and depth, all at full size;
+/// frames render into the top-left `viewport(r)` of them.
+#[derive(Debug)]
+pub struct LowResBuffer {
+    full_size: (u32, u32),
+    color: wgpu::Texture,
+    geometry: wgpu::Texture,
+    depth: wgpu::Texture,
+}
+
+impl LowResBuffer {
+    /// Allocates L for a `width` x `height` target with color format `color_format`.
+    pub fn new(
+        gpu: &GpuContext,
+        width: u32,
+        height: u32,
+        color_format: wgpu::TextureFormat,
+    ) -> Self {
+        let size = (width.max(1), height.max(1));
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        Self {
+            full_size: size,
+            color: texture_2d(gpu, size, color_format, usage, "low-res color"),
+            geometry: texture_2d(gpu, size, GEOMETRY_FORMAT, usage, "low-res geometry"),
+            depth: texture_2d(
+                gpu,
+                size,
+                LOW_DEPTH_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+                "low-res depth",
+            ),
+        }
+    }
+
+    /// Size of the full-resolution target.
+    pub fn full_size(&self) -> (u32, u32) {
+        self.full_size
+    }
+
+    /// The part of L used at resize factor `r` (clamped to >= 1): ceil(size / r).
+    ///
+    /// Changing r only changes this viewport; the textures stay.
+    pub fn viewport(&self, r: f32) -> (u32, u32) {
+        let r = if r.is_finite() { r.max(1.0) } else { 1.0 };
+        let (w, h) = self.full_size;
+        (
+            ((w as f32 / r).ceil() as u32).clamp(1, w),
+            ((h as f32 / r).ceil() as u32).clamp(1, h),
+        )
+    }
+
+    /// Color texture.
+    pub fn color(&self) -> &wgpu::Texture {
+        &self.color
+    }
+
+    /// Geometry texture (view depth, normal).
+    pub fn geometry(&self) -> &wgpu::Texture {
+        &self.geometry
+    }
+
+    /// Begins the low-resolution pass at resize factor `r`: clears color to `clear`, geometry to
+    /// (far_view_depth, 0, 0, 1) and depth to 1, and sets the viewport and scissor to
+    /// [`viewport(r)`](Self::viewport).
+    pub fn begin_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        r: f32,
+        clear: wgpu::Color,
+        far_view_depth: f32,
+    ) -> wgpu::RenderPass<'e> {
+        let color = self.color.create_view(&Default::default());
+        let geometry = self.geometry.create_view(&Default::default());
+        let depth = self.depth.create_view(&Default::default());
+        let geometry_clear = wgpu::Color {
+            r: f64::from(far_view_depth),
+            g: 0.0,
+            b: 0.0,
+            a: 1.0,
+        };
+        let attachment = |view, clear| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("low-res pass"),
+            color_attachments: &[
+                attachment(&color, clear),
+                attachment(&geometry, geometry_clear),
+            ],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let (w, h) = self.viewport(r);
+        pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
+        pass.set_scissor_rect(0, 0, w, h);
+        pass
+    }
+}
+
+/// Rust mirror of `UpsampleParams` in `passes/upsample.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct UpsampleParams {
+    /// Size of L's viewport this frame.
+    pub low_viewport: [f32; 2],
+    /// Size of the full-resolution target.
+    pub full_size: [f32; 2],
+    /// Depth range sigma (world units; +inf: no depth term).
+    pub sigma_z: f32,
+    /// Normal range sigma (+inf: no normal term).
+    pub sigma_n: f32,
+    /// Padding.
+    pub pad: [f32; 2],
+}
+
+/// The upsample pass (`passes/upsample.wgsl`): full-res color from L and a full-res depth/normal
+/// prepass. With both sigmas +inf it is a plain bilinear upsample.
+#[derive(Debug)]
+pub struct UpsamplePass {
+    pipeline: wgpu::RenderPipeline,
+    params: wgpu::Buffer,
+}
+
+impl UpsamplePass {
+    /// Builds the pipeline for targets of `target_format`.
+    pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
+        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+            source: find_pass_source("upsample").unwrap_or_default(),
+            file_path: "shader_lib/passes/upsample.wgsl",
+            ..Default::default()
+        })?;
+        let module = gpu.shader_module("upsample", &composed);
+        Ok(Self {
+            pipeline: fullscreen_pipeline(gpu, &module, target_format, "lodkit upsample"),
+            params: uniform_buffer(
+                gpu,
+                std::mem::size_of::<UpsampleParams>(),
+                "upsample params",
+            ),
+        })
+    }
+
+    /// Records the upsampling of `low` (rendered at resize factor `r`) into `target`, with the
+    /// full-resolution geometry `full_geometry` (gbuffer layout) and range sigmas.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        low: &LowResBuffer,
+        r: f32,
+        full_geometry: &wgpu::Texture,
+        sigma_z: f32,
+        sigma_n: f32,
+        target: &wgpu::TextureView,
+    ) {
+        let (vw, vh) = low.viewport(r);
+        let (w, h) = low.full_size();
+        let params = UpsampleParams {
+            low_viewport: [vw as f32, vh as f32],
+            full_size: [w as f32, h as f32],
+            sigma_z,
+            sigma_n,
+            pad: [0.0; 2],
+        };
+        gpu.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let views = [low.color(), low.geometry(), full_geometry]
+            .map(|t| t.create_view(&Default::default()));
+        let mut entries: Vec<wgpu::BindGroupEntry> = views
+            .iter()
+            .enumerate()
+            .map(|(i, v)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: wgpu::BindingResource::TextureView(v),
+            })
+            .collect();
+        entries.push(wgpu::BindGroupEntry {
+            binding: 3,
+            resource: self.params.as_entire_binding(),
+        });
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lodkit upsample"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit upsample");
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

@@ -1,0 +1,268 @@
+//! Drawing meshes into a [`LowResBuffer`] with `passes/gbuffer_mesh.wgsl`: the reference for an
+//! engine's low-resolution (or full-resolution prepass) pass under framebuffer LOD, used by the
+//! examples, tests and demo.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::GpuContext;
+use super::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
+use super::resources::{DrawUniforms, uniform_buffer, uniform_entry};
+use super::scene::{GpuMesh, MESH_VERTEX_LAYOUT};
+use crate::gbuffer::GEOMETRY_FORMAT;
+use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
+
+/// Rust mirror of `GCamera` in `passes/gbuffer_mesh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GCameraUniform {
+    /// Projection x view.
+    pub view_proj: [[f32; 4]; 4],
+    /// World to view.
+    pub view: [[f32; 4]; 4],
+    /// World-space direction toward the light.
+    pub light_dir: [f32; 4],
+}
+
+/// Rust mirror of `GDraw` in `passes/gbuffer_mesh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GDrawUniform {
+    /// Object to world.
+    pub model: [[f32; 4]; 4],
+    /// Base color.
+    pub color: [f32; 4],
+}
+
+/// One draw: mesh, transform, base color.
+#[derive(Clone, Copy, Debug)]
+pub struct GDrawItem<'a> {
+    /// The mesh.
+    pub mesh: &'a GpuMesh,
+    /// Object to world.
+    pub model: Mat4,
+    /// Base color.
+    pub color: Vec4,
+}
+
+/// Draws [`GDrawItem`]s into a [`LowResBuffer`] at any resize factor.
+#[derive(Debug)]
+pub struct GBufferRenderer {
+    pipeline: wgpu::RenderPipeline,
+    camera: wgpu::Buffer,
+    camera_group: wgpu::BindGroup,
+    draws: DrawUniforms,
+    draw_group: wgpu::BindGroup,
+}
+
+impl GBufferRenderer {
+    /// Most draws per [`render`](Self::render).
+    pub const MAX_DRAWS: usize = 256;
+
+    /// Builds the pipeline for color format `color_format`.
+    pub fn new(gpu: &GpuContext, color_format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
+        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+            source: find_pass_source("gbuffer_mesh").unwrap_or_default(),
+            file_path: "shader_lib/passes/gbuffer_mesh.wgsl",
+            ..Default::default()
+        })?;
+        let module = gpu.shader_module("gbuffer_mesh", &composed);
+        let device = &gpu.device;
+        let layout_of = |dynamic| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: None,
+                entries: &[uniform_entry(0, dynamic)],
+            })
+        };
+        let (camera_layout, draw_layout) = (layout_of(false), layout_of(true));
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gbuffer_mesh"),
+            bind_group_layouts: &[Some(&camera_layout), Some(&draw_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("gbuffer_mesh"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(MESH_VERTEX_LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: Some(wgpu::Face::Back),
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: LOW_DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(color_format.into()), Some(GEOMETRY_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let camera = uniform_buffer(gpu, std::mem::size_of::<GCameraUniform>(), "gbuffer camera");
+        let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &camera_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: camera.as_entire_binding(),
+            }],
+        });
+        let draws = DrawUniforms::new(
+            gpu,
+            std::mem::size_of::<GDrawUniform>(),
+            Self::MAX_DRAWS,
+            "gbuffer draws",
+        );
+        let draw_group = draws.bind_group(gpu, &draw_layout);
+        Ok(Self {
+            pipeline,
+            camera,
+            camera_group,
+            draws,
+            draw_group,
+        })
+    }
+
+    /// Renders `items` into `target` at resize factor `r` (the viewport shrinks with r; the
+    /// textures do not change), cleared to `clear` with geometry (`far_view_depth`, +z).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(
+        &self,
+        gpu: &GpuContext,
+        target: &LowResBuffer,
+        r: f32,
+        view: Mat4,
+        proj: Mat4,
+        items: &[GDrawItem],
+        clear: wgpu::Color,
+        far_view_depth: f32,
+    ) {
+        let camera = GCameraUniform {
+            view_proj: (proj * view).to_cols_array_2d(),
+            view: view.to_cols_array_2d(),
+            light_dir: Vec3::new(0.5, 0.8, 0.4).extend(0.0).to_array(),
+        };
+        gpu.queue
+            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+        let uniforms: Vec<GDrawUniform> = items
+            .iter()
+            .map(|i| GDrawUniform {
+                model: i.model.to_cols_array_2d(),
+                color: i.color.to_array(),
+            })
+            .collect();
+        let n = self.draws.write(gpu, &uniforms);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = target.begin_pass(&mut encoder, r, clear, far_view_depth);
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.camera_group, &[]);
+            for (i, item) in items[..n].iter().enumerate() {
+                pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
+                item.mesh.draw(&mut pass);
+            }
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
+}
+
+/// An edge-heavy test scene: boxes and spheres of different depths and orientations in front of
+/// a far wall, with striped shading; the framebuffer-LOD quality tests and examples render it.
+#[derive(Debug)]
+pub struct EdgeScene {
+    renderer: GBufferRenderer,
+    sphere: GpuMesh,
+    cube: GpuMesh,
+    aspect: f32,
+}
+
+impl EdgeScene {
+    /// View depth of the background (cleared geometry).
+    pub const FAR_VIEW_DEPTH: f32 = 40.0;
+
+    /// Uploads the meshes and builds the renderer for targets of `color_format` and `aspect`.
+    pub fn new(
+        gpu: &GpuContext,
+        color_format: wgpu::TextureFormat,
+        aspect: f32,
+    ) -> Result<Self, ShaderError> {
+        Ok(Self {
+            renderer: GBufferRenderer::new(gpu, color_format)?,
+            sphere: GpuMesh::new(gpu, &super::scene::Mesh::sphere(24, 48)),
+            cube: GpuMesh::new(gpu, &super::scene::Mesh::cube()),
+            aspect,
+        })
+    }
+
+    /// Renders the scene into `target` at resize factor `r`.
+    pub fn render(&self, gpu: &GpuContext, target: &LowResBuffer, r: f32) {
+        let view = glam::camera::rh::view::look_at_mat4(
+            Vec3::new(0.5, 1.2, 6.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::Y,
+        );
+        let proj = glam::camera::rh::proj::directx::perspective(0.9, self.aspect, 0.1, 100.0);
+        let rot = |a: f32, b: f32| Mat4::from_rotation_y(a) * Mat4::from_rotation_x(b);
+        let t = Mat4::from_translation;
+        let s = |v: f32| Mat4::from_scale(Vec3::splat(v));
+        let items = [
+            GDrawItem {
+                mesh: &self.cube,
+                model: t(Vec3::new(0.0, 0.0, -12.0)) * Mat4::from_scale(Vec3::new(12.0, 8.0, 0.2)),
+                color: Vec4::new(0.9, 0.85, 0.7, 1.0),
+            },
+            GDrawItem {
+                mesh: &self.cube,
+                model: t(Vec3::new(-1.6, 0.0, -1.0)) * rot(0.6, 0.3) * s(0.8),
+                color: Vec4::new(0.9, 0.3, 0.2, 1.0),
+            },
+            GDrawItem {
+                mesh: &self.sphere,
+                model: t(Vec3::new(1.2, 0.3, 0.0)) * s(0.9),
+                color: Vec4::new(0.2, 0.5, 0.9, 1.0),
+            },
+            GDrawItem {
+                mesh: &self.cube,
+                model: t(Vec3::new(0.3, -0.8, 1.5)) * rot(-0.8, 0.5) * s(0.5),
+                color: Vec4::new(0.3, 0.8, 0.3, 1.0),
+            },
+            GDrawItem {
+                mesh: &self.sphere,
+                model: t(Vec3::new(-0.5, 1.0, -3.0)) * s(0.7),
+                color: Vec4::new(0.8, 0.7, 0.2, 1.0),
+            },
+            GDrawItem {
+                mesh: &self.cube,
+                model: t(Vec3::new(2.2, -0.5, -4.0)) * rot(0.3, -0.4) * s(1.0),
+                color: Vec4::new(0.6, 0.3, 0.8, 1.0),
+            },
+        ];
+        let clear = wgpu::Color {
+            r: 0.1,
+            g: 0.12,
+            b: 0.15,
+            a: 1.0,
+        };
+        self.renderer.render(
+            gpu,
+            target,
+            r,
+            view,
+            proj,
+            &items,
+            clear,
+            Self::FAR_VIEW_DEPTH,
+        );
+    }
+}
