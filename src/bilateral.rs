@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::normal_distance::foreshortened_normal_distance;
+use crate::normal_distance::foreshortened_normal;
 
 /// Sum of weights below which [`bilateral_upsample`] falls back to the sample closest in depth.
 pub const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
@@ -75,9 +75,10 @@ pub fn bilateral_upsample(
     sigma_n: f32,
 ) -> Vec4 {
     let tent = bilateral_tent(f);
+    let here = foreshortened_normal(normal);
     let (mut sum, mut total, mut closest) = (Vec4::ZERO, 0.0f32, 0usize);
     for i in 0..4 {
-        let n = foreshortened_normal_distance(normals[i], normal);
+        let n = foreshortened_normal(normals[i]).distance(here);
         let w = bilateral_weight(tent[i], depths[i] - depth, n, sigma_z, sigma_n);
         sum += w * values[i];
         total += w;

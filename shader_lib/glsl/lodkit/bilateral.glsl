@@ -30,19 +30,23 @@ vec4 lodkit_bilateral_tent(vec2 f) {
     return vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
 }
 
-/// One weight of eq. 1.
+/// One weight of eq. 1, as one exponential of the summed exponents.
 float lodkit_bilateral_weight(float tent, float depth_diff, float normal_dist, float sigma_z, float sigma_n) {
-    return tent * lodkit_bilateral_range(depth_diff, sigma_z) * lodkit_bilateral_range(normal_dist, sigma_n);
+    float z = depth_diff / sigma_z;
+    float n = normal_dist / sigma_n;
+    return tent * exp(-0.5 * (z * z + n * n));
 }
 
 /// Eq. 1 over the 2x2 low-res samples, with the closest-depth fallback.
 vec4 lodkit_bilateral_upsample(vec2 f, vec4 values[4], vec4 depths, vec3 normals[4], float depth, vec3 normal, float sigma_z, float sigma_n) {
     vec4 tent = lodkit_bilateral_tent(f);
+    vec2 here = lodkit_foreshortened_normal(normal);
     vec4 sum = vec4(0.0);
     float total = 0.0;
     uint closest = 0u;
     for (uint i = 0u; i < 4u; i++) {
-        float w = lodkit_bilateral_weight(tent[i], depths[i] - depth, lodkit_foreshortened_normal_distance(normals[i], normal), sigma_z, sigma_n);
+        float normal_dist = distance(lodkit_foreshortened_normal(normals[i]), here);
+        float w = lodkit_bilateral_weight(tent[i], depths[i] - depth, normal_dist, sigma_z, sigma_n);
         sum += w * values[i];
         total += w;
         if (abs(depths[i] - depth) < abs(depths[closest] - depth)) {

@@ -20,7 +20,7 @@
 //   bilateral_upsample(f, values, depths, normals, depth, normal, sigma_z, sigma_n) -> vec4<f32>
 // Shader defs: none.
 #define_import_path lodkit::bilateral
-#import lodkit::normal_distance::foreshortened_normal_distance
+#import lodkit::normal_distance::foreshortened_normal
 
 /// Sum of weights below which eq. 1 falls back to the sample closest in depth.
 const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
@@ -36,9 +36,12 @@ fn bilateral_tent(f: vec2<f32>) -> vec4<f32> {
     return vec4<f32>((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
 }
 
-/// One weight of eq. 1: tent x g(depth difference, sigma_z) x g(normal distance, sigma_n).
+/// One weight of eq. 1: tent x g(depth difference, sigma_z) x g(normal distance, sigma_n),
+/// evaluated as one exponential of the summed exponents.
 fn bilateral_weight(tent: f32, depth_diff: f32, normal_dist: f32, sigma_z: f32, sigma_n: f32) -> f32 {
-    return tent * bilateral_range(depth_diff, sigma_z) * bilateral_range(normal_dist, sigma_n);
+    let z = depth_diff / sigma_z;
+    let n = normal_dist / sigma_n;
+    return tent * exp(-0.5 * (z * z + n * n));
 }
 
 /// Eq. 1 over the 2x2 low-res samples (`values`, `depths`, `normals`) for a full-res pixel at
@@ -55,11 +58,14 @@ fn bilateral_upsample(
     sigma_n: f32,
 ) -> vec4<f32> {
     let tent = bilateral_tent(f);
+    let here = foreshortened_normal(normal);
     var sum = vec4<f32>(0.0);
     var total = 0.0;
     var closest = 0u;
     for (var i = 0u; i < 4u; i++) {
-        let w = bilateral_weight(tent[i], depths[i] - depth, foreshortened_normal_distance(normals[i], normal), sigma_z, sigma_n);
+        // foreshortened_normal_distance, with this pixel's half computed once.
+        let normal_dist = distance(foreshortened_normal(normals[i]), here);
+        let w = bilateral_weight(tent[i], depths[i] - depth, normal_dist, sigma_z, sigma_n);
         sum += w * values[i];
         total += w;
         if (abs(depths[i] - depth) < abs(depths[closest] - depth)) {
