@@ -440,3 +440,48 @@ fn rust_uniform_mirrors_match_the_wgsl_layout() {
     assert_eq!(size_of("Camera"), std::mem::size_of::<CameraUniform>());
     assert_eq!(size_of("Draw"), std::mem::size_of::<DrawUniform>());
 }
+
+#[test]
+fn glsl_texture_macros_compile_with_glslang() {
+    let Some(_) = tool("glslangValidator") else {
+        return;
+    };
+    let include_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib/glsl");
+    let source = "#version 450
+#extension GL_GOOGLE_include_directive : require
+#include \"lodkit/visibility.glsl\"
+#include \"lodkit/bilateral.glsl\"
+layout(set = 0, binding = 0) uniform sampler2D vis_tex;
+layout(set = 0, binding = 1) uniform sampler2D low_color;
+layout(set = 0, binding = 2) uniform sampler2D low_geometry;
+layout(location = 0) in vec3 object_pos;
+layout(location = 0) out vec4 color;
+void main() {
+    if (!lodkit_check_visibility(vis_tex, object_pos, 0.5)) discard;
+    color = lodkit_bilateral_upsample_at(low_color, low_geometry, vec2(320.0, 180.0), vec2(640.0, 360.0),
+                                         gl_FragCoord.xy, 4.0, vec3(0.0, 0.0, 1.0), 0.25, 0.4);
+}
+";
+    let frag = scratch("macros.frag");
+    std::fs::write(&frag, source).unwrap();
+    let spv = frag.with_extension("spv");
+    let out = std::process::Command::new("glslangValidator")
+        .args(["-V", "-S", "frag"])
+        .arg(format!("-I{}", include_root.display()))
+        .arg(&frag)
+        .arg("-o")
+        .arg(&spv)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "glslangValidator rejects the macros:\n{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let bytes = std::fs::read(&spv).unwrap();
+    let words: Vec<u32> = bytes
+        .chunks(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    spirv_val(&words, "macros.frag");
+}

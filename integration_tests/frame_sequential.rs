@@ -90,6 +90,7 @@ fn combine_samples_twins_match_on_hand_derived_cases() {
                 inputs: 12,
                 outputs: 4,
                 texture: None,
+                rgba: &[],
             };
             let got = floats(&run_with(gpu, &probe, &inputs, language, defs));
             assert_eq!(got, want, "{language:?} {convention:?}");
@@ -245,6 +246,7 @@ fn reproject_twins_match_including_reversed_z_sky_and_outside() {
             inputs: 19,
             outputs: 4,
             texture: None,
+            rgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
         for (i, (g, w)) in got.chunks(4).zip(&want).enumerate() {
@@ -342,6 +344,7 @@ fn visibility_twins_match_with_a_real_texture() {
             inputs: 3,
             outputs: 4,
             texture: Some((64, &tex.texels)),
+            rgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
         assert_eq!(got, want, "{language:?} visibility");

@@ -168,6 +168,7 @@ fn bilateral_upsample_twins_match_on_hand_built_neighbourhoods() {
             inputs: 40,
             outputs: 4,
             texture: None,
+            rgba: &[],
         };
         let got = floats(&run_with(gpu, &probe, &inputs(&cases), language, &[]));
         assert_close(
@@ -445,5 +446,88 @@ mod rendered {
                 "L stays at full size"
             );
         }
+    }
+}
+
+#[test]
+fn bilateral_upsample_at_twins_match_on_real_textures() {
+    use lodkit::bilateral::{Image, bilateral_upsample_at};
+    let gpu = lodkit_test_gpu!();
+    // L textures of 6x5 with only 5x4 rendered (the viewport), a 10x8 full-res target: r = 2.
+    let (lw, lh) = (6u32, 5u32);
+    let noise = lodkit::noise::white_noise((lw * lh * 8) as usize, 21);
+    let colors: Vec<Vec4> = noise
+        .chunks(8)
+        .map(|c| Vec4::new(c[0], c[1], c[2], 1.0))
+        .collect();
+    let geometry: Vec<Vec4> = (0..lw * lh)
+        .map(|i| {
+            let (x, n) = ((i % lw) as f32, &noise[(i * 8) as usize..]);
+            let depth = if x < 2.5 {
+                3.0 + 0.1 * n[3]
+            } else {
+                9.0 + 0.1 * n[4]
+            };
+            Vec4::new(depth, n[5] * 0.6 - 0.3, n[6] * 0.6 - 0.3, 0.9)
+        })
+        .collect();
+    let (viewport, full) = (Vec2::new(5.0, 4.0), Vec2::new(10.0, 8.0));
+    let pixels: Vec<(Vec2, f32, Vec3)> = (0..80)
+        .map(|i| {
+            let p = Vec2::new((i % 10) as f32 + 0.5, (i / 10) as f32 + 0.5);
+            let depth = if p.x < 5.0 { 3.05 } else { 9.05 };
+            (p, depth, Vec3::new(0.1, -0.1, 0.99).normalize())
+        })
+        .collect();
+    let inputs: Vec<u32> = pixels
+        .iter()
+        .flat_map(|(p, d, n)| words(&[p.x, p.y, *d, n.x, n.y, n.z]))
+        .collect();
+    let want: Vec<f32> = pixels
+        .iter()
+        .flat_map(|(p, d, n)| {
+            let c = Image {
+                width: lw,
+                texels: &colors,
+            };
+            let g = Image {
+                width: lw,
+                texels: &geometry,
+            };
+            bilateral_upsample_at(c, g, viewport, full, *p, *d, *n, 0.3, 0.5).to_array()
+        })
+        .collect();
+    let wgsl = "let r = bilateral_upsample_at(probe_rgba0, probe_rgba1, vec2(5.0, 4.0), vec2(10.0, 8.0), vec2(inp_f(0u), inp_f(1u)), inp_f(2u), vec3(inp_f(3u), inp_f(4u), inp_f(5u)), 0.3, 0.5);
+        out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_f(3u, r.w);";
+    let glsl = "vec4 r = lodkit_bilateral_upsample_at(sampler2D(probe_rgba0, probe_sampler), sampler2D(probe_rgba1, probe_sampler), vec2(5.0, 4.0), vec2(10.0, 8.0), vec2(inp_f(0u), inp_f(1u)), inp_f(2u), vec3(inp_f(3u), inp_f(4u), inp_f(5u)), 0.3, 0.5);
+        out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_f(3u, r.w);";
+    let textures = [(lw, lh, &colors[..]), (lw, lh, &geometry[..])];
+    for (language, header, body) in [
+        (
+            SourceLanguage::Wgsl,
+            "#import lodkit::bilateral::bilateral_upsample_at",
+            wgsl,
+        ),
+        (
+            SourceLanguage::Glsl(naga::ShaderStage::Compute),
+            "#include \"lodkit/bilateral.glsl\"",
+            glsl,
+        ),
+    ] {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 6,
+            outputs: 4,
+            texture: None,
+            rgba: &textures,
+        };
+        let got = floats(&run_with(gpu, &probe, &inputs, language, &[]));
+        assert_close(
+            &got,
+            &want,
+            1e-5,
+            &format!("{language:?} bilateral_upsample_at"),
+        );
     }
 }

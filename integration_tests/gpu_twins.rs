@@ -55,6 +55,7 @@ fn normal_probe(expr: &str) -> Probe<'static> {
         inputs: 6,
         outputs: 1,
         texture: None,
+        rgba: &[],
     }
 }
 
@@ -96,6 +97,7 @@ fn foreshortened_normal_distance_glsl_matches_rust_twin() {
         inputs: 6,
         outputs: 1,
         texture: None,
+        rgba: &[],
     };
     let got = floats(&run_glsl(gpu, &probe, &normal_inputs(&pairs)));
     let want: Vec<f32> = pairs
@@ -138,6 +140,7 @@ fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
         inputs: 1,
         outputs: 6,
         texture: None,
+        rgba: &[],
     };
     let glsl = Probe {
         header: "#include \"lodkit/fullscreen.glsl\"",
@@ -147,6 +150,7 @@ fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
         inputs: 1,
         outputs: 6,
         texture: None,
+        rgba: &[],
     };
     let want = fullscreen_want();
     assert_eq!(

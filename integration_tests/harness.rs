@@ -105,14 +105,23 @@ pub struct Probe<'a> {
     /// An R32Float texture (size, row-major texels) bound as `probe_tex` (WGSL `texture_2d<f32>`;
     /// GLSL `texture2D`, with `probe_sampler` to make a `sampler2D`).
     pub texture: Option<(u32, &'a [f32])>,
+    /// Rgba32Float textures (width, height, texels) bound as `probe_rgba0`, `probe_rgba1`, ...
+    /// (GLSL: `texture2D`s to combine with `probe_sampler`).
+    pub rgba: &'a [(u32, u32, &'a [glam::Vec4])],
 }
 
 fn wgsl_probe(p: &Probe) -> String {
-    let texture = if p.texture.is_some() {
-        "@group(0) @binding(2) var probe_tex: texture_2d<f32>;"
+    let mut texture = if p.texture.is_some() {
+        "@group(0) @binding(2) var probe_tex: texture_2d<f32>;".to_owned()
     } else {
-        ""
+        String::new()
     };
+    for k in 0..p.rgba.len() {
+        texture.push_str(&format!(
+            "\n@group(0) @binding({}) var probe_rgba{k}: texture_2d<f32>;",
+            4 + k
+        ));
+    }
     format!(
         "{header}
 {texture}
@@ -138,11 +147,19 @@ fn main(@builtin(workgroup_id) id: vec3<u32>) {{
 
 /// The GLSL probe shader (compute, `#include`s resolved against the library).
 pub fn glsl_probe(p: &Probe) -> String {
-    let texture = if p.texture.is_some() {
-        "layout(set = 0, binding = 2) uniform texture2D probe_tex;\nlayout(set = 0, binding = 3) uniform sampler probe_sampler;"
-    } else {
-        ""
-    };
+    let mut texture = String::new();
+    if p.texture.is_some() {
+        texture.push_str("layout(set = 0, binding = 2) uniform texture2D probe_tex;\n");
+    }
+    for k in 0..p.rgba.len() {
+        texture.push_str(&format!(
+            "layout(set = 0, binding = {}) uniform texture2D probe_rgba{k};\n",
+            4 + k
+        ));
+    }
+    if p.texture.is_some() || !p.rgba.is_empty() {
+        texture.push_str("layout(set = 0, binding = 3) uniform sampler probe_sampler;\n");
+    }
     format!(
         "#version 450
 #extension GL_GOOGLE_include_directive : require
@@ -257,6 +274,41 @@ fn run(
         let texture = lodkit::gpu::resources::r32float_texture(gpu, size, texels, "probe texture");
         texture.create_view(&Default::default())
     });
+    let rgba_views: Vec<wgpu::TextureView> = probe
+        .rgba
+        .iter()
+        .map(|(w, h, texels)| {
+            use wgpu::util::DeviceExt;
+            let flat: Vec<f32> = texels.iter().flat_map(|v| v.to_array()).collect();
+            device
+                .create_texture_with_data(
+                    &gpu.queue,
+                    &wgpu::TextureDescriptor {
+                        label: Some("probe rgba"),
+                        size: wgpu::Extent3d {
+                            width: *w,
+                            height: *h,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: wgpu::TextureFormat::Rgba32Float,
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    },
+                    wgpu::util::TextureDataOrder::LayerMajor,
+                    bytemuck::cast_slice(&flat),
+                )
+                .create_view(&Default::default())
+        })
+        .collect();
+    for (k, v) in rgba_views.iter().enumerate() {
+        entries.push(wgpu::BindGroupEntry {
+            binding: 4 + k as u32,
+            resource: wgpu::BindingResource::TextureView(v),
+        });
+    }
     if let Some(view) = &view {
         entries.push(wgpu::BindGroupEntry {
             binding: 2,

@@ -96,6 +96,7 @@ fn screen_door_twins_are_complementary_on_the_gpu() {
         inputs: 2,
         outputs: 4,
         texture: None,
+        rgba: &[],
     };
     let glsl = Probe {
         header: "#include \"lodkit/screen_door.glsl\"",
@@ -110,6 +111,7 @@ fn screen_door_twins_are_complementary_on_the_gpu() {
         inputs: 2,
         outputs: 4,
         texture: None,
+        rgba: &[],
     };
     for (pattern, defs) in [
         (DitherPattern::Bayer4x4, &[][..]),
@@ -155,6 +157,7 @@ fn unpopping_twins_match_on_the_gpu() {
         inputs: 1,
         outputs: 4,
         texture: None,
+    rgba: &[],
     };
     let glsl = Probe {
         header: "#include \"lodkit/unpopping.glsl\"",
@@ -164,6 +167,7 @@ fn unpopping_twins_match_on_the_gpu() {
         inputs: 1,
         outputs: 4,
         texture: None,
+    rgba: &[],
     };
     let want: Vec<u32> = ts
         .iter()

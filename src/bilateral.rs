@@ -1,7 +1,7 @@
 //! Geometry-aware upsampling (Yang, Sander & Lawrence 2008, eq. 1): Rust twins of
 //! `lodkit::bilateral`.
 
-use glam::{Vec2, Vec3, Vec4};
+use glam::{UVec2, Vec2, Vec3, Vec4};
 
 use crate::normal_distance::foreshortened_normal;
 
@@ -53,7 +53,7 @@ pub fn bilateral_weight(
 ///
 /// ```
 /// # use lodkit::bilateral::bilateral_upsample;
-/// # use glam::{Vec2, Vec3, Vec4};
+/// # use glam::{UVec2, Vec2, Vec3, Vec4};
 /// let values = [Vec4::ZERO, Vec4::ONE, Vec4::ZERO, Vec4::ONE];
 /// let flat = [Vec3::Z; 4];
 /// // A flat region: bilinear.
@@ -91,4 +91,106 @@ pub fn bilateral_upsample(
     } else {
         sum / total
     }
+}
+
+/// Continuous position of a full-res pixel (at `frag_coord`, pixel centers at .5) in L's texel
+/// grid (texel centers at integers), for L drawn into `low_viewport` of a `full_size` target.
+///
+/// ```
+/// # use lodkit::bilateral::bilateral_low_position;
+/// # use glam::Vec2;
+/// // r = 2: full-res pixel 3 (center 3.5) sits between L texels 1 and 2.
+/// let p = bilateral_low_position(Vec2::splat(3.5), Vec2::splat(8.0), Vec2::splat(16.0));
+/// assert_eq!(p, Vec2::splat(1.25));
+/// ```
+pub fn bilateral_low_position(frag_coord: Vec2, low_viewport: Vec2, full_size: Vec2) -> Vec2 {
+    frag_coord * low_viewport / full_size - 0.5
+}
+
+/// Top-left texel of the 2x2 cell around `p`, kept inside the viewport.
+pub fn bilateral_cell_origin(p: Vec2, low_viewport: Vec2) -> Vec2 {
+    p.floor()
+        .clamp(Vec2::ZERO, (low_viewport - 2.0).max(Vec2::ZERO))
+}
+
+/// Fraction between the 2x2 L texels of the full-res pixel at `frag_coord`.
+pub fn bilateral_cell_fraction(frag_coord: Vec2, low_viewport: Vec2, full_size: Vec2) -> Vec2 {
+    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
+    (p - bilateral_cell_origin(p, low_viewport)).clamp(Vec2::ZERO, Vec2::ONE)
+}
+
+/// L texel `i` (0..3) of the 2x2 cell of the full-res pixel at `frag_coord`.
+pub fn bilateral_cell_texel(
+    frag_coord: Vec2,
+    low_viewport: Vec2,
+    full_size: Vec2,
+    i: u32,
+) -> UVec2 {
+    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
+    let origin = bilateral_cell_origin(p, low_viewport);
+    let last = (low_viewport - 1.0).max(Vec2::ZERO);
+    (origin + Vec2::new((i & 1) as f32, (i >> 1) as f32))
+        .min(last)
+        .as_uvec2()
+}
+
+/// Eq. 1 from four fetched L texels: `colors` and `geometry` (gbuffer layout).
+#[allow(clippy::too_many_arguments)]
+pub fn bilateral_upsample_texels(
+    f: Vec2,
+    colors: &[Vec4; 4],
+    geometry: &[Vec4; 4],
+    depth: f32,
+    normal: Vec3,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> Vec4 {
+    use crate::gbuffer::{gbuffer_depth, gbuffer_normal};
+    let depths = Vec4::from_array(geometry.map(gbuffer_depth));
+    bilateral_upsample(
+        f,
+        colors,
+        depths,
+        &geometry.map(gbuffer_normal),
+        depth,
+        normal,
+        sigma_z,
+        sigma_n,
+    )
+}
+
+/// An image on the CPU: `width` and row-major texels.
+#[derive(Clone, Copy, Debug)]
+pub struct Image<'a> {
+    /// Width in texels.
+    pub width: u32,
+    /// Texels, row-major.
+    pub texels: &'a [Vec4],
+}
+
+impl Image<'_> {
+    fn at(&self, t: UVec2) -> Vec4 {
+        self.texels[(t.y * self.width + t.x) as usize]
+    }
+}
+
+/// The whole lookup on the CPU, as `bilateral_upsample_at` does on the GPU: the 2x2 L texels of
+/// the full-res pixel at `frag_coord` from `low_color` and `low_geometry`, then eq. 1.
+#[allow(clippy::too_many_arguments)]
+pub fn bilateral_upsample_at(
+    low_color: Image,
+    low_geometry: Image,
+    low_viewport: Vec2,
+    full_size: Vec2,
+    frag_coord: Vec2,
+    depth: f32,
+    normal: Vec3,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> Vec4 {
+    let texel = |i| bilateral_cell_texel(frag_coord, low_viewport, full_size, i);
+    let colors = [0, 1, 2, 3].map(|i| low_color.at(texel(i)));
+    let geometry = [0, 1, 2, 3].map(|i| low_geometry.at(texel(i)));
+    let f = bilateral_cell_fraction(frag_coord, low_viewport, full_size);
+    bilateral_upsample_texels(f, &colors, &geometry, depth, normal, sigma_z, sigma_n)
 }

@@ -1,8 +1,8 @@
 // passes/upsample — geometry-aware upsampling of the low-resolution buffer L to full resolution
 // from a full-resolution depth/normal prepass (Yang, Sander & Lawrence 2008, sec. 2.2, eq. 1).
 //
-// For each full-res pixel: its position in L's viewport, the 2x2 nearest L samples (clamped to
-// the viewport), the full-res depth and normal from the prepass, and bilateral_upsample.
+// For each full-res pixel: the full-res depth and normal from the prepass, then
+// bilateral_upsample_at (its 2x2 nearest L samples, clamped to the viewport, and eq. 1).
 // sigma_z = sigma_n = +inf gives plain bilinear upsampling through the same pass.
 // Built only from lodkit::fullscreen, lodkit::gbuffer, lodkit::bilateral.
 //
@@ -14,7 +14,7 @@
 // Shader defs: none.
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 #import lodkit::gbuffer::{gbuffer_depth, gbuffer_normal}
-#import lodkit::bilateral::bilateral_upsample
+#import lodkit::bilateral::bilateral_upsample_at
 
 /// Per-frame parameters.
 struct UpsampleParams {
@@ -43,21 +43,16 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 /// Reconstructs the full-res pixel from L.
 @fragment
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
-    let pixel = vec2<u32>(v.position.xy);
-    let p = (v.position.xy) * params.low_viewport / params.full_size - 0.5;
-    let last = max(params.low_viewport - 1.0, vec2<f32>(0.0));
-    let base = clamp(floor(p), vec2<f32>(0.0), max(last - 1.0, vec2<f32>(0.0)));
-    let f = clamp(p - base, vec2<f32>(0.0), vec2<f32>(1.0));
-    var values: array<vec4<f32>, 4>;
-    var normals: array<vec3<f32>, 4>;
-    var depths: vec4<f32>;
-    for (var i = 0u; i < 4u; i++) {
-        let texel = vec2<u32>(min(base + vec2<f32>(f32(i & 1u), f32(i >> 1u)), last));
-        values[i] = textureLoad(low_color, texel, 0);
-        let g = textureLoad(low_geometry, texel, 0);
-        depths[i] = gbuffer_depth(g);
-        normals[i] = gbuffer_normal(g);
-    }
-    let full = textureLoad(full_geometry, pixel, 0);
-    return bilateral_upsample(f, values, depths, normals, gbuffer_depth(full), gbuffer_normal(full), params.sigma_z, params.sigma_n);
+    let full = textureLoad(full_geometry, vec2<u32>(v.position.xy), 0);
+    return bilateral_upsample_at(
+        low_color,
+        low_geometry,
+        params.low_viewport,
+        params.full_size,
+        v.position.xy,
+        gbuffer_depth(full),
+        gbuffer_normal(full),
+        params.sigma_z,
+        params.sigma_n,
+    );
 }

@@ -10,11 +10,20 @@
 //   lodkit_bilateral_tent(f) -> vec4
 //   lodkit_bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> float
 //   lodkit_bilateral_upsample(f, values, depths, normals, depth, normal, sigma_z, sigma_n) -> vec4
+//   lodkit_bilateral_low_position(frag_coord, low_viewport, full_size) -> vec2
+//   lodkit_bilateral_cell_origin(p, low_viewport) -> vec2
+//   lodkit_bilateral_cell_fraction(frag_coord, low_viewport, full_size) -> vec2
+//   lodkit_bilateral_cell_texel(frag_coord, low_viewport, full_size, i) -> uvec2
+//   lodkit_bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n) -> vec4
+//   lodkit_bilateral_upsample_at(low_color, low_geometry, low_viewport, full_size, frag_coord,
+//       depth, normal, sigma_z, sigma_n) -> vec4   a macro: takes a sampler2D (OpenGL) or
+//       sampler2D(texture, sampler) (Vulkan) for each texture
 // Shader defs: none.
 #ifndef LODKIT_BILATERAL_GLSL
 #define LODKIT_BILATERAL_GLSL
 
 #include "lodkit/normal_distance.glsl"
+#include "lodkit/gbuffer.glsl"
 
 /// Sum of weights below which eq. 1 falls back to the sample closest in depth.
 const float LODKIT_BILATERAL_MIN_WEIGHT = 1e-4;
@@ -58,5 +67,47 @@ vec4 lodkit_bilateral_upsample(vec2 f, vec4 values[4], vec4 depths, vec3 normals
     }
     return sum / total;
 }
+
+/// Continuous position of a full-res pixel in L's texel grid (texel centers at integers).
+vec2 lodkit_bilateral_low_position(vec2 frag_coord, vec2 low_viewport, vec2 full_size) {
+    return frag_coord * low_viewport / full_size - 0.5;
+}
+
+/// Top-left texel of the 2x2 cell around position `p`, kept inside the viewport.
+vec2 lodkit_bilateral_cell_origin(vec2 p, vec2 low_viewport) {
+    return clamp(floor(p), vec2(0.0), max(low_viewport - 2.0, vec2(0.0)));
+}
+
+/// Fraction `f` between the 2x2 L texels of the full-res pixel at `frag_coord`.
+vec2 lodkit_bilateral_cell_fraction(vec2 frag_coord, vec2 low_viewport, vec2 full_size) {
+    vec2 p = lodkit_bilateral_low_position(frag_coord, low_viewport, full_size);
+    return clamp(p - lodkit_bilateral_cell_origin(p, low_viewport), vec2(0.0), vec2(1.0));
+}
+
+/// L texel `i` (0..3) of the 2x2 cell of the full-res pixel at `frag_coord`.
+uvec2 lodkit_bilateral_cell_texel(vec2 frag_coord, vec2 low_viewport, vec2 full_size, uint i) {
+    vec2 origin = lodkit_bilateral_cell_origin(lodkit_bilateral_low_position(frag_coord, low_viewport, full_size), low_viewport);
+    vec2 last = max(low_viewport - 1.0, vec2(0.0));
+    return uvec2(min(origin + vec2(float(i & 1u), float(i >> 1u)), last));
+}
+
+/// Eq. 1 from four fetched L texels (lodkit gbuffer layout).
+vec4 lodkit_bilateral_upsample_texels(vec2 f, vec4 colors[4], vec4 geometry[4], float depth, vec3 normal, float sigma_z, float sigma_n) {
+    vec4 depths = vec4(lodkit_gbuffer_depth(geometry[0]), lodkit_gbuffer_depth(geometry[1]), lodkit_gbuffer_depth(geometry[2]), lodkit_gbuffer_depth(geometry[3]));
+    vec3 normals[4] = vec3[4](lodkit_gbuffer_normal(geometry[0]), lodkit_gbuffer_normal(geometry[1]), lodkit_gbuffer_normal(geometry[2]), lodkit_gbuffer_normal(geometry[3]));
+    return lodkit_bilateral_upsample(f, colors, depths, normals, depth, normal, sigma_z, sigma_n);
+}
+
+#define LODKIT_BILATERAL_FETCH_(tex, fc, vp, fs, i) texelFetch((tex), ivec2(lodkit_bilateral_cell_texel((fc), (vp), (fs), (i))), 0)
+
+/// The full lookup for the full-res pixel at `frag_coord`: fetches the 2x2 L texels and applies eq. 1.
+#define lodkit_bilateral_upsample_at(low_color, low_geometry, low_viewport, full_size, frag_coord, depth, normal, sigma_z, sigma_n) \
+    lodkit_bilateral_upsample_texels( \
+        lodkit_bilateral_cell_fraction((frag_coord), (low_viewport), (full_size)), \
+        vec4[4](LODKIT_BILATERAL_FETCH_(low_color, frag_coord, low_viewport, full_size, 0u), LODKIT_BILATERAL_FETCH_(low_color, frag_coord, low_viewport, full_size, 1u), \
+                LODKIT_BILATERAL_FETCH_(low_color, frag_coord, low_viewport, full_size, 2u), LODKIT_BILATERAL_FETCH_(low_color, frag_coord, low_viewport, full_size, 3u)), \
+        vec4[4](LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 0u), LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 1u), \
+                LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 2u), LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 3u)), \
+        (depth), (normal), (sigma_z), (sigma_n))
 
 #endif // LODKIT_BILATERAL_GLSL

@@ -18,9 +18,21 @@
 //   bilateral_tent(f) -> vec4<f32>   bilinear weights of the 2x2 samples at fraction f
 //   bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> f32   one term of eq. 1
 //   bilateral_upsample(f, values, depths, normals, depth, normal, sigma_z, sigma_n) -> vec4<f32>
+//   bilateral_low_position(frag_coord, low_viewport, full_size) -> vec2<f32>   position in L's grid
+//   bilateral_cell_origin(p, low_viewport) -> vec2<f32>   top-left texel of the 2x2 cell
+//   bilateral_cell_fraction(frag_coord, low_viewport, full_size) -> vec2<f32>   f of a full-res pixel
+//   bilateral_cell_texel(frag_coord, low_viewport, full_size, i) -> vec2<u32>   its 2x2 L texels
+//   bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n) -> vec4<f32>
+//       eq. 1 from four fetched L color and geometry texels (lodkit::gbuffer layout)
+//   bilateral_upsample_at(low_color, low_geometry, low_viewport, full_size, frag_coord, depth,
+//       normal, sigma_z, sigma_n) -> vec4<f32>   the whole lookup, for a geometry pass that
+//       re-renders the scene at full resolution (the paper's route) or a fullscreen pass
+// L is drawn into the top-left `low_viewport` texels of textures of any size; full_size is the
+// full-resolution target's size.
 // Shader defs: none.
 #define_import_path lodkit::bilateral
 #import lodkit::normal_distance::foreshortened_normal
+#import lodkit::gbuffer::{gbuffer_depth, gbuffer_normal}
 
 /// Sum of weights below which eq. 1 falls back to the sample closest in depth.
 const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
@@ -76,4 +88,66 @@ fn bilateral_upsample(
         return values[closest];
     }
     return sum / total;
+}
+
+/// Continuous position of a full-res pixel in L's texel grid (texel centers at integers).
+fn bilateral_low_position(frag_coord: vec2<f32>, low_viewport: vec2<f32>, full_size: vec2<f32>) -> vec2<f32> {
+    return frag_coord * low_viewport / full_size - 0.5;
+}
+
+/// Top-left texel of the 2x2 cell around position `p`, kept inside the viewport.
+fn bilateral_cell_origin(p: vec2<f32>, low_viewport: vec2<f32>) -> vec2<f32> {
+    return clamp(floor(p), vec2<f32>(0.0), max(low_viewport - 2.0, vec2<f32>(0.0)));
+}
+
+/// Fraction `f` between the 2x2 L texels of the full-res pixel at `frag_coord`.
+fn bilateral_cell_fraction(frag_coord: vec2<f32>, low_viewport: vec2<f32>, full_size: vec2<f32>) -> vec2<f32> {
+    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
+    return clamp(p - bilateral_cell_origin(p, low_viewport), vec2<f32>(0.0), vec2<f32>(1.0));
+}
+
+/// L texel `i` (0..3, order as above) of the 2x2 cell of the full-res pixel at `frag_coord`.
+fn bilateral_cell_texel(frag_coord: vec2<f32>, low_viewport: vec2<f32>, full_size: vec2<f32>, i: u32) -> vec2<u32> {
+    let origin = bilateral_cell_origin(bilateral_low_position(frag_coord, low_viewport, full_size), low_viewport);
+    let last = max(low_viewport - 1.0, vec2<f32>(0.0));
+    return vec2<u32>(min(origin + vec2<f32>(f32(i & 1u), f32(i >> 1u)), last));
+}
+
+/// Eq. 1 from four fetched L texels: `colors` and `geometry` (lodkit::gbuffer layout).
+fn bilateral_upsample_texels(
+    f: vec2<f32>,
+    colors: array<vec4<f32>, 4>,
+    geometry: array<vec4<f32>, 4>,
+    depth: f32,
+    normal: vec3<f32>,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> vec4<f32> {
+    let depths = vec4<f32>(gbuffer_depth(geometry[0]), gbuffer_depth(geometry[1]), gbuffer_depth(geometry[2]), gbuffer_depth(geometry[3]));
+    let normals = array<vec3<f32>, 4>(gbuffer_normal(geometry[0]), gbuffer_normal(geometry[1]), gbuffer_normal(geometry[2]), gbuffer_normal(geometry[3]));
+    return bilateral_upsample(f, colors, depths, normals, depth, normal, sigma_z, sigma_n);
+}
+
+/// The full lookup for the full-res pixel at `frag_coord` with `depth` and screen `normal`:
+/// fetches the 2x2 L texels from `low_color` and `low_geometry` and applies eq. 1.
+fn bilateral_upsample_at(
+    low_color: texture_2d<f32>,
+    low_geometry: texture_2d<f32>,
+    low_viewport: vec2<f32>,
+    full_size: vec2<f32>,
+    frag_coord: vec2<f32>,
+    depth: f32,
+    normal: vec3<f32>,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> vec4<f32> {
+    var colors: array<vec4<f32>, 4>;
+    var geometry: array<vec4<f32>, 4>;
+    for (var i = 0u; i < 4u; i++) {
+        let texel = bilateral_cell_texel(frag_coord, low_viewport, full_size, i);
+        colors[i] = textureLoad(low_color, texel, 0);
+        geometry[i] = textureLoad(low_geometry, texel, 0);
+    }
+    let f = bilateral_cell_fraction(frag_coord, low_viewport, full_size);
+    return bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n);
 }
