@@ -355,9 +355,9 @@ mod controller {
 }
 
 mod rendered {
-    use lodkit::framebuffer_lod::psnr_rgba8;
+    use lodkit::framebuffer_lod::{multiply_rgba8, psnr_rgba8};
     use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
-    use lodkit::gpu::gbuffer_scene::EdgeScene;
+    use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
     use lodkit::gpu::readback::read_texture_rgba8;
     use lodkit::gpu::resources::texture_2d;
 
@@ -375,6 +375,7 @@ mod rendered {
         scene.render(gpu, &full, 1.0);
         let reference = read_texture_rgba8(gpu, full.color());
         let low = LowResBuffer::new(gpu, W, H, format);
+        let albedo = LowResBuffer::new(gpu, W, H, format);
         let upsample = UpsamplePass::new(gpu, format).unwrap();
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let target = texture_2d(gpu, (W, H), format, usage, "upsampled");
@@ -393,12 +394,34 @@ mod rendered {
                 gpu.queue.submit([encoder.finish()]);
                 psnr[i] = psnr_rgba8(&read_texture_rgba8(gpu, &target), &reference);
             }
+            // Fine-grained: only the lighting goes through L; the albedo is drawn at full res.
+            scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            upsample.encode(
+                gpu,
+                &mut encoder,
+                &low,
+                r,
+                full.geometry(),
+                0.25,
+                0.4,
+                &view,
+            );
+            gpu.queue.submit([encoder.finish()]);
+            let lighting = read_texture_rgba8(gpu, &target);
+            scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
+            let albedo_pixels = read_texture_rgba8(gpu, albedo.color());
+            let fine = psnr_rgba8(&multiply_rgba8(&lighting, &albedo_pixels), &reference);
             rows.push(format!(
-                "r = {r}: bilinear {:.2} dB, bilateral {:.2} dB, gain {:+.2} dB",
+                "r = {r}: bilinear {:.2} dB, bilateral {:.2} dB, gain {:+.2} dB; fine-grained {fine:.2} dB",
                 psnr[0],
                 psnr[1],
                 psnr[1] - psnr[0]
             ));
+            assert!(
+                fine > psnr[1],
+                "fine-grained resizing must beat full resizing at r = {r}"
+            );
             if r == 2.0 {
                 gain_at_2 = psnr[1] - psnr[0];
             }

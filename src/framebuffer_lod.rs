@@ -441,3 +441,20 @@ pub fn psnr_rgba8(a: &[u8], b: &[u8]) -> f32 {
     }
     (10.0 * (255.0f64 * 255.0 / (sum / n as f64)).log10()) as f32
 }
+
+/// Multiplies two RGBA8 images channel by channel (RGB; alpha 255): how fine-grained resizing
+/// puts an upsampled term and a full-resolution term back together.
+///
+/// ```
+/// # use lodkit::framebuffer_lod::multiply_rgba8;
+/// assert_eq!(multiply_rgba8(&[255, 128, 0, 255], &[128, 255, 9, 7]), vec![128, 128, 0, 255]);
+/// ```
+pub fn multiply_rgba8(a: &[u8], b: &[u8]) -> Vec<u8> {
+    a.chunks(4)
+        .zip(b.chunks(4))
+        .flat_map(|(x, y)| {
+            let m = |c: usize| ((u32::from(x[c]) * u32::from(y[c]) + 127) / 255) as u8;
+            [m(0), m(1), m(2), 255]
+        })
+        .collect()
+}

@@ -11,7 +11,11 @@
 //   fs_main   GBufferOutput (location 0 color, location 1 rgba16float geometry)
 // Bindings: group 0: 0 `camera: GCamera` (uniform); group 1: 0 `draw: GDraw` (uniform, dynamic
 // offset).
-// Shader defs: none.
+// Shader defs (default: the full shading, albedo x lighting):
+//   GBUFFER_MESH_LIGHTING_ONLY (bool) — color holds only the lighting term (smooth: the part
+//   worth resizing).
+//   GBUFFER_MESH_ALBEDO_ONLY (bool) — color holds only the striped albedo (detailed, cheap at full
+//   resolution). Fine-grained resizing (sec. 2.3) upsamples the first and multiplies by the second.
 #import lodkit::gbuffer::{GBufferOutput, gbuffer_output}
 
 /// Per-view data.
@@ -52,7 +56,15 @@ fn fs_main(in: VertexOut) -> GBufferOutput {
     let n = normalize(in.world_normal);
     let lambert = max(dot(n, normalize(camera.light_dir.xyz)), 0.0);
     let stripes = 0.5 + 0.5 * sin(18.0 * (in.object_pos.x + in.object_pos.y));
-    let color = draw.color.rgb * (0.3 + 0.7 * lambert) * (0.6 + 0.4 * stripes);
+    let lighting = vec3<f32>(0.3 + 0.7 * lambert);
+    let albedo = draw.color.rgb * (0.6 + 0.4 * stripes);
+#ifdef GBUFFER_MESH_LIGHTING_ONLY
+    let color = lighting;
+#else ifdef GBUFFER_MESH_ALBEDO_ONLY
+    let color = albedo;
+#else
+    let color = albedo * lighting;
+#endif
     let view_normal = normalize((camera.view * vec4<f32>(n, 0.0)).xyz);
     return gbuffer_output(vec4<f32>(color, 1.0), -in.view_pos.z, view_normal);
 }

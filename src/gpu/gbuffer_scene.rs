@@ -44,6 +44,18 @@ pub struct GDrawItem<'a> {
     pub color: Vec4,
 }
 
+/// What the color target of `passes/gbuffer_mesh.wgsl` holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ShadingTerm {
+    /// Albedo x lighting.
+    #[default]
+    Full,
+    /// Only the lighting (smooth; the part fine-grained resizing upsamples).
+    Lighting,
+    /// Only the striped albedo (detailed; rendered at full resolution).
+    Albedo,
+}
+
 /// Draws [`GDrawItem`]s into a [`LowResBuffer`] at any resize factor.
 #[derive(Debug)]
 pub struct GBufferRenderer {
@@ -58,11 +70,25 @@ impl GBufferRenderer {
     /// Most draws per [`render`](Self::render).
     pub const MAX_DRAWS: usize = 256;
 
-    /// Builds the pipeline for color format `color_format`.
-    pub fn new(gpu: &GpuContext, color_format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
+    /// Builds the pipeline for color format `color_format`, writing `term` into the color target.
+    pub fn new(
+        gpu: &GpuContext,
+        color_format: wgpu::TextureFormat,
+        term: ShadingTerm,
+    ) -> Result<Self, ShaderError> {
+        let mut shader_defs = std::collections::HashMap::new();
+        let def = match term {
+            ShadingTerm::Full => None,
+            ShadingTerm::Lighting => Some("GBUFFER_MESH_LIGHTING_ONLY"),
+            ShadingTerm::Albedo => Some("GBUFFER_MESH_ALBEDO_ONLY"),
+        };
+        if let Some(def) = def {
+            shader_defs.insert(def.to_owned(), crate::shaders::ShaderDefValue::Bool(true));
+        }
         let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
             source: find_pass_source("gbuffer_mesh").unwrap_or_default(),
             file_path: "shader_lib/passes/gbuffer_mesh.wgsl",
+            shader_defs,
             ..Default::default()
         })?;
         let module = gpu.shader_module("gbuffer_mesh", &composed);
@@ -181,7 +207,7 @@ impl GBufferRenderer {
 /// a far wall, with striped shading; the framebuffer-LOD quality tests and examples render it.
 #[derive(Debug)]
 pub struct EdgeScene {
-    renderer: GBufferRenderer,
+    renderers: [GBufferRenderer; 3],
     sphere: GpuMesh,
     cube: GpuMesh,
     aspect: f32,
@@ -198,15 +224,24 @@ impl EdgeScene {
         aspect: f32,
     ) -> Result<Self, ShaderError> {
         Ok(Self {
-            renderer: GBufferRenderer::new(gpu, color_format)?,
+            renderers: [
+                GBufferRenderer::new(gpu, color_format, ShadingTerm::Full)?,
+                GBufferRenderer::new(gpu, color_format, ShadingTerm::Lighting)?,
+                GBufferRenderer::new(gpu, color_format, ShadingTerm::Albedo)?,
+            ],
             sphere: GpuMesh::new(gpu, &super::scene::Mesh::sphere(24, 48)),
             cube: GpuMesh::new(gpu, &super::scene::Mesh::cube()),
             aspect,
         })
     }
 
-    /// Renders the scene into `target` at resize factor `r`.
+    /// Renders the full shading into `target` at resize factor `r`.
     pub fn render(&self, gpu: &GpuContext, target: &LowResBuffer, r: f32) {
+        self.render_term(gpu, target, r, ShadingTerm::Full);
+    }
+
+    /// Renders one shading term into `target` at resize factor `r`.
+    pub fn render_term(&self, gpu: &GpuContext, target: &LowResBuffer, r: f32, term: ShadingTerm) {
         let view = glam::camera::rh::view::look_at_mat4(
             Vec3::new(0.5, 1.2, 6.0),
             Vec3::new(0.0, 0.0, -1.0),
@@ -254,7 +289,12 @@ impl EdgeScene {
             b: 0.15,
             a: 1.0,
         };
-        self.renderer.render(
+        let (renderer, clear) = match term {
+            ShadingTerm::Full => (&self.renderers[0], clear),
+            ShadingTerm::Lighting => (&self.renderers[1], wgpu::Color::WHITE),
+            ShadingTerm::Albedo => (&self.renderers[2], clear),
+        };
+        renderer.render(
             gpu,
             target,
             r,
