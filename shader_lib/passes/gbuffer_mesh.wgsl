@@ -11,7 +11,7 @@
 //   fs_main   GBufferOutput (location 0 color, location 1 rgba16float geometry)
 // Bindings: group 0: 0 `camera: GCamera` (uniform); group 1: 0 `draw: GDraw` (uniform, dynamic
 // offset).
-// Shader defs (default: the full shading, albedo x lighting):
+// Shader defs: (with neither set, color is the full shading, albedo x lighting)
 //   GBUFFER_MESH_LIGHTING_ONLY (bool) — color holds only the lighting term (smooth: the part
 //   worth resizing).
 //   GBUFFER_MESH_ALBEDO_ONLY (bool) — color holds only the striped albedo (detailed, cheap at full

@@ -8,7 +8,9 @@
 use glam::Mat4;
 
 use super::GpuContext;
-use super::resources::{begin_color_pass, fullscreen_pipeline, texture_2d};
+use super::resources::{
+    begin_color_pass, begin_targets_pass, fullscreen_pipeline, texture_2d, textures_and_uniform,
+};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
 use crate::shaders::{
     ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
@@ -109,32 +111,13 @@ impl LodBuffers {
             b: 0.0,
             a: 0.0,
         };
-        let attachment = |view, clear| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("lod buffer"),
-            color_attachments: &[attachment(&color, clear), attachment(&id_depth, id_clear)],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(far_depth),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        })
+        begin_targets_pass(
+            encoder,
+            &[(&color, clear), (&id_depth, id_clear)],
+            &depth,
+            far_depth,
+            "lod buffer",
+        )
     }
 }
 
@@ -204,30 +187,15 @@ impl CombinePass {
         };
         gpu.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let views = [
-            view(buffers.color(newer)),
-            view(buffers.id_depth(newer)),
-            view(buffers.color(newer + 1)),
-            view(buffers.id_depth(newer + 1)),
+        let textures = [
+            buffers.color(newer),
+            buffers.id_depth(newer),
+            buffers.color(newer + 1),
+            buffers.id_depth(newer + 1),
         ];
-        let mut entries: Vec<wgpu::BindGroupEntry> = views
-            .iter()
-            .enumerate()
-            .map(|(i, v)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: wgpu::BindingResource::TextureView(v),
-            })
-            .collect();
-        entries.push(wgpu::BindGroupEntry {
-            binding: 4,
-            resource: self.params.as_entire_binding(),
-        });
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("lodkit combine"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
+        let layout = self.pipeline.get_bind_group_layout(0);
+        let bind_group =
+            textures_and_uniform(gpu, &layout, &textures, &self.params, "lodkit combine");
         let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit combine");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);

@@ -3,7 +3,10 @@
 //! and the upsample pass as a ready object.
 
 use super::GpuContext;
-use super::resources::{begin_color_pass, fullscreen_pipeline, texture_2d, uniform_buffer};
+use super::resources::{
+    begin_color_pass, begin_targets_pass, fullscreen_pipeline, texture_2d, textures_and_uniform,
+    uniform_buffer,
+};
 use crate::gbuffer::GEOMETRY_FORMAT;
 use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
 
@@ -92,35 +95,13 @@ impl LowResBuffer {
             b: 0.0,
             a: 1.0,
         };
-        let attachment = |view, clear| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("low-res pass"),
-            color_attachments: &[
-                attachment(&color, clear),
-                attachment(&geometry, geometry_clear),
-            ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = begin_targets_pass(
+            encoder,
+            &[(&color, clear), (&geometry, geometry_clear)],
+            &depth,
+            1.0,
+            "low-res pass",
+        );
         let (w, h) = self.viewport(r);
         pass.set_viewport(0.0, 0.0, w as f32, h as f32, 0.0, 1.0);
         pass.set_scissor_rect(0, 0, w, h);
@@ -196,25 +177,10 @@ impl UpsamplePass {
         };
         gpu.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let views = [low.color(), low.geometry(), full_geometry]
-            .map(|t| t.create_view(&Default::default()));
-        let mut entries: Vec<wgpu::BindGroupEntry> = views
-            .iter()
-            .enumerate()
-            .map(|(i, v)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: wgpu::BindingResource::TextureView(v),
-            })
-            .collect();
-        entries.push(wgpu::BindGroupEntry {
-            binding: 3,
-            resource: self.params.as_entire_binding(),
-        });
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("lodkit upsample"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
+        let layout = self.pipeline.get_bind_group_layout(0);
+        let textures = [low.color(), low.geometry(), full_geometry];
+        let bind_group =
+            textures_and_uniform(gpu, &layout, &textures, &self.params, "lodkit upsample");
         let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit upsample");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);

@@ -6,8 +6,10 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::GpuContext;
 use super::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
-use super::resources::{DrawUniforms, uniform_buffer, uniform_entry};
-use super::scene::{GpuMesh, MESH_VERTEX_LAYOUT};
+use super::resources::{
+    DrawUniforms, depth_write_state, mesh_pipeline, uniform_buffer, uniform_entry,
+};
+use super::scene::GpuMesh;
 use crate::gbuffer::GEOMETRY_FORMAT;
 use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
 
@@ -105,36 +107,14 @@ impl GBufferRenderer {
             bind_group_layouts: &[Some(&camera_layout), Some(&draw_layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer_mesh"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(MESH_VERTEX_LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: Some(wgpu::Face::Back),
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: LOW_DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(color_format.into()), Some(GEOMETRY_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = mesh_pipeline(
+            gpu,
+            &module,
+            &layout,
+            &[Some(color_format.into()), Some(GEOMETRY_FORMAT.into())],
+            depth_write_state(LOW_DEPTH_FORMAT, wgpu::CompareFunction::Less),
+            "gbuffer_mesh",
+        );
         let camera = uniform_buffer(gpu, std::mem::size_of::<GCameraUniform>(), "gbuffer camera");
         let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,

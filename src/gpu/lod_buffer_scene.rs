@@ -5,8 +5,10 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::GpuContext;
 use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
-use super::resources::{DrawUniforms, r32float_texture, uniform_buffer, uniform_entry};
-use super::scene::{CameraUniform, GpuMesh, MESH_VERTEX_LAYOUT};
+use super::resources::{
+    DrawUniforms, depth_write_state, mesh_pipeline, r32float_texture, uniform_buffer, uniform_entry,
+};
+use super::scene::{CameraUniform, GpuMesh};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
 use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
 use crate::visibility::VisibilityTexture;
@@ -99,36 +101,14 @@ impl LodBufferRenderer {
             bind_group_layouts: &[Some(&view_layout), Some(&draw_layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("lod_buffer_mesh"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(MESH_VERTEX_LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: Some(wgpu::Face::Back),
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: LOD_DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = mesh_pipeline(
+            gpu,
+            &module,
+            &layout,
+            &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
+            depth_write_state(LOD_DEPTH_FORMAT, wgpu::CompareFunction::Less),
+            "lod_buffer_mesh",
+        );
         let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture");
         let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera");
         let draws = DrawUniforms::new(

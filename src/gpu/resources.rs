@@ -197,3 +197,125 @@ pub fn fullscreen_pipeline(
             cache: None,
         })
 }
+
+/// A render pipeline for [`Mesh`](super::scene::Mesh) geometry: `vs_main` / `fs_main` of
+/// `module`, back faces culled, the given layout, color targets and depth state.
+pub fn mesh_pipeline(
+    gpu: &GpuContext,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    targets: &[Option<wgpu::ColorTargetState>],
+    depth: wgpu::DepthStencilState,
+    label: &str,
+) -> wgpu::RenderPipeline {
+    gpu.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(super::scene::MESH_VERTEX_LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: Some(wgpu::Face::Back),
+                ..Default::default()
+            },
+            depth_stencil: Some(depth),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
+/// Depth-tested, depth-writing state with `compare` (`Less` for standard Z).
+pub fn depth_write_state(
+    format: wgpu::TextureFormat,
+    compare: wgpu::CompareFunction,
+) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+/// A bind group of `textures` at bindings 0.. followed by `uniform` at the next binding.
+pub fn textures_and_uniform(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    textures: &[&wgpu::Texture],
+    uniform: &wgpu::Buffer,
+    label: &str,
+) -> wgpu::BindGroup {
+    let views: Vec<wgpu::TextureView> = textures
+        .iter()
+        .map(|t| t.create_view(&Default::default()))
+        .collect();
+    let mut entries: Vec<wgpu::BindGroupEntry> = views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: wgpu::BindingResource::TextureView(v),
+        })
+        .collect();
+    entries.push(wgpu::BindGroupEntry {
+        binding: views.len() as u32,
+        resource: uniform.as_entire_binding(),
+    });
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// A render pass into several color targets (each cleared to its color) and a depth target
+/// cleared to `depth_clear`.
+pub fn begin_targets_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    colors: &[(&wgpu::TextureView, wgpu::Color)],
+    depth: &wgpu::TextureView,
+    depth_clear: f32,
+    label: &str,
+) -> wgpu::RenderPass<'e> {
+    let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = colors
+        .iter()
+        .map(|(view, clear)| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(*clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+        .collect();
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &attachments,
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(depth_clear),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

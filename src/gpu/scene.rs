@@ -9,7 +9,9 @@ use glam::{Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 use super::GpuContext;
-use super::resources::{DrawUniforms, texture_2d, uniform_buffer, uniform_entry};
+use super::resources::{
+    DrawUniforms, begin_targets_pass, mesh_pipeline, texture_2d, uniform_buffer, uniform_entry,
+};
 use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
 use crate::shaders::{
     ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
@@ -268,38 +270,13 @@ impl MeshRenderer {
             immediate_size: 0,
         });
         let pipeline = |state: LodRenderState| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("lod_mesh"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(MESH_VERTEX_LAYOUT)],
-                },
-                primitive: wgpu::PrimitiveState {
-                    cull_mode: Some(wgpu::Face::Back),
-                    ..Default::default()
-                },
-                depth_stencil: Some(lod_depth_stencil(
-                    &state,
-                    DEPTH_FORMAT,
-                    wgpu::CompareFunction::Less,
-                )),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: COLOR_FORMAT,
-                        blend: lod_blend(&state),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            let target = wgpu::ColorTargetState {
+                format: COLOR_FORMAT,
+                blend: lod_blend(&state),
+                write_mask: wgpu::ColorWrites::ALL,
+            };
+            let depth = lod_depth_stencil(&state, DEPTH_FORMAT, wgpu::CompareFunction::Less);
+            mesh_pipeline(gpu, &module, &layout, &[Some(target)], depth, "lod_mesh")
         };
         let opaque_state = LodRenderState {
             alpha: 1.0,
@@ -370,29 +347,13 @@ impl MeshRenderer {
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("lod_mesh"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(clear),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = begin_targets_pass(
+                &mut encoder,
+                &[(&color_view, clear)],
+                &depth_view,
+                1.0,
+                "lod_mesh",
+            );
             pass.set_bind_group(0, &self.camera_group, &[]);
             for (i, item) in items.iter().enumerate() {
                 pass.set_pipeline(if item.state.blend {
