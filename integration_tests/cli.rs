@@ -295,6 +295,35 @@ fn export_writes_every_target() {
             "x",
         ],
     );
-    assert_eq!(code, 1);
+    assert_eq!(code, 2, "a missing entry point is a usage error");
     assert!(stderr.contains("no entry point `nope`"), "{stderr}");
+}
+
+#[test]
+fn a_def_set_to_false_is_off_for_ifdef() {
+    let src = b"#ifdef BROKEN\nthis does not parse\n#endif\n@fragment fn main() -> @location(0) vec4<f32> { return vec4<f32>(1.0); }\n";
+    let dir = fixture(&[("gate.wgsl", src)]);
+    assert_eq!(
+        run(&dir, &["check", "-D", "BROKEN=false", "gate.wgsl"]).0,
+        0
+    );
+    assert_eq!(run(&dir, &["check", "-D", "BROKEN", "gate.wgsl"]).0, 1);
+}
+
+#[test]
+fn a_user_module_may_not_reuse_a_lodkit_import_path() {
+    let module = b"#define_import_path lodkit::combine\nfn x() -> f32 { return 1.0; }\n";
+    let dir = fixture(&[("mods/combine.wgsl", module), ("good.wgsl", GOOD)]);
+    let (code, _, stderr) = run(&dir, &["check", "-I", "mods", "good.wgsl"]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("duplicate-module") && stderr.contains("lodkit::combine"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn an_include_line_may_end_with_a_comment() {
+    let src = b"#version 450\n#include \"lodkit/normal_distance.glsl\" // the guard\nlayout(location = 0) out vec4 color;\nvoid main() { color = vec4(lodkit_foreshortened_normal_distance(vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0))); }\n";
+    assert_eq!(check_one("commented.frag", src, &[]).0, 0);
 }

@@ -414,6 +414,15 @@ fn schedule_ends_and_ids_are_quarantined() {
     );
     s.remove(b).unwrap();
     assert!(s.draw(b).is_err(), "stale key");
+    // Default is the same as new(): ids start at 1.
+    let mut d = TransitionScheduler::default();
+    let k = d.insert(0);
+    d.begin_transition(k, 1, Drive::Time { seconds: 1.0 })
+        .unwrap();
+    assert_eq!(d.draw(k).unwrap().id, 1);
+    // set_progress leaves time-driven transitions alone.
+    d.set_progress(k, 0.9).unwrap();
+    assert_eq!(d.draw(k).unwrap().progress, 0.0);
 }
 
 proptest! {

@@ -336,3 +336,65 @@ proptest! {
         prop_assert!((0.0..=1.0).contains(&sel.transition));
     }
 }
+
+#[test]
+fn infinite_distance_without_max_distance_is_the_last_level_and_visible() {
+    let g = LodGroup::from_distances(&[0.0, 10.0]).unwrap();
+    for d in [f32::INFINITY, f32::NAN] {
+        let mut st = LodState::NEW;
+        let s = g.select(d, &LodSettings::default(), 0.0, &mut st);
+        assert!(s.visible && s.current == 1, "{d}: {s:?}");
+    }
+    let capped = g.with_max_distance(100.0).unwrap();
+    let mut st = LodState::NEW;
+    assert!(
+        !capped
+            .select(f32::INFINITY, &LodSettings::default(), 0.0, &mut st)
+            .visible
+    );
+}
+
+#[test]
+fn a_timed_transition_does_not_reverse_inside_the_band() {
+    let g = LodGroup::from_distances(&[0.0, 100.0]).unwrap();
+    let s = settings(10.0, TransitionMode::Time { seconds: 1.0 });
+    let mut st = LodState::NEW;
+    g.select(90.0, &s, 0.1, &mut st);
+    assert_eq!(
+        g.select(106.0, &s, 0.1, &mut st).next,
+        Some(1),
+        "switch decided at 105"
+    );
+    // Back inside the band (above 95): the switch goes on.
+    for _ in 0..3 {
+        let sel = g.select(101.0, &s, 0.1, &mut st);
+        assert_eq!(
+            (sel.current, sel.next),
+            (0, Some(1)),
+            "reversed inside the band: {sel:?}"
+        );
+    }
+    // Below 95 it turns back.
+    assert_eq!(g.select(94.0, &s, 0.1, &mut st).next, Some(0));
+}
+
+#[test]
+fn a_negative_camera_bias_is_an_error() {
+    let camera = LodCamera::new(Vec3::ZERO, Mat4::IDENTITY).with_bias(-1.0);
+    let groups = [LodGroup::from_distances(&[0.0]).unwrap()];
+    let batch = InstanceBatch {
+        positions: &[Vec3::ZERO],
+        max_scales: &[1.0],
+        groups: &[0],
+    };
+    let r = select_batch(
+        &camera,
+        &LodSettings::default(),
+        &groups,
+        &batch,
+        0.0,
+        &mut [LodState::NEW],
+        &mut [LodSelection::default()],
+    );
+    assert_eq!(r, Err(LodError::BadBias(-1.0)));
+}

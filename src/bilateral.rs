@@ -37,7 +37,14 @@ pub fn bilateral_tent(f: Vec2) -> Vec4 {
     )
 }
 
-/// One weight of eq. 1: tent x g(depth difference, sigma_z) x g(normal distance, sigma_n).
+/// One weight of eq. 1: tent x g(depth difference, sigma_z) x g(normal distance, sigma_n),
+/// evaluated as one exponential of the summed exponents (as the shaders do).
+///
+/// ```
+/// # use lodkit::bilateral::{bilateral_range, bilateral_weight};
+/// let w = bilateral_weight(0.5, 0.2, 0.1, 0.3, 0.4);
+/// assert!((w - 0.5 * bilateral_range(0.2, 0.3) * bilateral_range(0.1, 0.4)).abs() < 1e-7);
+/// ```
 pub fn bilateral_weight(
     tent: f32,
     depth_diff: f32,
@@ -45,7 +52,9 @@ pub fn bilateral_weight(
     sigma_z: f32,
     sigma_n: f32,
 ) -> f32 {
-    tent * bilateral_range(depth_diff, sigma_z) * bilateral_range(normal_dist, sigma_n)
+    let z = depth_diff / sigma_z;
+    let n = normal_dist / sigma_n;
+    tent * (-0.5 * (z * z + n * n)).exp()
 }
 
 /// Eq. 1 over 2x2 low-res samples for a full-res pixel at fraction `f` with `depth` and

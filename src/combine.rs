@@ -108,7 +108,8 @@ pub struct CombinedPixel {
 }
 
 /// The combine pass on the CPU: every pixel of `newer` reprojected into `older` through
-/// `new_to_old` and combined with [`combine_samples`], as `passes/combine.wgsl` does.
+/// `new_to_old` and combined with [`combine_samples`], as `passes/combine.wgsl` does. Both images
+/// must have the same, non-zero size and complete texel arrays; otherwise the result is empty.
 pub fn combine_images(
     newer: &LodImage,
     older: &LodImage,
@@ -116,6 +117,12 @@ pub fn combine_images(
     convention: DepthConvention,
 ) -> Vec<CombinedPixel> {
     use glam::Vec2;
+    let n = (newer.width * newer.height) as usize;
+    let complete = |i: &LodImage| i.colors.len() == n && i.ids.len() == n && i.depths.len() == n;
+    let same_size = (newer.width, newer.height) == (older.width, older.height);
+    if n == 0 || !same_size || !complete(newer) || !complete(older) {
+        return Vec::new();
+    }
     let size = Vec2::new(newer.width as f32, newer.height as f32);
     (0..newer.colors.len())
         .map(|p| {

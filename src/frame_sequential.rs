@@ -90,7 +90,7 @@ struct Slot {
 }
 
 /// Tracks instances, their transitions, frame parity and instance ids.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct TransitionScheduler {
     frame: u64,
     slots: Vec<Slot>,
@@ -99,12 +99,21 @@ pub struct TransitionScheduler {
     free_ids: std::collections::VecDeque<(u64, u32)>,
 }
 
+impl Default for TransitionScheduler {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl TransitionScheduler {
     /// An empty scheduler at frame 0.
     pub fn new() -> Self {
         Self {
+            frame: 0,
+            slots: Vec::new(),
+            free_slots: Vec::new(),
             next_id: 1,
-            ..Default::default()
+            free_ids: Default::default(),
         }
     }
 
@@ -218,10 +227,15 @@ impl TransitionScheduler {
     }
 
     /// Sets the progress of a [`Drive::Progress`] transition (clamped to [0, 1]; NaN counts as 0).
-    /// At 1 the transition ends at the next [`advance`](Self::advance).
+    /// At 1 the transition ends at the next [`advance`](Self::advance). No effect on time-driven
+    /// transitions or on instances not in a transition.
     pub fn set_progress(&mut self, key: InstanceKey, progress: f32) -> Result<(), ScheduleError> {
         let slot = self.slot_mut(key)?;
-        if let Some(t) = slot.transition.as_mut() {
+        if let Some(t) = slot
+            .transition
+            .as_mut()
+            .filter(|t| t.drive == Drive::Progress)
+        {
             t.progress = if progress.is_nan() {
                 0.0
             } else {

@@ -45,11 +45,20 @@ impl ResizeLimits {
     /// assert_eq!(l.apply(2.0, f32::NAN), 2.0);
     /// ```
     pub fn apply(&self, r: f32, wanted: f32) -> f32 {
-        let r_max = self.r_max.max(1.0);
+        let r_max = if self.r_max.is_nan() {
+            1.0
+        } else {
+            self.r_max.max(1.0)
+        };
+        let r = if r.is_nan() { 1.0 } else { r.clamp(1.0, r_max) };
         if wanted.is_nan() {
             return r.clamp(1.0, r_max);
         }
-        let step = self.max_step.max(0.0);
+        let step = if self.max_step.is_nan() {
+            0.0
+        } else {
+            self.max_step.max(0.0)
+        };
         wanted.clamp(r - step, r + step).clamp(1.0, r_max)
     }
 }
@@ -418,7 +427,8 @@ pub fn step_response(
     }
 }
 
-/// Peak signal-to-noise ratio in dB between two RGBA8 images (RGB channels only); +inf when equal.
+/// Peak signal-to-noise ratio in dB between two RGBA8 images (RGB channels only); +inf when equal,
+/// NaN when the two differ in length or are empty.
 ///
 /// ```
 /// # use lodkit::framebuffer_lod::psnr_rgba8;
@@ -428,30 +438,34 @@ pub fn step_response(
 /// assert!((psnr_rgba8(&a, &b) - 10.0 * (255.0f32 * 255.0 * 3.0).log10()).abs() < 1e-3);
 /// ```
 pub fn psnr_rgba8(a: &[u8], b: &[u8]) -> f32 {
+    if a.len() != b.len() || a.len() < 4 {
+        return f32::NAN;
+    }
     let (mut sum, mut n) = (0.0f64, 0usize);
-    for (pa, pb) in a.chunks(4).zip(b.chunks(4)) {
+    for (pa, pb) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
         for c in 0..3 {
             let d = f64::from(pa[c]) - f64::from(pb[c]);
             sum += d * d;
             n += 1;
         }
     }
-    if sum == 0.0 || n == 0 {
+    if sum == 0.0 {
         return f32::INFINITY;
     }
     (10.0 * (255.0f64 * 255.0 / (sum / n as f64)).log10()) as f32
 }
 
 /// Multiplies two RGBA8 images channel by channel (RGB; alpha 255): how fine-grained resizing
-/// puts an upsampled term and a full-resolution term back together.
+/// puts an upsampled term and a full-resolution term back together. Stops at the shorter image
+/// and ignores a trailing partial pixel.
 ///
 /// ```
 /// # use lodkit::framebuffer_lod::multiply_rgba8;
 /// assert_eq!(multiply_rgba8(&[255, 128, 0, 255], &[128, 255, 9, 7]), vec![128, 128, 0, 255]);
 /// ```
 pub fn multiply_rgba8(a: &[u8], b: &[u8]) -> Vec<u8> {
-    a.chunks(4)
-        .zip(b.chunks(4))
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
         .flat_map(|(x, y)| {
             let m = |c: usize| ((u32::from(x[c]) * u32::from(y[c]) + 127) / 255) as u8;
             [m(0), m(1), m(2), 255]

@@ -4,7 +4,8 @@
 //!
 //! Rust twins of `lodkit::unpopping`, plus the render states an engine maps onto its pipelines.
 
-/// Alpha of a LOD at transition progress `t` (clamped to [0, 1]): the outgoing LOD is opaque
+/// Alpha of a LOD at transition progress `t` (clamped to [0, 1]; NaN counts as 0 here, while on
+/// the GPU it is implementation-defined): the outgoing LOD is opaque
 /// (1) for t < 0.5 and then fades as 2(1 - t); the incoming fades in as 2t and is opaque from
 /// t = 0.5 on. At t = 0.5 both are 1.
 ///
@@ -16,7 +17,8 @@
 /// assert_eq!(unpopping_alpha(0.5, true), unpopping_alpha(0.5, false));
 /// ```
 pub fn unpopping_alpha(t: f32, incoming: bool) -> f32 {
-    let s = t.clamp(0.0, 1.0);
+    // NaN counts as 0 (the shaders' clamp of NaN is implementation-defined: pass a number).
+    let s = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
     if incoming {
         (2.0 * s).min(1.0)
     } else {
@@ -33,7 +35,7 @@ pub fn unpopping_alpha(t: f32, incoming: bool) -> f32 {
 /// assert!(unpopping_is_opaque(0.5, true) && !unpopping_is_opaque(0.5, false));
 /// ```
 pub fn unpopping_is_opaque(t: f32, incoming: bool) -> bool {
-    // NaN counts as 0 (the outgoing LOD stays opaque), like `clamp` in unpopping_alpha.
+    // NaN counts as 0 (the outgoing LOD stays opaque), as in unpopping_alpha.
     let late = t >= 0.5;
     if incoming { late } else { !late }
 }

@@ -49,7 +49,8 @@ pub enum VisibilityPattern {
     Radial,
 }
 
-/// Generates a visibility texture, deterministic for `seed` (the radial pattern ignores it).
+/// Generates a visibility texture, deterministic for `seed` (the radial pattern ignores it). The
+/// size is clamped to 4096.
 ///
 /// ```
 /// # use lodkit::visibility::{visibility_texture, VisibilityPattern};
@@ -57,6 +58,7 @@ pub enum VisibilityPattern {
 /// assert!(t.texels.iter().all(|&v| v > 0.0 && v < 1.0));
 /// ```
 pub fn visibility_texture(pattern: VisibilityPattern, size: u32, seed: u64) -> VisibilityTexture {
+    let size = size.min(4096);
     let n = (size * size) as usize;
     let texels = match pattern {
         VisibilityPattern::WhiteNoise => crate::noise::white_noise(n, seed)
@@ -97,14 +99,16 @@ pub fn visibility_texel(size: UVec2, object_pos: Vec3) -> UVec2 {
     let c = visibility_coord(object_pos);
     let uv = c - c.floor();
     let texel = UVec2::new((uv.x * size.x as f32) as u32, (uv.y * size.y as f32) as u32);
-    texel.min(size - UVec2::ONE)
+    texel.min(size.saturating_sub(UVec2::ONE))
 }
 
 impl VisibilityTexture {
-    /// The texel value an object-space position looks up, as the shader does.
+    /// The texel value an object-space position looks up, as the shader does. An empty or short
+    /// texture reads as 1 (every fragment kept).
     pub fn lookup(&self, object_pos: Vec3) -> f32 {
         let t = visibility_texel(UVec2::splat(self.size), object_pos);
-        self.texels[(t.y * self.size + t.x) as usize]
+        let index = u64::from(t.y) * u64::from(self.size) + u64::from(t.x);
+        self.texels.get(index as usize).copied().unwrap_or(1.0)
     }
 }
 

@@ -394,7 +394,9 @@ fn export(
         Ok(x) => x,
         Err(e) => {
             print_error(&e);
-            return ExitCode::from(1);
+            // Choosing an entry point that is missing or ambiguous is a usage error.
+            let usage = matches!(e, ShaderError::EntryPoint(_));
+            return ExitCode::from(if usage { 2 } else { 1 });
         }
     };
     let result = if output == Path::new("-") {

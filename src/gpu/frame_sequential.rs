@@ -172,7 +172,9 @@ impl CombinePass {
     }
 
     /// Records the combination of buffer `newer` with the other one (reprojected through
-    /// `new_to_old`) into `target`, which must be as large as the buffers.
+    /// `new_to_old`) into `target`, which must be as large as the buffers. The parameters go
+    /// through one uniform buffer written with `queue.write_buffer`: record one `encode` per
+    /// submit (two in one encoder would both see the last matrix).
     pub fn encode(
         &self,
         gpu: &GpuContext,

@@ -153,7 +153,8 @@ impl UpsamplePass {
     }
 
     /// Records the upsampling of `low` (rendered at resize factor `r`) into `target`, with the
-    /// full-resolution geometry `full_geometry` (gbuffer layout) and range sigmas.
+    /// full-resolution geometry `full_geometry` (gbuffer layout) and range sigmas. The parameters
+    /// go through one uniform buffer: record one `encode` per submit.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,

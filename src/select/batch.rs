@@ -51,6 +51,9 @@ pub fn select_batch(
     out: &mut [LodSelection],
 ) -> Result<(), LodError> {
     settings.validate()?;
+    if camera.bias.is_nan() || camera.bias < 0.0 {
+        return Err(LodError::BadBias(camera.bias));
+    }
     let n = batch.positions.len();
     for (what, got) in [
         ("max_scales", batch.max_scales.len()),

@@ -322,7 +322,7 @@ impl LodGroup {
     ) -> LodSelection {
         let d = sanitize(distance);
         let h = settings.hysteresis.max(0.0);
-        if d >= self.max_distance {
+        if self.max_distance.is_finite() && d >= self.max_distance {
             *state = LodState::NEW;
             return LodSelection {
                 current: (self.levels.len() - 1) as u8,
@@ -371,7 +371,9 @@ impl LodGroup {
             };
         }
         // Stateful hysteresis: move the settled level until d lies in its window.
-        let mut desired = state.level as usize;
+        // From the level being approached (the settled one outside a timed transition), so that
+        // turning back mid-transition also needs the far edge of the band.
+        let mut desired = state.target as usize;
         while desired + 1 < n && d >= band(desired + 1).1 {
             desired += 1;
         }
@@ -427,8 +429,12 @@ impl LodGroup {
             state.progress = 0.0;
         }
         if state.target != state.level {
-            let step = if dt > 0.0 { dt / seconds } else { 0.0 };
-            state.progress += step;
+            let step = if dt > 0.0 && seconds > 0.0 {
+                dt / seconds
+            } else {
+                0.0
+            };
+            state.progress = (state.progress + step).clamp(0.0, 1.0);
             if state.progress >= 1.0 {
                 state.level = state.target;
                 state.progress = 0.0;

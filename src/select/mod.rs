@@ -75,8 +75,9 @@ pub fn is_orthographic(projection: &Mat4) -> bool {
 /// object at the same size. Either is divided by `max_scale`, the largest world-scale component
 /// of the object (so a model scaled x2 selects as if it were half as far).
 ///
-/// Documented edge cases: a negative `max_scale` counts by its magnitude; a zero one gives +inf;
-/// NaN in, NaN out (selection treats NaN as +inf).
+/// Documented edge cases: a negative `max_scale` counts by its magnitude; a zero one gives +inf
+/// (NaN at distance 0); NaN in, NaN out. Selection treats NaN as +inf: the last level, hidden only
+/// beyond a group's max distance.
 ///
 /// ```
 /// # use lodkit::select::view_normalized_distance;

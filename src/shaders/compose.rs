@@ -98,7 +98,7 @@ pub fn add_to_composer(composer: &mut Composer) -> Result<(), ShaderError> {
         .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
         .map(|m| (format!("shader_lib/{}", m.path), Arc::from(m.source)))
         .collect();
-    add_modules(composer, sources)
+    add_modules(composer, sources, true)
 }
 
 impl ShaderLibrary {
@@ -168,7 +168,7 @@ impl ShaderLibrary {
             .iter()
             .filter_map(|(_, s)| registry::define_import_path(s))
             .collect();
-        add_modules(&mut self.composer, sources)?;
+        add_modules(&mut self.composer, sources, false)?;
         self.user_modules.extend(names.iter().cloned());
         Ok(names)
     }
@@ -185,13 +185,21 @@ impl ShaderLibrary {
         add_modules(
             &mut self.composer,
             vec![(file_path.to_owned(), Arc::from(source))],
+            false,
         )?;
         self.user_modules.push(name.clone());
         Ok(name)
     }
 
-    /// Composes a top-level shader against the library and validates it.
+    /// Composes a top-level shader against the library and validates it. A shader def set to
+    /// `Bool(false)` is left out, so `#ifdef` sees it as off in WGSL and GLSL alike.
     pub fn compose(&mut self, desc: &ComposeDescriptor) -> Result<Composed, ShaderError> {
+        let mut defs = desc.shader_defs.clone();
+        defs.retain(|_, v| *v != ShaderDefValue::Bool(false));
+        let desc = &ComposeDescriptor {
+            shader_defs: defs,
+            ..desc.clone()
+        };
         let module = match desc.language {
             SourceLanguage::Wgsl => self.compose_wgsl(desc)?,
             SourceLanguage::Glsl(stage) => return self.compose_glsl(desc, stage),
@@ -232,10 +240,13 @@ impl ShaderLibrary {
             };
             if !found {
                 let name = module_prefix(&import);
-                let mut span = import_site(desc.source, name);
-                if span.is_empty() {
-                    span = line_at..line_at + "#import".len();
-                }
+                // Search from this statement on: an earlier import may contain the name too.
+                let site = import_site(&desc.source[line_at..], name);
+                let span = if site.is_empty() {
+                    line_at..line_at + "#import".len()
+                } else {
+                    site.start + line_at..site.end + line_at
+                };
                 let d = Diagnostic::new(
                     DiagnosticKind::UnknownImport,
                     desc.file_path,
@@ -367,9 +378,12 @@ fn collect_wgsl(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), ShaderError> {
 }
 
 /// Adds `(file, source)` modules to `composer` so that every module comes after those it imports.
+/// A module whose import path the composer already has is skipped when `skip_existing` (adding
+/// the lodkit modules twice is harmless) and an error otherwise.
 fn add_modules(
     composer: &mut Composer,
     sources: Vec<(String, Arc<str>)>,
+    skip_existing: bool,
 ) -> Result<(), ShaderError> {
     let mut by_name: HashMap<String, usize> = HashMap::new();
     let mut deps: Vec<Vec<String>> = Vec::new();
@@ -448,7 +462,7 @@ fn add_modules(
                     source.clone(),
                     import_site(source, module_prefix_of(import, &by_name)),
                 )
-                .with_label("this import closes the cycle")
+                .with_label("the cycle starts with this import")
                 .with_hint("move what both modules need into a third module that imports neither");
                 return Err(ShaderError::Source(Box::new(d)));
             }
@@ -458,7 +472,22 @@ fn add_modules(
         let (file, source) = &sources[i];
         let name = registry::define_import_path(source).unwrap_or_default();
         if composer.contains_module(&name) {
-            continue;
+            if skip_existing {
+                continue;
+            }
+            let owner = if registry::find_module(&name).is_some() {
+                "a lodkit module"
+            } else {
+                "a module added earlier"
+            };
+            let d = Diagnostic::new(
+                DiagnosticKind::DuplicateModule,
+                file.clone(),
+                format!("`{name}` is already {owner}"),
+            )
+            .with_span(source.clone(), import_site_define(source))
+            .with_hint("give the module another #define_import_path");
+            return Err(ShaderError::Source(Box::new(d)));
         }
         let added = composer.add_composable_module(ComposableModuleDescriptor {
             source,

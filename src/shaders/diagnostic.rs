@@ -203,8 +203,10 @@ pub(crate) fn undecorate(text: &str) -> String {
         let end = tail
             .find(|c: char| !(c.is_ascii_uppercase() || ('2'..='7').contains(&c)))
             .unwrap_or(tail.len());
+        // The run ends with the closing `X` (which is also a base32 letter): drop exactly one.
+        let encoded = tail[..end].strip_suffix('X').unwrap_or(&tail[..end]);
         let decoded = data_encoding::BASE32_NOPAD
-            .decode(tail[..end].trim_end_matches('X').as_bytes())
+            .decode(encoded.as_bytes())
             .ok()
             .and_then(|b| String::from_utf8(b).ok());
         match decoded {
@@ -213,7 +215,7 @@ pub(crate) fn undecorate(text: &str) -> String {
                 out.push_str(&module);
                 out.push_str("::");
                 out.push_str(&head[item_start..]);
-                rest = tail[end..].strip_prefix('X').unwrap_or(&tail[end..]);
+                rest = &tail[end..];
             }
             None => {
                 out.push_str(&rest[..i + PRE.len()]);
@@ -392,6 +394,9 @@ mod tests {
             "call to `lodkit::combine::combine_samples` failed"
         );
         assert_eq!(undecorate("nothing to do"), "nothing to do");
+        // A module path whose base32 form itself ends in `X`.
+        let name = naga_oil::compose::Composer::decorated_name(Some("mesh::draw"), "f");
+        assert_eq!(undecorate(&format!("`{name}`")), "`mesh::draw::f`");
     }
 
     #[test]

@@ -130,7 +130,8 @@ pub fn export(
             Ok(Exported::Text(out))
         }
         ExportTarget::Glsl | ExportTarget::GlslEs => {
-            let entry = pick_entry_point(module, options.entry_point.as_deref()).map_err(fail)?;
+            let entry = pick_entry_point(module, options.entry_point.as_deref())
+                .map_err(ShaderError::EntryPoint)?;
             let version = match (target, entry.stage) {
                 (ExportTarget::Glsl, _) => back::glsl::Version::Desktop(450),
                 (_, naga::ShaderStage::Compute) => back::glsl::Version::new_gles(310),

@@ -111,6 +111,7 @@ impl Expander<'_> {
             };
             self.push(file, &source, copied..start);
             copied = line_start;
+            let rest = rest.split("//").next().unwrap_or_default();
             let name = rest
                 .trim()
                 .trim_matches(|c| c == '"' || c == '<' || c == '>');

@@ -54,6 +54,9 @@ pub enum ShaderError {
     /// A problem in shader source, with its location.
     #[error("{0}")]
     Source(Box<Diagnostic>),
+    /// The entry point to export is missing, or must be chosen among several.
+    #[error("{0}")]
+    EntryPoint(String),
     /// A back end could not write the module.
     #[error("cannot export to {target}: {message}")]
     Export {
