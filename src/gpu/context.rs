@@ -2,7 +2,10 @@
 
 use std::borrow::Cow;
 
-use crate::shaders::Composed;
+use crate::shaders::{
+    ComposeDescriptor, Composed, Diagnostic, DiagnosticKind, ShaderDefValue, ShaderError,
+    ShaderLibrary,
+};
 
 /// Why no GPU context could be made.
 #[derive(Debug, thiserror::Error)]
@@ -117,6 +120,35 @@ impl GpuContext {
                 label: Some(label),
                 source: wgpu::ShaderSource::Naga(Cow::Owned(composed.module.clone())),
             })
+    }
+
+    /// The shader module of lodkit's pass `shader_lib/passes/<name>.wgsl`, composed with the
+    /// boolean shader defs `defs` switched on.
+    pub fn pass_module(
+        &self,
+        name: &str,
+        defs: &[&str],
+    ) -> Result<wgpu::ShaderModule, ShaderError> {
+        let file_path = format!("shader_lib/passes/{name}.wgsl");
+        let Some(source) = crate::shaders::find_pass_source(name) else {
+            let d = Diagnostic::new(
+                DiagnosticKind::UnknownImport,
+                file_path,
+                format!("lodkit has no pass `{name}`"),
+            );
+            return Err(ShaderError::Source(Box::new(d)));
+        };
+        let shader_defs = defs
+            .iter()
+            .map(|d| (d.to_string(), ShaderDefValue::Bool(true)))
+            .collect();
+        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+            source,
+            file_path: &file_path,
+            shader_defs,
+            ..Default::default()
+        })?;
+        Ok(self.shader_module(name, &composed))
     }
 
     /// Blocks until the GPU has finished all submitted work.

@@ -10,11 +10,10 @@ use glam::Mat4;
 use super::GpuContext;
 use super::resources::{
     begin_color_pass, begin_targets_pass, fullscreen_pipeline, texture_2d, textures_and_uniform,
+    uniform_buffer,
 };
 use crate::lod_buffer::ID_DEPTH_FORMAT;
-use crate::shaders::{
-    ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
-};
+use crate::shaders::ShaderError;
 
 /// Depth format of the pair's shared depth buffer.
 pub const LOD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -150,24 +149,14 @@ impl CombinePass {
         target_format: wgpu::TextureFormat,
         reverse_z: bool,
     ) -> Result<Self, ShaderError> {
-        let mut defs = std::collections::HashMap::new();
-        if reverse_z {
-            defs.insert("LODKIT_REVERSE_Z".to_owned(), ShaderDefValue::Bool(true));
-        }
-        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-            source: find_pass_source("combine").unwrap_or_default(),
-            file_path: "shader_lib/passes/combine.wgsl",
-            shader_defs: defs,
-            ..Default::default()
-        })?;
-        let module = gpu.shader_module("combine", &composed);
+        let defs: &[&str] = if reverse_z {
+            &["LODKIT_REVERSE_Z"]
+        } else {
+            &[]
+        };
+        let module = gpu.pass_module("combine", defs)?;
         let pipeline = fullscreen_pipeline(gpu, &module, target_format, "lodkit combine");
-        let params = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("combine params"),
-            size: std::mem::size_of::<CombineParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let params = uniform_buffer(gpu, std::mem::size_of::<CombineParams>(), "combine params");
         Ok(Self { pipeline, params })
     }
 

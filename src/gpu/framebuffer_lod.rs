@@ -8,7 +8,7 @@ use super::resources::{
     uniform_buffer,
 };
 use crate::gbuffer::GEOMETRY_FORMAT;
-use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
+use crate::shaders::ShaderError;
 
 /// Depth format of the low-resolution pass.
 pub const LOW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -136,12 +136,7 @@ pub struct UpsamplePass {
 impl UpsamplePass {
     /// Builds the pipeline for targets of `target_format`.
     pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
-        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-            source: find_pass_source("upsample").unwrap_or_default(),
-            file_path: "shader_lib/passes/upsample.wgsl",
-            ..Default::default()
-        })?;
-        let module = gpu.shader_module("upsample", &composed);
+        let module = gpu.pass_module("upsample", &[])?;
         Ok(Self {
             pipeline: fullscreen_pipeline(gpu, &module, target_format, "lodkit upsample"),
             params: uniform_buffer(

@@ -7,11 +7,11 @@ use glam::{Mat4, Vec3, Vec4};
 use super::GpuContext;
 use super::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
 use super::resources::{
-    DrawUniforms, depth_write_state, mesh_pipeline, uniform_buffer, uniform_entry,
+    DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, uniform_buffer,
 };
 use super::scene::GpuMesh;
 use crate::gbuffer::GEOMETRY_FORMAT;
-use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
+use crate::shaders::ShaderError;
 
 /// Rust mirror of `GCamera` in `passes/gbuffer_mesh.wgsl`.
 #[repr(C)]
@@ -78,35 +78,14 @@ impl GBufferRenderer {
         color_format: wgpu::TextureFormat,
         term: ShadingTerm,
     ) -> Result<Self, ShaderError> {
-        let mut shader_defs = std::collections::HashMap::new();
-        let def = match term {
-            ShadingTerm::Full => None,
-            ShadingTerm::Lighting => Some("GBUFFER_MESH_LIGHTING_ONLY"),
-            ShadingTerm::Albedo => Some("GBUFFER_MESH_ALBEDO_ONLY"),
+        let defs: &[&str] = match term {
+            ShadingTerm::Full => &[],
+            ShadingTerm::Lighting => &["GBUFFER_MESH_LIGHTING_ONLY"],
+            ShadingTerm::Albedo => &["GBUFFER_MESH_ALBEDO_ONLY"],
         };
-        if let Some(def) = def {
-            shader_defs.insert(def.to_owned(), crate::shaders::ShaderDefValue::Bool(true));
-        }
-        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-            source: find_pass_source("gbuffer_mesh").unwrap_or_default(),
-            file_path: "shader_lib/passes/gbuffer_mesh.wgsl",
-            shader_defs,
-            ..Default::default()
-        })?;
-        let module = gpu.shader_module("gbuffer_mesh", &composed);
+        let module = gpu.pass_module("gbuffer_mesh", defs)?;
         let device = &gpu.device;
-        let layout_of = |dynamic| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: None,
-                entries: &[uniform_entry(0, dynamic)],
-            })
-        };
-        let (camera_layout, draw_layout) = (layout_of(false), layout_of(true));
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gbuffer_mesh"),
-            bind_group_layouts: &[Some(&camera_layout), Some(&draw_layout)],
-            immediate_size: 0,
-        });
+        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "gbuffer_mesh");
         let pipeline = mesh_pipeline(
             gpu,
             &module,

@@ -10,7 +10,7 @@ use super::resources::{
 };
 use super::scene::{CameraUniform, GpuMesh};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
-use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary, find_pass_source};
+use crate::shaders::ShaderError;
 use crate::visibility::VisibilityTexture;
 
 /// Rust mirror of `LodDraw` in `passes/lod_buffer_mesh.wgsl`.
@@ -69,12 +69,7 @@ impl LodBufferRenderer {
         vis: &VisibilityTexture,
         vis_scale: f32,
     ) -> Result<Self, ShaderError> {
-        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-            source: find_pass_source("lod_buffer_mesh").unwrap_or_default(),
-            file_path: "shader_lib/passes/lod_buffer_mesh.wgsl",
-            ..Default::default()
-        })?;
-        let module = gpu.shader_module("lod_buffer_mesh", &composed);
+        let module = gpu.pass_module("lod_buffer_mesh", &[])?;
         let device = &gpu.device;
         let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lod_buffer_mesh view"),

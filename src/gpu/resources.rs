@@ -319,3 +319,31 @@ pub fn begin_targets_pass<'e>(
         multiview_mask: None,
     })
 }
+
+/// The bind group layouts of a mesh pass with a camera uniform in group 0 and per-draw uniforms
+/// (dynamic offset) in group 1, and the pipeline layout over both.
+pub fn camera_draw_layouts(
+    gpu: &GpuContext,
+    label: &str,
+) -> (
+    wgpu::BindGroupLayout,
+    wgpu::BindGroupLayout,
+    wgpu::PipelineLayout,
+) {
+    let layout_of = |dynamic| {
+        gpu.device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries: &[uniform_entry(0, dynamic)],
+            })
+    };
+    let (camera, draw) = (layout_of(false), layout_of(true));
+    let layout = gpu
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&camera), Some(&draw)],
+            immediate_size: 0,
+        });
+    (camera, draw, layout)
+}

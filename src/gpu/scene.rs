@@ -10,12 +10,11 @@ use wgpu::util::DeviceExt;
 
 use super::GpuContext;
 use super::resources::{
-    DrawUniforms, begin_targets_pass, mesh_pipeline, texture_2d, uniform_buffer, uniform_entry,
+    DrawUniforms, begin_targets_pass, camera_draw_layouts, mesh_pipeline, texture_2d,
+    uniform_buffer,
 };
 use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
-use crate::shaders::{
-    ComposeDescriptor, ShaderDefValue, ShaderError, ShaderLibrary, find_pass_source,
-};
+use crate::shaders::ShaderError;
 use crate::unpopping::LodRenderState;
 
 /// Depth format of [`RenderTarget`].
@@ -241,34 +240,14 @@ impl MeshRenderer {
 
     /// Builds the pipelines (`blue_noise` selects the screen-door pattern).
     pub fn new(gpu: &GpuContext, blue_noise: bool) -> Result<Self, ShaderError> {
-        let mut library = ShaderLibrary::new()?;
-        let mut defs = std::collections::HashMap::new();
-        if blue_noise {
-            defs.insert(
-                "LODKIT_SCREEN_DOOR_BLUE_NOISE".to_owned(),
-                ShaderDefValue::Bool(true),
-            );
-        }
-        let composed = library.compose(&ComposeDescriptor {
-            source: find_pass_source("lod_mesh").unwrap_or_default(),
-            file_path: "shader_lib/passes/lod_mesh.wgsl",
-            shader_defs: defs,
-            ..Default::default()
-        })?;
-        let module = gpu.shader_module("lod_mesh", &composed);
-        let device = &gpu.device;
-        let uniform_layout = |dynamic| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: None,
-                entries: &[uniform_entry(0, dynamic)],
-            })
+        let defs: &[&str] = if blue_noise {
+            &["LODKIT_SCREEN_DOOR_BLUE_NOISE"]
+        } else {
+            &[]
         };
-        let (camera_layout, draw_layout) = (uniform_layout(false), uniform_layout(true));
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("lod_mesh"),
-            bind_group_layouts: &[Some(&camera_layout), Some(&draw_layout)],
-            immediate_size: 0,
-        });
+        let module = gpu.pass_module("lod_mesh", defs)?;
+        let device = &gpu.device;
+        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "lod_mesh");
         let pipeline = |state: LodRenderState| {
             let target = wgpu::ColorTargetState {
                 format: COLOR_FORMAT,
