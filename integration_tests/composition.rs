@@ -213,38 +213,43 @@ fn glsl_harness(twin: &ModuleInfo) -> String {
     )
 }
 
+/// Compiles a fragment shader with glslangValidator (lodkit's GLSL folder on the include path)
+/// and returns the SPIR-V words, failing the test with glslang's output when it rejects it.
+fn glslang_spirv(name: &str, source: &str, what: &str) -> Vec<u32> {
+    let include_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib/glsl");
+    let frag = scratch(name);
+    std::fs::write(&frag, source).unwrap();
+    let spv = frag.with_extension("spv");
+    let out = std::process::Command::new("glslangValidator")
+        .args(["-V", "-S", "frag"])
+        .arg(format!("-I{}", include_root.display()))
+        .arg(&frag)
+        .arg("-o")
+        .arg(&spv)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{what}: glslangValidator rejects it:\n{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let bytes = std::fs::read(&spv).unwrap();
+    bytes
+        .chunks(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
 #[test]
 fn every_glsl_twin_compiles_with_glslang_and_passes_spirv_val() {
     let Some(_) = tool("glslangValidator") else {
         return;
     };
-    let include_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib/glsl");
     for twin in shaders::modules()
         .iter()
         .filter(|m| m.language == Language::Glsl)
     {
-        let frag = scratch("harness.frag");
-        std::fs::write(&frag, glsl_harness(twin)).unwrap();
-        let spv = frag.with_extension("spv");
-        let out = std::process::Command::new("glslangValidator")
-            .args(["-V", "-S", "frag"])
-            .arg(format!("-I{}", include_root.display()))
-            .arg(&frag)
-            .arg("-o")
-            .arg(&spv)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}: glslangValidator rejects it:\n{}",
-            twin.path,
-            String::from_utf8_lossy(&out.stdout)
-        );
-        let bytes = std::fs::read(&spv).unwrap();
-        let words: Vec<u32> = bytes
-            .chunks(4)
-            .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
-            .collect();
+        let words = glslang_spirv("harness.frag", &glsl_harness(twin), twin.path);
         spirv_val(&words, twin.path);
     }
 }
@@ -446,7 +451,6 @@ fn glsl_texture_macros_compile_with_glslang() {
     let Some(_) = tool("glslangValidator") else {
         return;
     };
-    let include_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib/glsl");
     let source = "#version 450
 #extension GL_GOOGLE_include_directive : require
 #include \"lodkit/visibility.glsl\"
@@ -462,26 +466,6 @@ void main() {
                                          gl_FragCoord.xy, 4.0, vec3(0.0, 0.0, 1.0), 0.25, 0.4);
 }
 ";
-    let frag = scratch("macros.frag");
-    std::fs::write(&frag, source).unwrap();
-    let spv = frag.with_extension("spv");
-    let out = std::process::Command::new("glslangValidator")
-        .args(["-V", "-S", "frag"])
-        .arg(format!("-I{}", include_root.display()))
-        .arg(&frag)
-        .arg("-o")
-        .arg(&spv)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "glslangValidator rejects the macros:\n{}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    let bytes = std::fs::read(&spv).unwrap();
-    let words: Vec<u32> = bytes
-        .chunks(4)
-        .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
-        .collect();
+    let words = glslang_spirv("macros.frag", source, "macros.frag");
     spirv_val(&words, "macros.frag");
 }
