@@ -3,14 +3,14 @@
 //! and transition per object, and plots it.
 //!
 //! `cargo run --example selection -- [--config FILE] [--out DIR] [--mode hard|distance|time]`
-//! Writes DIR/selection.svg (default DIR: lodkit-out/selection).
+//! Writes DIR/selection.png (default DIR: lodkit-out/selection).
 
 use std::path::PathBuf;
 
 use glam::Vec3;
+use lodkit::demo::plots::{Chart, Series, line_chart};
 use lodkit::select::config::LodConfig;
 use lodkit::select::*;
-use plotters::prelude::*;
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
@@ -117,43 +117,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             println!("{row}");
         }
     }
-    std::fs::create_dir_all(&out)?;
-    let file = out.join("selection.svg");
-    let root = SVGBackend::new(&file, (960, 420)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!(
-                "LOD per object along the camera path ({:?})",
-                settings.transition
-            ),
-            ("sans-serif", 18),
-        )
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(48)
-        .build_cartesian_2d(0f32..path.len() as f32, -0.1f32..2.2f32)?;
-    chart
-        .configure_mesh()
-        .x_desc("frame")
-        .y_desc("level (fractional while blending)")
-        .draw()?;
-    for (i, points) in series.iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
-        let visible: Vec<(f32, f32)> = points.iter().copied().filter(|p| p.1.is_finite()).collect();
-        chart
-            .draw_series(LineSeries::new(visible, color.stroke_width(2)))?
-            .label(objects[i].0)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
-            });
-    }
-    chart
-        .configure_series_labels()
-        .border_style(BLACK)
-        .background_style(WHITE)
-        .draw()?;
-    root.present()?;
+    let file = out.join("selection.png");
+    let chart = Chart {
+        title: format!(
+            "LOD per object along the camera path ({:?}), fractional while blending",
+            settings.transition
+        ),
+        x_label: "frame".to_owned(),
+        y_label: "level".to_owned(),
+        series: series
+            .iter()
+            .enumerate()
+            .map(|(i, points)| Series {
+                name: objects[i].0.to_owned(),
+                points: points.iter().copied().filter(|p| p.1.is_finite()).collect(),
+            })
+            .collect(),
+        markers: false,
+        reference: None,
+    };
+    line_chart(&file, &chart)?;
     println!("wrote {}", file.display());
     Ok(())
 }

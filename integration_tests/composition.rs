@@ -12,13 +12,13 @@ use lodkit::shaders::{
 
 use crate::harness::{render, tool};
 
-fn wgsl_modules() -> impl Iterator<Item = &'static ModuleInfo> {
+pub(crate) fn wgsl_modules() -> impl Iterator<Item = &'static ModuleInfo> {
     shaders::modules()
         .iter()
         .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
 }
 
-fn scratch(name: &str) -> PathBuf {
+pub(crate) fn scratch(name: &str) -> PathBuf {
     static N: AtomicUsize = AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
         "lodkit-test-{}-{}",
@@ -58,7 +58,7 @@ fn params(signature: &str) -> Vec<(String, String)> {
 
 /// A fragment shader that imports `module` and calls every function it exports with zero
 /// values (textures and samplers become bindings), so that every function reaches the back ends.
-fn wgsl_harness(module: &ModuleInfo) -> String {
+pub(crate) fn wgsl_harness(module: &ModuleInfo) -> String {
     let path = module.import_path.as_deref().unwrap();
     let mut globals = String::new();
     let mut calls = String::new();

@@ -358,3 +358,42 @@ pub fn assert_close(got: &[f32], want: &[f32], tol: f32, what: &str) {
         );
     }
 }
+
+/// `node .ci/browser/<script>` ready to take arguments, when node, the scripts' npm packages and
+/// Chromium are installed. Otherwise fails under `LODKIT_REQUIRE_BROWSER=1` (CI sets it) and
+/// skips loudly.
+pub fn browser_script(script: &str) -> Option<std::process::Command> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".ci/browser");
+    let chromium = std::env::var_os("LODKIT_CHROMIUM")
+        .map_or_else(|| "/usr/bin/chromium".into(), std::path::PathBuf::from);
+    let node = std::process::Command::new("node")
+        .arg("--version")
+        .output()
+        .is_ok();
+    let missing = if !node {
+        Some("node is not installed")
+    } else if !dir.join("node_modules/playwright-core").exists() {
+        Some("the browser scripts' packages are not installed (npm ci --prefix .ci/browser)")
+    } else if !chromium.exists() {
+        Some("Chromium is not installed (apt-get install chromium)")
+    } else {
+        None
+    };
+    match missing {
+        None => {
+            let mut cmd = std::process::Command::new("node");
+            cmd.arg(dir.join(script));
+            Some(cmd)
+        }
+        Some(why) if std::env::var("LODKIT_REQUIRE_BROWSER").is_ok_and(|v| v == "1") => {
+            panic!("LODKIT_REQUIRE_BROWSER=1 but {why}")
+        }
+        Some(why) => {
+            say(&format!(
+                "SKIPPED {}: {why}. Set LODKIT_REQUIRE_BROWSER=1 to make this a failure",
+                test_name()
+            ));
+            None
+        }
+    }
+}

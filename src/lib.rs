@@ -18,6 +18,7 @@
 //!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders.
 //! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
 //! - [`gpu`] (feature `wgpu`): headless devices and ready-made passes.
+//! - `demo` (feature `demo`): the quality/cost harness behind `lodkit demo`.
 //!
 //! Every pure shader function has a Rust twin with the same name; tests hold the GPU result
 //! against it.
@@ -42,3 +43,6 @@ pub mod visibility;
 
 #[cfg(feature = "wgpu")]
 pub mod gpu;
+
+#[cfg(feature = "demo")]
+pub mod demo;

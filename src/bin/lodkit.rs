@@ -1,6 +1,8 @@
-//! `lodkit`: list the shader library, check shaders that import it, export them to other languages.
+//! `lodkit`: list the shader library, check shaders that import it, export them to other
+//! languages, and run the demo that measures every technique.
 //!
-//! Exit codes: 0 success, 1 a shader is invalid, 2 usage or I/O error.
+//! Exit codes: 0 success, 1 a shader is invalid or the demo failed (no GPU adapter included),
+//! 2 usage, scene-file or I/O error.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -79,6 +81,28 @@ enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Render the built-in scenes with every technique, measure them, write images, plots and
+    /// an HTML report.
+    Demo {
+        /// Output folder.
+        #[arg(long, default_value = "lodkit-demo")]
+        out: PathBuf,
+        /// Image size.
+        #[arg(long, value_name = "WxH", default_value = "320x180", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Frames a transition lasts.
+        #[arg(long, default_value_t = 24)]
+        frames: usize,
+        /// A RON scene to measure instead of the built-in ones.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// Interleaved pairs per pass-time ratio.
+        #[arg(long, default_value_t = 40)]
+        pairs: usize,
+        /// Also write benchmarks.md and quality.md into this folder (e.g. `docs`).
+        #[arg(long, value_name = "DIR")]
+        docs: Option<PathBuf>,
+    },
     /// Compose a shader and write it through one of naga's back ends.
     Export {
         #[command(flatten)]
@@ -123,9 +147,61 @@ fn parse_def(s: &str) -> Result<(String, ShaderDefValue), String> {
     Ok((name.to_owned(), value))
 }
 
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}` is not WxH (e.g. 320x180)"))?;
+    let side = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{v}` in `{s}` is not a whole number of pixels"))
+    };
+    Ok((side(w)?, side(h)?))
+}
+
+fn demo(options: lodkit::demo::DemoOptions) -> ExitCode {
+    use lodkit::demo::DemoError;
+    println!("lodkit demo: writing into {}", options.out.display());
+    match lodkit::demo::run(&options) {
+        Ok(report) => {
+            println!("{}", lodkit::demo::report::summary(&report));
+            println!("open {}", options.out.join("index.html").display());
+            if !report.plot_text {
+                println!("note: no TrueType font found, plots have no text (set LODKIT_FONT)");
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            match e {
+                DemoError::Options(_) | DemoError::Scene(_) | DemoError::Io { .. } => {
+                    ExitCode::from(2)
+                }
+                _ => ExitCode::from(1),
+            }
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Demo {
+            out,
+            size,
+            frames,
+            scene,
+            pairs,
+            docs,
+        } => demo(lodkit::demo::DemoOptions {
+            out,
+            size,
+            frames,
+            scene,
+            timing_pairs: pairs,
+            docs,
+            progress: true,
+        }),
         Command::Modules { format } => modules(format),
         Command::Check {
             compose,

@@ -94,12 +94,15 @@ impl LodBuffers {
 
     /// Begins a render pass into buffer `index` that clears color to `clear`, id to 0 and the
     /// stored depth and the depth buffer to `far_depth` (1 for standard Z, 0 for reversed).
+    /// `occlusion_query_set` is passed on to the pass (see
+    /// [`FragmentCounter`](super::counters::FragmentCounter)).
     pub fn begin_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
         index: usize,
         clear: wgpu::Color,
         far_depth: f32,
+        occlusion_query_set: Option<&wgpu::QuerySet>,
     ) -> wgpu::RenderPass<'e> {
         let color = self.colors[index % 2].create_view(&Default::default());
         let id_depth = self.id_depths[index % 2].create_view(&Default::default());
@@ -115,6 +118,7 @@ impl LodBuffers {
             &[(&color, clear), (&id_depth, id_clear)],
             &depth,
             far_depth,
+            occlusion_query_set,
             "lod buffer",
         )
     }

@@ -100,6 +100,7 @@ impl LowResBuffer {
             &[(&color, clear), (&geometry, geometry_clear)],
             &depth,
             1.0,
+            None,
             "low-res pass",
         );
         let (w, h) = self.viewport(r);

@@ -4,6 +4,7 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::GpuContext;
+use super::counters::FragmentCounter;
 use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
 use super::resources::{
     DrawUniforms, depth_write_state, mesh_pipeline, r32float_texture, uniform_buffer, uniform_entry,
@@ -149,6 +150,23 @@ impl LodBufferRenderer {
         items: &[LodDrawItem],
         clear: wgpu::Color,
     ) -> u64 {
+        self.render_counted(gpu, buffers, index, view_proj, items, clear, None)
+            .0
+    }
+
+    /// [`Self::render`], also counting the pass's fragments with `counter`: returns the
+    /// triangles drawn and the count (0 without a counter).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_counted(
+        &self,
+        gpu: &GpuContext,
+        buffers: &LodBuffers,
+        index: usize,
+        view_proj: Mat4,
+        items: &[LodDrawItem],
+        clear: wgpu::Color,
+        counter: Option<&FragmentCounter>,
+    ) -> (u64, u64) {
         let items = &items[..items.len().min(self.draws.capacity())];
         let camera = CameraUniform {
             view_proj: view_proj.to_cols_array_2d(),
@@ -171,7 +189,11 @@ impl LodBufferRenderer {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let mut triangles = 0u64;
         {
-            let mut pass = buffers.begin_pass(&mut encoder, index, clear, 1.0);
+            let occlusion = counter.and_then(FragmentCounter::occlusion_query_set);
+            let mut pass = buffers.begin_pass(&mut encoder, index, clear, 1.0, occlusion);
+            if let Some(c) = counter {
+                c.begin(&mut pass);
+            }
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.camera_group, &[]);
             for (i, item) in items.iter().enumerate() {
@@ -179,8 +201,16 @@ impl LodBufferRenderer {
                 item.mesh.draw(&mut pass);
                 triangles += u64::from(item.mesh.triangles());
             }
+            if let Some(c) = counter {
+                c.end(&mut pass);
+            }
         }
-        gpu.queue.submit([encoder.finish()]);
-        triangles
+        match counter {
+            Some(c) => (triangles, c.read(gpu, encoder)),
+            None => {
+                gpu.queue.submit([encoder.finish()]);
+                (triangles, 0)
+            }
+        }
     }
 }

@@ -2,6 +2,7 @@
 //! each technique.
 
 mod context;
+pub mod counters;
 pub mod frame_sequential;
 pub mod framebuffer_lod;
 pub mod gbuffer_scene;

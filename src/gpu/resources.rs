@@ -281,12 +281,13 @@ pub fn textures_and_uniform(
 }
 
 /// A render pass into several color targets (each cleared to its color) and a depth target
-/// cleared to `depth_clear`.
+/// cleared to `depth_clear`, with an optional occlusion query set.
 pub fn begin_targets_pass<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     colors: &[(&wgpu::TextureView, wgpu::Color)],
     depth: &wgpu::TextureView,
     depth_clear: f32,
+    occlusion_query_set: Option<&wgpu::QuerySet>,
     label: &str,
 ) -> wgpu::RenderPass<'e> {
     let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = colors
@@ -315,7 +316,7 @@ pub fn begin_targets_pass<'e>(
             stencil_ops: None,
         }),
         timestamp_writes: None,
-        occlusion_query_set: None,
+        occlusion_query_set,
         multiview_mask: None,
     })
 }

@@ -9,6 +9,7 @@ use glam::{Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 use super::GpuContext;
+use super::counters::FragmentCounter;
 use super::resources::{
     DrawUniforms, begin_targets_pass, camera_draw_layouts, mesh_pipeline, texture_2d,
     uniform_buffer,
@@ -91,6 +92,19 @@ impl Mesh {
     /// Number of triangles.
     pub fn triangles(&self) -> usize {
         self.indices.len() / 3
+    }
+
+    /// Appends `other` transformed by `transform` (normals by its inverse transpose), to build
+    /// one mesh out of several parts.
+    pub fn append(&mut self, other: &Mesh, transform: Mat4) {
+        let base = self.vertices.len() as u32;
+        let normal_matrix = glam::Mat3::from_mat4(transform).inverse().transpose();
+        self.vertices.extend(other.vertices.iter().map(|v| {
+            let p = transform.transform_point3(Vec3::new(v[0], v[1], v[2]));
+            let n = (normal_matrix * Vec3::new(v[3], v[4], v[5])).normalize_or_zero();
+            [p.x, p.y, p.z, n.x, n.y, n.z]
+        }));
+        self.indices.extend(other.indices.iter().map(|i| i + base));
     }
 }
 
@@ -305,6 +319,22 @@ impl MeshRenderer {
         light_dir: Vec3,
         items: &[DrawItem],
     ) {
+        self.render_counted(gpu, target, clear, view_proj, light_dir, items, None);
+    }
+
+    /// [`Self::render`], also counting the pass's fragments with `counter`; returns the count
+    /// (0 without a counter).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_counted(
+        &self,
+        gpu: &GpuContext,
+        target: &RenderTarget,
+        clear: wgpu::Color,
+        view_proj: Mat4,
+        light_dir: Vec3,
+        items: &[DrawItem],
+        counter: Option<&FragmentCounter>,
+    ) -> u64 {
         let items = &items[..items.len().min(self.draws.capacity())];
         let camera = CameraUniform {
             view_proj: view_proj.to_cols_array_2d(),
@@ -331,8 +361,12 @@ impl MeshRenderer {
                 &[(&color_view, clear)],
                 &depth_view,
                 1.0,
+                counter.and_then(FragmentCounter::occlusion_query_set),
                 "lod_mesh",
             );
+            if let Some(c) = counter {
+                c.begin(&mut pass);
+            }
             pass.set_bind_group(0, &self.camera_group, &[]);
             for (i, item) in items.iter().enumerate() {
                 pass.set_pipeline(if item.state.blend {
@@ -344,7 +378,16 @@ impl MeshRenderer {
                 pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                 item.mesh.draw(&mut pass);
             }
+            if let Some(c) = counter {
+                c.end(&mut pass);
+            }
         }
-        gpu.queue.submit([encoder.finish()]);
+        match counter {
+            Some(c) => c.read(gpu, encoder),
+            None => {
+                gpu.queue.submit([encoder.finish()]);
+                0
+            }
+        }
     }
 }

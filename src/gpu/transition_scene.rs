@@ -35,6 +35,14 @@ impl SingleFrameTechnique {
         Self::Unpopping,
     ];
 
+    /// The screen-door pattern the technique draws with, if it dithers.
+    pub fn dither_pattern(self) -> Option<DitherPattern> {
+        match self {
+            Self::Dither(p) => Some(p),
+            _ => None,
+        }
+    }
+
     /// Short name for tables and file names.
     pub fn name(self) -> &'static str {
         match self {
@@ -149,44 +157,20 @@ impl TransitionScene {
                 dither_alpha: None,
             });
         }
-        let mut pattern = DitherPattern::Bayer4x4;
         match parts {
             SceneParts::FineOnly => items.push(item(LodRole::Outgoing, OPAQUE, None)),
             SceneParts::CoarseOnly => items.push(item(LodRole::Incoming, OPAQUE, None)),
-            SceneParts::All => match technique {
-                SingleFrameTechnique::HardSwitch => {
-                    let role = if t < 0.5 {
-                        LodRole::Outgoing
-                    } else {
-                        LodRole::Incoming
-                    };
-                    items.push(item(role, OPAQUE, None));
-                }
-                SingleFrameTechnique::Dither(p) => {
-                    pattern = p;
-                    let selection = LodSelection {
-                        current: 0,
-                        next: Some(1),
-                        transition: t,
-                        fade: 1.0,
-                        visible: true,
-                    };
-                    let (current, next) = selection.screen_door_alphas();
-                    items.push(item(LodRole::Outgoing, OPAQUE, Some(current)));
-                    items.push(item(LodRole::Incoming, OPAQUE, next));
-                }
-                SingleFrameTechnique::CrossFade | SingleFrameTechnique::Unpopping => {
-                    let plan: TransitionPlan = if technique == SingleFrameTechnique::Unpopping {
-                        unpopping_plan(t)
-                    } else {
-                        cross_fade_plan(t)
-                    };
-                    for role in plan.order {
-                        items.push(item(role, plan.state(role), None));
-                    }
-                }
-            },
+            SceneParts::All => items.extend(transition_items(
+                technique,
+                t,
+                model,
+                (&self.fine, FINE_COLOR),
+                (&self.coarse, COARSE_COLOR),
+            )),
         }
+        let pattern = technique
+            .dither_pattern()
+            .unwrap_or(DitherPattern::Bayer4x4);
         let renderer = &self.renderers[usize::from(pattern == DitherPattern::BlueNoise16x16)];
         let clear = wgpu::Color {
             r: 0.02,
@@ -203,6 +187,67 @@ impl TransitionScene {
             &items,
         );
         read_texture_rgba8(gpu, &self.target.color)
+    }
+}
+
+/// The draws of one object in transition from `outgoing` to `incoming` (mesh and color each) at
+/// progress `t`, drawn with `technique`, in the order to draw them. Blended items (cross-fade,
+/// unpopping) belong after the scene's opaque objects; a dithering technique needs a renderer
+/// with its [`SingleFrameTechnique::dither_pattern`].
+pub fn transition_items<'a>(
+    technique: SingleFrameTechnique,
+    t: f32,
+    model: Mat4,
+    outgoing: (&'a GpuMesh, Vec4),
+    incoming: (&'a GpuMesh, Vec4),
+) -> Vec<DrawItem<'a>> {
+    let item = |role, state, dither_alpha| {
+        let (mesh, color) = match role {
+            LodRole::Outgoing => outgoing,
+            LodRole::Incoming => incoming,
+        };
+        DrawItem {
+            mesh,
+            model,
+            color,
+            state,
+            dither_alpha,
+        }
+    };
+    match technique {
+        SingleFrameTechnique::HardSwitch => {
+            let role = if t < 0.5 {
+                LodRole::Outgoing
+            } else {
+                LodRole::Incoming
+            };
+            vec![item(role, OPAQUE, None)]
+        }
+        SingleFrameTechnique::Dither(_) => {
+            let selection = LodSelection {
+                current: 0,
+                next: Some(1),
+                transition: t,
+                fade: 1.0,
+                visible: true,
+            };
+            let (current, next) = selection.screen_door_alphas();
+            vec![
+                item(LodRole::Outgoing, OPAQUE, Some(current)),
+                item(LodRole::Incoming, OPAQUE, next),
+            ]
+        }
+        SingleFrameTechnique::CrossFade | SingleFrameTechnique::Unpopping => {
+            let plan: TransitionPlan = if technique == SingleFrameTechnique::Unpopping {
+                unpopping_plan(t)
+            } else {
+                cross_fade_plan(t)
+            };
+            plan.order
+                .iter()
+                .map(|&role| item(role, plan.state(role), None))
+                .collect()
+        }
     }
 }
 

@@ -1,0 +1,250 @@
+//! The demo harness: its metrics against hand-derived expectations, its scene files, its command
+//! line, and its report opened in headless Chromium.
+
+use std::process::Command;
+
+use lodkit::demo::scene::{DemoScene, SceneError};
+use lodkit::demo::transitions::{pop, transition_change};
+use lodkit::demo::{DemoOptions, run_on, utc_date};
+
+use crate::composition::scratch;
+use crate::harness::{browser_script, say};
+
+fn lodkit() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_lodkit"))
+}
+
+#[test]
+fn change_and_pop_follow_their_definitions() {
+    let black = [0u8, 0, 0, 255];
+    let color = [30u8, 60, 90, 255];
+    // Only the image changed: mean of 30, 60, 90 over 255.
+    let c = transition_change(&black, &color, &black, &black);
+    assert!((c - 60.0 / 255.0).abs() < 1e-6, "{c}");
+    // Image and reference changed alike (camera motion): nothing is left.
+    assert_eq!(transition_change(&black, &color, &black, &color), 0.0);
+    // Alpha is ignored.
+    assert_eq!(
+        transition_change(&[0, 0, 0, 0], &[0, 0, 0, 255], &black, &black),
+        0.0
+    );
+    assert_eq!(pop(&[0.0, 0.5, 0.0]), 1.0);
+    assert!((pop(&[0.1, 0.3, 0.1]) - 0.6).abs() < 1e-6);
+    assert_eq!(pop(&[0.0, 0.0]), 0.0);
+}
+
+#[test]
+fn utc_dates_match_the_calendar() {
+    assert_eq!(utc_date(0), "1970-01-01");
+    assert_eq!(utc_date(951_782_400), "2000-02-29");
+    assert_eq!(utc_date(1_704_067_199), "2023-12-31");
+    assert_eq!(utc_date(1_709_251_200), "2024-03-01");
+}
+
+#[test]
+fn scene_files_name_the_line_and_the_field() {
+    let good = DemoScene::simple();
+    let text = ron::ser::to_string_pretty(&good, Default::default()).unwrap();
+    assert_eq!(DemoScene::from_ron(&text, "s.ron").unwrap(), good);
+
+    let broken = text.replacen("objects:", "objects", 1);
+    match DemoScene::from_ron(&broken, "s.ron") {
+        Err(SceneError::Parse { path, line, .. }) => {
+            assert_eq!(path, "s.ron");
+            let expected = text.lines().position(|l| l.contains("objects:")).unwrap() + 1;
+            assert_eq!(line, expected, "{broken}");
+        }
+        other => panic!("expected a parse error, got {other:?}"),
+    }
+    let mut bad = good.clone();
+    bad.objects[3].fine = lodkit::demo::scene::Shape::Sphere {
+        rings: 1,
+        segments: 8,
+    };
+    let text = ron::ser::to_string_pretty(&bad, Default::default()).unwrap();
+    let e = DemoScene::from_ron(&text, "s.ron").unwrap_err().to_string();
+    assert!(
+        e.contains("objects[3].fine") && e.contains("rings = 1"),
+        "{e}"
+    );
+    let mut bad = good.clone();
+    bad.objects[0].scale = [1.0, 0.0, 1.0];
+    let e = bad.check().unwrap_err();
+    assert!(e.contains("objects[0].scale"), "{e}");
+    let mut bad = good;
+    bad.objects.iter_mut().for_each(|o| o.transition = false);
+    assert!(bad.check().unwrap_err().contains("transition"));
+    let e = DemoScene::from_file(std::path::Path::new("no/such/scene.ron")).unwrap_err();
+    assert!(e.to_string().contains("no/such/scene.ron"), "{e}");
+}
+
+#[test]
+fn demo_command_rejects_bad_options_with_usage_errors() {
+    let out = lodkit().args(["demo", "--size", "10x10"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--size 10x10"));
+    let out = lodkit().args(["demo", "--size", "wide"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("WxH"));
+    let out = lodkit()
+        .args(["demo", "--scene", "no/such/scene.ron"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/scene.ron"));
+}
+
+#[test]
+fn demo_without_an_adapter_says_what_to_install() {
+    // This build has no Metal backend on Linux, so asking for it finds no adapter at all.
+    if cfg!(target_os = "macos") {
+        return;
+    }
+    let dir = scratch("no-adapter");
+    let out = lodkit()
+        .env("LODKIT_BACKEND", "metal")
+        .args(["demo", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("mesa-vulkan-drivers"), "{stderr}");
+}
+
+/// Triangles a run submits over the transition's frames (LEAD ..= LEAD + N), computed from the
+/// scene's meshes: `both` draws both LODs of each transitioning object every frame, otherwise
+/// the fine LOD until t = 0.5 and the coarse one from there (a hard switch).
+fn expected_triangles(scene: &DemoScene, frames: usize, both: bool) -> u64 {
+    let mut total = 0u64;
+    for f in 0..=frames {
+        let t = f as f32 / frames as f32;
+        for o in &scene.objects {
+            let fine = o.fine.mesh().triangles() as u64;
+            let coarse = o.coarse.mesh().triangles() as u64;
+            total += match (o.transition, both) {
+                (false, _) => fine,
+                (true, true) => fine + coarse,
+                (true, false) if t < 0.5 => fine,
+                (true, false) => coarse,
+            };
+        }
+    }
+    total
+}
+
+#[test]
+fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
+    let gpu = lodkit_test_gpu!();
+    let out = scratch("demo");
+    let frames = 8;
+    let options = DemoOptions {
+        out: out.clone(),
+        size: (96, 64),
+        frames,
+        scene: None,
+        timing_pairs: 3,
+        docs: Some(out.join("docs")),
+        progress: false,
+    };
+    let scenes = DemoScene::built_in();
+    let report = run_on(gpu, &options, &scenes).unwrap();
+    assert_eq!(report.transitions.len(), scenes.len() * 7);
+    for scene in &scenes {
+        let row = |name: &str| {
+            report
+                .transitions
+                .iter()
+                .find(|t| t.scene == scene.name && t.technique == name)
+                .unwrap_or_else(|| panic!("no {name} row for {}", scene.name))
+        };
+        let hard = row("hard-switch");
+        assert_eq!(hard.pop_static, 1.0, "a hard switch changes in one frame");
+        assert_eq!(hard.triangles, expected_triangles(scene, frames, false));
+        let fade = row("cross-fade");
+        assert_eq!(fade.triangles, expected_triangles(scene, frames, true));
+        assert!(fade.see_through > 0.5, "cross-fade: {}", fade.see_through);
+        for name in ["dither-bayer", "dither-blue-noise", "unpopping"] {
+            let r = row(name);
+            assert_eq!(r.see_through, 0.0, "{name} in {}", scene.name);
+            assert!(r.pop_static < 0.6, "{name} pops: {}", r.pop_static);
+        }
+        for name in ["frame-seq-white-noise", "frame-seq-blue-noise"] {
+            let r = row(name);
+            assert!(r.see_through < 0.02, "{name}: {}", r.see_through);
+            assert!(
+                r.triangles_vs_hard < 1.25,
+                "{name}: {}",
+                r.triangles_vs_hard
+            );
+            assert!(r.pop_static < 0.6, "{name} pops: {}", r.pop_static);
+        }
+    }
+    for u in &report.upsampling {
+        assert!(
+            u.psnr[1] > u.psnr[0],
+            "r = {}: bilateral must beat bilinear",
+            u.r
+        );
+        assert!(
+            u.psnr[2] > u.psnr[1],
+            "r = {}: fine-grained must beat bilateral",
+            u.r
+        );
+        assert!(u.ssim.iter().all(|s| *s > 0.0 && *s <= 1.0), "{:?}", u.ssim);
+        assert!(u.ssim[1] >= u.ssim[0], "r = {}: {:?}", u.r, u.ssim);
+    }
+    let settle = |name: &str| {
+        report
+            .controllers
+            .iter()
+            .find(|c| c.name.starts_with(name))
+            .and_then(|c| c.settling_frames)
+            .unwrap_or(f32::INFINITY)
+    };
+    assert!(settle("lodkit") < settle("paper"));
+
+    // Every image the page refers to exists, and the generated docs name the adapter.
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let sources: Vec<&str> = html
+        .split("src=\"")
+        .skip(1)
+        .map(|s| &s[..s.find('"').unwrap()])
+        .collect();
+    assert!(sources.len() >= 40, "{} images", sources.len());
+    for src in &sources {
+        assert!(out.join(src).is_file(), "index.html shows missing {src}");
+    }
+    for doc in ["quality.md", "benchmarks.md"] {
+        let text = std::fs::read_to_string(out.join("docs").join(doc)).unwrap();
+        assert!(
+            text.contains(&report.adapter) && text.contains("Generated by"),
+            "{doc}"
+        );
+    }
+    let Some(mut page) = browser_script("page.mjs") else {
+        return;
+    };
+    let shot = out.join("screenshot.png");
+    let result = page
+        .arg(out.join("index.html"))
+        .arg(&shot)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&result.stdout).into_owned()
+        + &String::from_utf8_lossy(&result.stderr);
+    assert!(result.status.success(), "index.html in Chromium:\n{text}");
+    assert!(
+        text.contains(&format!("images: {0}/{0} loaded", sources.len())),
+        "{text}"
+    );
+    let png = std::fs::read(&shot).unwrap();
+    assert!(
+        png.starts_with(b"\x89PNG") && png.len() > 10_000,
+        "screenshot"
+    );
+    say(&format!(
+        "demo report opened in Chromium: {}",
+        shot.display()
+    ));
+}

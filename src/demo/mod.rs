@@ -1,0 +1,299 @@
+//! The quality and cost harness behind `lodkit demo` (feature `demo`): renders the built-in
+//! scenes (or a RON scene) headless with every technique, measures pop, see-through, cost, pass
+//! time ratios and framebuffer-LOD quality, and writes images, PNG plots, `report.json` and a
+//! browsable `index.html`; optionally regenerates `docs/benchmarks.md` and `docs/quality.md`.
+//!
+//! ```no_run
+//! let options = lodkit::demo::DemoOptions::default();
+//! let report = lodkit::demo::run(&options)?;
+//! println!("{}", lodkit::demo::report::summary(&report));
+//! # Ok::<(), lodkit::demo::DemoError>(())
+//! ```
+
+pub mod plots;
+pub mod render;
+pub mod report;
+pub mod scene;
+pub mod timing;
+pub mod transitions;
+pub mod upsampling;
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::gpu::{GpuContext, GpuError, GpuOptions};
+use crate::shaders::ShaderError;
+use scene::{DemoScene, SceneError};
+
+/// What `lodkit demo` renders and where it writes.
+#[derive(Clone, Debug)]
+pub struct DemoOptions {
+    /// Output folder (created; files in it are overwritten).
+    pub out: PathBuf,
+    /// Image size of every rendering, 64..=4096 each way.
+    pub size: (u32, u32),
+    /// Frames a transition lasts, 4..=600.
+    pub frames: usize,
+    /// A RON scene to measure instead of the built-in ones.
+    pub scene: Option<PathBuf>,
+    /// Interleaved pairs per pass-time ratio and rounds of whole-frame timing.
+    pub timing_pairs: usize,
+    /// Folder to write `benchmarks.md` and `quality.md` into.
+    pub docs: Option<PathBuf>,
+    /// Show a progress bar on the terminal.
+    pub progress: bool,
+}
+
+impl Default for DemoOptions {
+    fn default() -> Self {
+        Self {
+            out: PathBuf::from("lodkit-demo"),
+            size: (320, 180),
+            frames: 24,
+            scene: None,
+            timing_pairs: 40,
+            docs: None,
+            progress: true,
+        }
+    }
+}
+
+/// Why the demo stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum DemoError {
+    /// No GPU adapter at all.
+    #[error(
+        "{source}\n\nlodkit demo needs a GPU adapter: a GPU driver with Vulkan, or the software \
+         rasterizers. On Debian/Ubuntu: `sudo apt-get install mesa-vulkan-drivers libvulkan1` \
+         (lavapipe); for OpenGL, `libegl1 libgl1-mesa-dri` and LODKIT_BACKEND=gl. On a desktop \
+         without a session bus set XDG_RUNTIME_DIR to a private folder."
+    )]
+    NoAdapter {
+        /// What wgpu said.
+        #[source]
+        source: GpuError,
+    },
+    /// The device could not be created.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// A lodkit pass did not compose (a bug: please report it).
+    #[error("a lodkit pass does not compose: {0}")]
+    Shader(#[from] ShaderError),
+    /// The scene file.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// An option out of range.
+    #[error("{0}")]
+    Options(String),
+    /// Writing output.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file or folder.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+    /// Drawing a plot.
+    #[error("plot: {0}")]
+    Plot(String),
+    /// An inconsistency inside the harness.
+    #[error("internal: {0}")]
+    Internal(String),
+}
+
+impl DemoError {
+    fn io(path: &Path, e: impl std::fmt::Display) -> Self {
+        DemoError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// Saves `image` as PNG at `path`, creating folders.
+pub fn save(image: &image::RgbaImage, path: &Path) -> Result<(), DemoError> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| DemoError::io(dir, e))?;
+    }
+    image.save(path).map_err(|e| DemoError::io(path, e))
+}
+
+/// Everything the demo measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct DemoReport {
+    /// Adapter name, backend, driver.
+    pub adapter: String,
+    /// Backend (Vulkan, Gl, ...).
+    pub backend: String,
+    /// Device type (Cpu = software rasterizer).
+    pub device_type: String,
+    /// UTC date of the run, YYYY-MM-DD.
+    pub date: String,
+    /// Image size.
+    pub size: (u32, u32),
+    /// Transition length in frames.
+    pub frames: usize,
+    /// What the fragment counts count.
+    pub counter: String,
+    /// Scenes measured.
+    pub scenes: Vec<String>,
+    /// Transition metrics, scene by scene, technique by technique.
+    pub transitions: Vec<transitions::TransitionMetrics>,
+    /// Framebuffer LOD quality and speed.
+    pub upsampling: Vec<upsampling::UpsampleRow>,
+    /// Pass time ratios.
+    pub pass_ratios: Vec<timing::PassRatio>,
+    /// Framerate controllers.
+    pub controllers: Vec<upsampling::ControllerRow>,
+    /// Whether the plots have text (a font was found).
+    pub plot_text: bool,
+    /// Wall time of the whole run, seconds.
+    pub seconds: f64,
+}
+
+fn check_options(o: &DemoOptions) -> Result<(), DemoError> {
+    let (w, h) = o.size;
+    if !(64..=4096).contains(&w) || !(64..=4096).contains(&h) {
+        return Err(DemoError::Options(format!(
+            "--size {w}x{h}: each side must be within 64..=4096"
+        )));
+    }
+    if !(4..=600).contains(&o.frames) {
+        return Err(DemoError::Options(format!(
+            "--frames {}: must be within 4..=600",
+            o.frames
+        )));
+    }
+    Ok(())
+}
+
+/// UTC date of `secs` seconds after the Unix epoch as YYYY-MM-DD (civil-from-days).
+pub fn utc_date(secs: u64) -> String {
+    let z = (secs / 86_400) as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// Opens the GPU the demo runs on: the first adapter of `LODKIT_BACKEND` or Vulkan then GL,
+/// with pipeline statistics when the adapter has them.
+pub fn open_gpu() -> Result<GpuContext, DemoError> {
+    let options = GpuOptions {
+        optional_features: wgpu::Features::PIPELINE_STATISTICS_QUERY,
+        ..Default::default()
+    };
+    GpuContext::new_headless(&options).map_err(|e| match e {
+        GpuError::NoAdapter { .. } => DemoError::NoAdapter { source: e },
+        other => DemoError::Gpu(other),
+    })
+}
+
+/// Runs the whole demo on a GPU of its own (see [`open_gpu`]).
+pub fn run(options: &DemoOptions) -> Result<DemoReport, DemoError> {
+    check_options(options)?;
+    let scenes = match &options.scene {
+        Some(path) => vec![DemoScene::from_file(path)?],
+        None => DemoScene::built_in(),
+    };
+    let gpu = open_gpu()?;
+    run_on(&gpu, options, &scenes)
+}
+
+/// Runs the demo on `gpu` over `scenes`.
+pub fn run_on(
+    gpu: &GpuContext,
+    options: &DemoOptions,
+    scenes: &[DemoScene],
+) -> Result<DemoReport, DemoError> {
+    check_options(options)?;
+    let start = std::time::Instant::now();
+    let out = &options.out;
+    std::fs::create_dir_all(out).map_err(|e| DemoError::io(out, e))?;
+    let steps = scenes.len() * render::Technique::ALL.len() + upsampling::RESIZE_FACTORS.len() + 4;
+    let bar = if options.progress {
+        indicatif::ProgressBar::new(steps as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{spinner} [{elapsed_precise}] {bar:32} {pos}/{len} {msg}",
+    ) {
+        bar.set_style(style);
+    }
+    let mut transitions = Vec::new();
+    let mut counter = String::new();
+    for scene in scenes {
+        scene.check().map_err(|message| SceneError::Invalid {
+            path: scene.name.clone(),
+            message,
+        })?;
+        bar.set_message(format!("scene {}", scene.name));
+        let renderer = render::SceneRenderer::new(gpu, scene, options.size, options.frames)?;
+        counter = renderer.counter().kind().describe().to_owned();
+        let mut tick = |name: &str| {
+            bar.set_message(format!("scene {}: {name}", scene.name));
+            bar.inc(1);
+        };
+        transitions.extend(transitions::measure_scene(
+            gpu,
+            &renderer,
+            &scene.name,
+            options.size,
+            out,
+            &mut tick,
+        )?);
+    }
+    bar.set_message("framebuffer LOD");
+    let mut tick = |name: &str| {
+        bar.set_message(format!("framebuffer LOD: {name}"));
+        bar.inc(1);
+    };
+    let rounds = (options.timing_pairs / 4).max(3);
+    let upsampling = upsampling::measure_upsampling(gpu, options.size, rounds, out, &mut tick)?;
+    bar.set_message("pass time ratios");
+    let pass_ratios = vec![
+        timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?,
+        timing::upsample_vs_bilinear(gpu, options.size, 2.0, options.timing_pairs)?,
+    ];
+    bar.inc(1);
+    bar.set_message("controllers");
+    let controllers = upsampling::measure_controllers(50);
+    bar.inc(1);
+    let info = gpu.adapter.get_info();
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let mut report = DemoReport {
+        adapter: gpu.adapter_summary(),
+        backend: format!("{:?}", info.backend),
+        device_type: format!("{:?}", info.device_type),
+        date: utc_date(now),
+        size: options.size,
+        frames: options.frames,
+        counter,
+        scenes: scenes.iter().map(|s| s.name.clone()).collect(),
+        transitions,
+        upsampling,
+        pass_ratios,
+        controllers,
+        plot_text: plots::plot_font().is_some(),
+        seconds: 0.0,
+    };
+    bar.set_message("plots and report");
+    report::write_plots(&report, out)?;
+    report.seconds = start.elapsed().as_secs_f64();
+    report::write_report(&report, out)?;
+    if let Some(docs) = &options.docs {
+        report::write_docs(&report, docs)?;
+    }
+    bar.inc(1);
+    bar.finish_and_clear();
+    Ok(report)
+}

@@ -1,0 +1,441 @@
+//! Renders a [`DemoScene`] frame by frame with any transition technique: single-frame techniques
+//! through [`MeshRenderer`], frame-sequential through the LOD buffers and the combine pass.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::scene::DemoScene;
+use crate::combine::{DepthConvention, PixelSource, combine_images};
+use crate::frame_sequential::{Drive, TransitionScheduler};
+use crate::gpu::GpuContext;
+use crate::gpu::counters::FragmentCounter;
+use crate::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
+use crate::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use crate::gpu::readback::read_texture_rgba8;
+use crate::gpu::resources::texture_2d;
+use crate::gpu::scene::{DrawItem, GpuMesh, MeshRenderer, RenderTarget};
+use crate::gpu::transition_scene::{SingleFrameTechnique, transition_items};
+use crate::reproject::new_to_old_matrix;
+use crate::screen_door::DitherPattern;
+use crate::shaders::ShaderError;
+use crate::unpopping::LodRenderState;
+use crate::visibility::{VisibilityPattern, visibility_texture};
+
+/// A transition technique of the harness.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Technique {
+    /// A single-frame technique.
+    Single(SingleFrameTechnique),
+    /// Frame-sequential interpolation with a visibility pattern.
+    FrameSequential(VisibilityPattern),
+}
+
+impl Technique {
+    /// Every technique the harness compares.
+    pub const ALL: [Technique; 7] = [
+        Technique::Single(SingleFrameTechnique::HardSwitch),
+        Technique::Single(SingleFrameTechnique::CrossFade),
+        Technique::Single(SingleFrameTechnique::Dither(DitherPattern::Bayer4x4)),
+        Technique::Single(SingleFrameTechnique::Dither(DitherPattern::BlueNoise16x16)),
+        Technique::Single(SingleFrameTechnique::Unpopping),
+        Technique::FrameSequential(VisibilityPattern::WhiteNoise),
+        Technique::FrameSequential(VisibilityPattern::BlueNoise),
+    ];
+
+    /// Short name for tables and file names.
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::Single(t) => t.name(),
+            Technique::FrameSequential(VisibilityPattern::WhiteNoise) => "frame-seq-white-noise",
+            Technique::FrameSequential(VisibilityPattern::BlueNoise) => "frame-seq-blue-noise",
+            Technique::FrameSequential(VisibilityPattern::Radial) => "frame-seq-radial",
+        }
+    }
+}
+
+/// What the scene's non-transitioning objects and the clear color look like.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Background {
+    /// As the scene describes them.
+    Scene,
+    /// Everything but the transitioning objects in one flat color (see-through measurement).
+    Flat(Vec4),
+}
+
+/// One rendered frame.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// RGBA8 pixels, rows top to bottom.
+    pub pixels: Vec<u8>,
+    /// Triangles submitted.
+    pub triangles: u64,
+    /// The pass's [`FragmentCounter`] reading.
+    pub fragments: u64,
+}
+
+/// One run of a technique over a scene.
+#[derive(Clone, Copy, Debug)]
+pub struct RunSpec {
+    /// Technique.
+    pub technique: Technique,
+    /// Whether the camera moves from `eye` to `moving_eye`.
+    pub moving: bool,
+    /// Whether the transitioning objects transition (false: they stay at the fine LOD, the
+    /// reference that camera motion is measured against).
+    pub transition: bool,
+    /// Background.
+    pub background: Background,
+}
+
+/// Frames before the transition starts (and after it ends) in every run.
+pub const LEAD_FRAMES: usize = 2;
+
+/// The scene on the GPU with everything needed to render it with each technique.
+#[derive(Debug)]
+pub struct SceneRenderer<'a> {
+    scene: &'a DemoScene,
+    size: (u32, u32),
+    frames: usize,
+    meshes: Vec<[GpuMesh; 2]>,
+    single: [MeshRenderer; 2],
+    target: RenderTarget,
+    lod_buffer: [LodBufferRenderer; 2],
+    buffers: LodBuffers,
+    combine: CombinePass,
+    combined: wgpu::Texture,
+    counter: FragmentCounter,
+}
+
+const CLEAR: Vec4 = Vec4::new(0.03, 0.03, 0.06, 1.0);
+const LIGHT: Vec3 = Vec3::new(0.4, 0.8, 0.6);
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+fn color(v: Vec4) -> wgpu::Color {
+    wgpu::Color {
+        r: f64::from(v.x),
+        g: f64::from(v.y),
+        b: f64::from(v.z),
+        a: f64::from(v.w),
+    }
+}
+
+impl<'a> SceneRenderer<'a> {
+    /// Uploads the scene and builds every pipeline for `size` images and transitions of
+    /// `frames` frames.
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &'a DemoScene,
+        size: (u32, u32),
+        frames: usize,
+    ) -> Result<Self, ShaderError> {
+        let meshes = scene
+            .objects
+            .iter()
+            .map(|o| {
+                [
+                    GpuMesh::new(gpu, &o.fine.mesh()),
+                    GpuMesh::new(gpu, &o.coarse.mesh()),
+                ]
+            })
+            .collect();
+        let vis = |p| visibility_texture(p, 64, 1);
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        Ok(Self {
+            scene,
+            size,
+            frames: frames.max(2),
+            meshes,
+            single: [
+                MeshRenderer::new(gpu, false)?,
+                MeshRenderer::new(gpu, true)?,
+            ],
+            target: RenderTarget::new(gpu, size.0, size.1),
+            lod_buffer: [
+                LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::WhiteNoise), 0.25)?,
+                LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), 0.25)?,
+            ],
+            buffers: LodBuffers::new(gpu, size.0, size.1, FORMAT),
+            combine: CombinePass::new(gpu, FORMAT, false)?,
+            combined: texture_2d(gpu, size, FORMAT, usage, "combined"),
+            counter: FragmentCounter::new(gpu),
+        })
+    }
+
+    /// Frames in a run: the transition's frames plus [`LEAD_FRAMES`] before and after.
+    pub fn run_length(&self) -> usize {
+        self.frames + 2 * LEAD_FRAMES + 1
+    }
+
+    /// Frames the transition lasts.
+    pub fn transition_frames(&self) -> usize {
+        self.frames
+    }
+
+    /// Transition progress at `frame` (0 before, 1 after).
+    pub fn progress(&self, frame: usize) -> f32 {
+        ((frame as f32 - LEAD_FRAMES as f32) / self.frames as f32).clamp(0.0, 1.0)
+    }
+
+    /// The counter used for [`Frame::fragments`].
+    pub fn counter(&self) -> &FragmentCounter {
+        &self.counter
+    }
+
+    fn camera(&self, frame: usize, moving: bool) -> (Mat4, Mat4) {
+        let c = &self.scene.camera;
+        let s = if moving {
+            frame as f32 / (self.run_length() - 1) as f32
+        } else {
+            0.0
+        };
+        let eye = Vec3::from(c.eye).lerp(Vec3::from(c.moving_eye), s);
+        let view = glam::camera::rh::view::look_at_mat4(eye, c.target.into(), Vec3::Y);
+        let aspect = self.size.0 as f32 / self.size.1 as f32;
+        let proj = glam::camera::rh::proj::directx::perspective(c.fov_y, aspect, 0.1, 100.0);
+        (view, proj)
+    }
+
+    fn object_color(&self, i: usize, lod: usize, background: Background) -> Vec4 {
+        let o = &self.scene.objects[i];
+        match background {
+            Background::Flat(c) if !o.transition => c,
+            _ => Vec3::from(if lod == 0 {
+                o.fine_color
+            } else {
+                o.coarse_color
+            })
+            .extend(1.0),
+        }
+    }
+
+    /// Runs `spec` over [`Self::run_length`] frames and hands each frame `wanted` accepts to
+    /// `on_frame` (single-frame techniques only render those; frame-sequential renders every
+    /// frame, since each depends on the last). For frame-sequential runs `on_sources` gets which
+    /// rule chose each pixel of the middle frame.
+    pub fn run(
+        &self,
+        gpu: &GpuContext,
+        spec: RunSpec,
+        wanted: &dyn Fn(usize) -> bool,
+        on_frame: &mut dyn FnMut(usize, Frame),
+        on_sources: Option<&mut dyn FnMut(Vec<PixelSource>)>,
+    ) {
+        match spec.technique {
+            Technique::Single(t) => {
+                for f in (0..self.run_length()).filter(|&f| wanted(f)) {
+                    on_frame(f, self.render_single(gpu, t, f, spec));
+                }
+            }
+            Technique::FrameSequential(p) => {
+                self.run_frame_sequential(gpu, p, spec, wanted, on_frame, on_sources)
+            }
+        }
+    }
+
+    fn render_single(
+        &self,
+        gpu: &GpuContext,
+        technique: SingleFrameTechnique,
+        frame: usize,
+        spec: RunSpec,
+    ) -> Frame {
+        let (view, proj) = self.camera(frame, spec.moving);
+        let t = self.progress(frame);
+        let opaque = LodRenderState {
+            alpha: 1.0,
+            depth_test: true,
+            depth_write: true,
+            blend: false,
+        };
+        let mut items: Vec<DrawItem> = Vec::new();
+        let mut blended: Vec<(f32, DrawItem)> = Vec::new();
+        for (i, o) in self.scene.objects.iter().enumerate() {
+            let model = self.scene.model(i);
+            let fine = (&self.meshes[i][0], self.object_color(i, 0, spec.background));
+            if !(o.transition && spec.transition) {
+                items.push(DrawItem {
+                    mesh: fine.0,
+                    model,
+                    color: fine.1,
+                    state: opaque,
+                    dither_alpha: None,
+                });
+                continue;
+            }
+            let coarse = (&self.meshes[i][1], self.object_color(i, 1, spec.background));
+            let depth = (view * model).w_axis.z;
+            for item in transition_items(technique, t, model, fine, coarse) {
+                if item.state.blend {
+                    blended.push((depth, item));
+                } else {
+                    items.push(item);
+                }
+            }
+        }
+        // Blended LODs after every opaque draw, far to near.
+        blended.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let triangles = items
+            .iter()
+            .chain(blended.iter().map(|(_, i)| i))
+            .map(|i| u64::from(i.mesh.triangles()))
+            .sum();
+        items.extend(blended.into_iter().map(|(_, i)| i));
+        let blue = technique.dither_pattern() == Some(DitherPattern::BlueNoise16x16);
+        let clear = match spec.background {
+            Background::Scene => CLEAR,
+            Background::Flat(c) => c,
+        };
+        let fragments = self.single[usize::from(blue)].render_counted(
+            gpu,
+            &self.target,
+            color(clear),
+            proj * view,
+            LIGHT,
+            &items,
+            Some(&self.counter),
+        );
+        Frame {
+            pixels: read_texture_rgba8(gpu, &self.target.color),
+            triangles,
+            fragments,
+        }
+    }
+
+    fn run_frame_sequential(
+        &self,
+        gpu: &GpuContext,
+        pattern: VisibilityPattern,
+        spec: RunSpec,
+        wanted: &dyn Fn(usize) -> bool,
+        on_frame: &mut dyn FnMut(usize, Frame),
+        mut on_sources: Option<&mut dyn FnMut(Vec<PixelSource>)>,
+    ) {
+        let renderer = &self.lod_buffer[usize::from(pattern == VisibilityPattern::BlueNoise)];
+        let mut scheduler = TransitionScheduler::new();
+        let keys: Vec<_> = self
+            .scene
+            .objects
+            .iter()
+            .map(|_| scheduler.insert(0))
+            .collect();
+        let seconds = self.frames as f32 / 30.0;
+        let clear = match spec.background {
+            Background::Scene => CLEAR,
+            Background::Flat(c) => c,
+        };
+        let mut previous: Option<Mat4> = None;
+        let middle = LEAD_FRAMES + self.frames / 2;
+        for frame in 0..self.run_length() {
+            if frame > 0 {
+                scheduler.advance(1.0 / 30.0);
+            }
+            if frame == LEAD_FRAMES && spec.transition {
+                for (o, key) in self.scene.objects.iter().zip(&keys) {
+                    if o.transition {
+                        // A fresh scheduler has ids to spare: this cannot fail.
+                        let _ = scheduler.begin_transition(*key, 1, Drive::Time { seconds });
+                    }
+                }
+            }
+            let (view, proj) = self.camera(frame, spec.moving);
+            let items: Vec<LodDrawItem> = keys
+                .iter()
+                .enumerate()
+                .filter_map(|(i, key)| {
+                    let d = scheduler.draw(*key).ok()?;
+                    let lod = usize::from(d.lod.min(1));
+                    Some(LodDrawItem {
+                        mesh: &self.meshes[i][lod],
+                        model: self.scene.model(i),
+                        color: self.object_color(i, lod, spec.background),
+                        id: d.id,
+                        tau: d.tau,
+                    })
+                })
+                .collect();
+            let index = scheduler.buffer_index();
+            let (triangles, fragments) = renderer.render_counted(
+                gpu,
+                &self.buffers,
+                index,
+                proj * view,
+                &items,
+                color(clear),
+                Some(&self.counter),
+            );
+            let m = previous.map_or(CombinePass::NO_HISTORY, |old| {
+                new_to_old_matrix(&view, &proj, &old, &proj)
+            });
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let target = self.combined.create_view(&Default::default());
+            self.combine
+                .encode(gpu, &mut encoder, &self.buffers, index, m, &target);
+            gpu.queue.submit([encoder.finish()]);
+            if frame == middle {
+                if let Some(f) = on_sources.as_mut() {
+                    let newer = read_lod_image(gpu, &self.buffers, index);
+                    let older = read_lod_image(gpu, &self.buffers, 1 - index);
+                    let sources = combine_images(&newer, &older, &m, DepthConvention::Standard);
+                    f(sources.iter().map(|p| p.source).collect());
+                }
+            }
+            if wanted(frame) {
+                // The combine pass shades every pixel once more.
+                let combine = u64::from(self.size.0) * u64::from(self.size.1);
+                let pixels = read_texture_rgba8(gpu, &self.combined);
+                let fragments = fragments + combine;
+                on_frame(
+                    frame,
+                    Frame {
+                        pixels,
+                        triangles,
+                        fragments,
+                    },
+                );
+            }
+            previous = Some(view);
+        }
+    }
+
+    /// Masks of the transitioning objects drawn opaque at the fine and at the coarse LOD (the
+    /// scenery in black, so hidden parts do not count), at the middle frame of the static
+    /// camera: `true` where the object covers the pixel.
+    pub fn lod_masks(&self, gpu: &GpuContext) -> [Vec<bool>; 2] {
+        let (view, proj) = self.camera(LEAD_FRAMES + self.frames / 2, false);
+        [0usize, 1].map(|lod| {
+            let opaque = LodRenderState {
+                alpha: 1.0,
+                depth_test: true,
+                depth_write: true,
+                blend: false,
+            };
+            let items: Vec<DrawItem> = self
+                .scene
+                .objects
+                .iter()
+                .enumerate()
+                .map(|(i, o)| {
+                    let k = if o.transition { lod } else { 0 };
+                    DrawItem {
+                        mesh: &self.meshes[i][k],
+                        model: self.scene.model(i),
+                        color: if o.transition { Vec4::ONE } else { Vec4::ZERO },
+                        state: opaque,
+                        dither_alpha: None,
+                    }
+                })
+                .collect();
+            self.single[0].render(
+                gpu,
+                &self.target,
+                wgpu::Color::BLACK,
+                proj * view,
+                LIGHT,
+                &items,
+            );
+            read_texture_rgba8(gpu, &self.target.color)
+                .chunks(4)
+                .map(|p| p[..3].iter().any(|&c| c > 8))
+                .collect()
+        })
+    }
+}

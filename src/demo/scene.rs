@@ -1,0 +1,375 @@
+//! Scenes for the transition harness: objects with a fine and a coarse LOD, a camera that stands
+//! still or moves, built in code or read from RON.
+//!
+//! ```ron
+//! (
+//!     name: "two-spheres",
+//!     camera: (eye: (0.0, 1.0, 6.0), target: (0.0, 0.0, 0.0), moving_eye: (1.5, 1.2, 5.0)),
+//!     objects: [
+//!         (fine: Sphere(rings: 24, segments: 48), coarse: Cube,
+//!          fine_color: (0.9, 0.2, 0.1), coarse_color: (0.1, 0.3, 0.9), position: (0.0, 0.0, 0.0)),
+//!         (fine: Cube, coarse: Cube, fine_color: (0.8, 0.8, 0.7), coarse_color: (0.8, 0.8, 0.7),
+//!          position: (0.0, 0.0, -3.0), scale: (4.0, 3.0, 0.2), transition: false),
+//!     ],
+//! )
+//! ```
+
+use std::path::Path;
+
+use glam::{Mat4, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::gpu::scene::Mesh;
+
+/// The most objects a scene may have (each transition draws two items per object).
+pub const MAX_OBJECTS: usize = 100;
+
+/// A scene of the transition harness.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DemoScene {
+    /// Name used in file names and tables (letters, digits, `-`, `_`).
+    pub name: String,
+    /// Camera.
+    pub camera: DemoCamera,
+    /// Objects; those with `transition: true` go from their fine to their coarse LOD.
+    pub objects: Vec<DemoObject>,
+}
+
+/// Camera of a scene; the moving camera goes from `eye` to `moving_eye` over the run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DemoCamera {
+    /// Eye position of the static camera and start of the moving one.
+    pub eye: [f32; 3],
+    /// Point looked at.
+    pub target: [f32; 3],
+    /// Where the moving camera ends.
+    pub moving_eye: [f32; 3],
+    /// Vertical field of view in radians (default 0.8).
+    #[serde(default = "default_fov")]
+    pub fov_y: f32,
+}
+
+fn default_fov() -> f32 {
+    0.8
+}
+
+fn unit_scale() -> [f32; 3] {
+    [1.0; 3]
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// One object with two LODs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DemoObject {
+    /// Shape of the fine LOD (LOD 0).
+    pub fine: Shape,
+    /// Shape of the coarse LOD (LOD 1).
+    pub coarse: Shape,
+    /// Linear RGB of the fine LOD.
+    pub fine_color: [f32; 3],
+    /// Linear RGB of the coarse LOD.
+    pub coarse_color: [f32; 3],
+    /// World position.
+    pub position: [f32; 3],
+    /// Scale per axis (default 1).
+    #[serde(default = "unit_scale")]
+    pub scale: [f32; 3],
+    /// Whether it transitions during the run (default true); `false` makes it scenery drawn at
+    /// its fine LOD.
+    #[serde(default = "yes")]
+    pub transition: bool,
+}
+
+/// A procedural shape.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Shape {
+    /// UV sphere of radius 1 (rings 2..=256, segments 3..=512).
+    Sphere {
+        /// Rings from pole to pole.
+        rings: u32,
+        /// Segments around.
+        segments: u32,
+    },
+    /// Cube from -1 to 1.
+    Cube,
+    /// Tree-like cluster: a trunk and `puffs` spheres of `rings` rings (puffs 1..=32).
+    Tree {
+        /// Canopy spheres.
+        puffs: u32,
+        /// Rings of each canopy sphere (segments are twice as many).
+        rings: u32,
+    },
+}
+
+impl Shape {
+    /// The mesh of the shape.
+    pub fn mesh(self) -> Mesh {
+        match self {
+            Shape::Sphere { rings, segments } => Mesh::sphere(rings, segments),
+            Shape::Cube => Mesh::cube(),
+            Shape::Tree { puffs, rings } => {
+                let mut m = Mesh::default();
+                let trunk = Mat4::from_translation(Vec3::new(0.0, -0.6, 0.0))
+                    * Mat4::from_scale(Vec3::new(0.12, 0.4, 0.12));
+                m.append(&Mesh::cube(), trunk);
+                let puff = Mesh::sphere(rings, rings * 2);
+                for k in 0..puffs {
+                    // Puffs on a golden-angle spiral around the canopy's center.
+                    let a = k as f32 * 2.399_963;
+                    let h = if puffs == 1 {
+                        0.0
+                    } else {
+                        k as f32 / (puffs - 1) as f32 - 0.5
+                    };
+                    let rad = if puffs == 1 { 0.0 } else { 0.35 };
+                    let c = Vec3::new(rad * a.cos(), 0.2 + 0.5 * h, rad * a.sin());
+                    let size = if puffs == 1 { 0.6 } else { 0.38 };
+                    m.append(
+                        &puff,
+                        Mat4::from_translation(c) * Mat4::from_scale(Vec3::splat(size)),
+                    );
+                }
+                m
+            }
+        }
+    }
+
+    fn check(self) -> Result<(), String> {
+        match self {
+            Shape::Sphere { rings, segments } if !(2..=256).contains(&rings) => Err(format!(
+                "Sphere rings = {rings} is outside 2..=256 (segments = {segments})"
+            )),
+            Shape::Sphere { segments, .. } if !(3..=512).contains(&segments) => {
+                Err(format!("Sphere segments = {segments} is outside 3..=512"))
+            }
+            Shape::Tree { puffs, .. } if !(1..=32).contains(&puffs) => {
+                Err(format!("Tree puffs = {puffs} is outside 1..=32"))
+            }
+            Shape::Tree { rings, .. } if !(2..=64).contains(&rings) => {
+                Err(format!("Tree rings = {rings} is outside 2..=64"))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A scene file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// RON syntax or a field of the wrong type.
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// Values that parse but cannot be rendered.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The file (or `built-in`).
+        path: String,
+        /// What is wrong and where (`objects[3].scale`, ...).
+        message: String,
+    },
+}
+
+impl DemoScene {
+    /// Reads and checks a RON scene file.
+    pub fn from_file(path: &Path) -> Result<Self, SceneError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: shown.clone(),
+            source,
+        })?;
+        Self::from_ron(&text, &shown)
+    }
+
+    /// Parses and checks a RON scene; `path` names it in errors.
+    pub fn from_ron(text: &str, path: &str) -> Result<Self, SceneError> {
+        let scene: DemoScene = ron::from_str(text).map_err(|e| SceneError::Parse {
+            path: path.to_owned(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })?;
+        scene.check().map_err(|message| SceneError::Invalid {
+            path: path.to_owned(),
+            message,
+        })?;
+        Ok(scene)
+    }
+
+    /// Checks names, counts and values; the message names the field.
+    pub fn check(&self) -> Result<(), String> {
+        let name_ok = !self.name.is_empty()
+            && self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+        if !name_ok {
+            return Err(format!(
+                "name `{}` must be non-empty letters, digits, `-` or `_`",
+                self.name
+            ));
+        }
+        if self.objects.len() > MAX_OBJECTS {
+            return Err(format!(
+                "objects: {} objects, at most {MAX_OBJECTS}",
+                self.objects.len()
+            ));
+        }
+        if !self.objects.iter().any(|o| o.transition) {
+            return Err("objects: no object has `transition: true`".to_owned());
+        }
+        let c = &self.camera;
+        let finite = |v: &[f32]| v.iter().all(|x| x.is_finite());
+        if !finite(&c.eye) || !finite(&c.target) || !finite(&c.moving_eye) {
+            return Err("camera: eye, target and moving_eye must be finite".to_owned());
+        }
+        if Vec3::from(c.eye) == Vec3::from(c.target)
+            || Vec3::from(c.moving_eye) == Vec3::from(c.target)
+        {
+            return Err("camera: the eye must not sit on the target".to_owned());
+        }
+        if !(c.fov_y > 0.01 && c.fov_y < 3.1) {
+            return Err(format!("camera.fov_y = {} is outside (0.01, 3.1)", c.fov_y));
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            let at = |m: String| format!("objects[{i}].{m}");
+            o.fine.check().map_err(|m| at(format!("fine: {m}")))?;
+            o.coarse.check().map_err(|m| at(format!("coarse: {m}")))?;
+            if !finite(&o.position) {
+                return Err(at(format!("position = {:?} is not finite", o.position)));
+            }
+            if !o.scale.iter().all(|s| s.is_finite() && *s > 0.0) {
+                return Err(at(format!("scale = {:?} must be > 0", o.scale)));
+            }
+            for (field, rgb) in [
+                ("fine_color", o.fine_color),
+                ("coarse_color", o.coarse_color),
+            ] {
+                if !rgb.iter().all(|v| (0.0..=1.0).contains(v)) {
+                    return Err(at(format!("{field} = {rgb:?} is outside 0..=1")));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Model matrix of object `i`.
+    pub fn model(&self, i: usize) -> Mat4 {
+        let o = &self.objects[i];
+        Mat4::from_translation(o.position.into()) * Mat4::from_scale(o.scale.into())
+    }
+
+    /// The built-in scenes: `simple` and `trees`.
+    pub fn built_in() -> Vec<DemoScene> {
+        vec![Self::simple(), Self::trees()]
+    }
+
+    /// A SIMPLE-like scene (Scherzer & Wimmer 2008, Fig. 9): a grid of red spheres (LOD 0)
+    /// turning into blue boxes (LOD 1) over a floor.
+    pub fn simple() -> DemoScene {
+        let mut objects: Vec<DemoObject> = (0..15)
+            .map(|i| DemoObject {
+                fine: Shape::Sphere {
+                    rings: 16,
+                    segments: 24,
+                },
+                coarse: Shape::Cube,
+                fine_color: [0.9, 0.15, 0.1],
+                coarse_color: [0.15, 0.3, 0.95],
+                position: [(i % 5) as f32 * 2.2 - 4.4, 0.0, -((i / 5) as f32) * 2.5],
+                scale: [0.8; 3],
+                transition: true,
+            })
+            .collect();
+        objects.push(scenery(
+            [0.0, -1.0, -2.5],
+            [8.0, 0.1, 5.0],
+            [0.7, 0.7, 0.65],
+        ));
+        DemoScene {
+            name: "simple".to_owned(),
+            camera: DemoCamera {
+                eye: [-1.0, 3.0, 7.5],
+                target: [0.0, 0.0, -2.5],
+                moving_eye: [1.2, 2.6, 6.0],
+                fov_y: 0.8,
+            },
+            objects,
+        }
+    }
+
+    /// Tree-like clusters (many small spheres, LOD 1 one blob) in front of a wall: the scene
+    /// where see-through of a cross-fade shows.
+    pub fn trees() -> DemoScene {
+        let mut objects: Vec<DemoObject> = (0..8)
+            .map(|i| {
+                let x = (i % 4) as f32 * 1.7 - 2.55;
+                let z = -((i / 4) as f32) * 1.8 + 0.3 * (i % 2) as f32;
+                DemoObject {
+                    fine: Shape::Tree { puffs: 7, rings: 8 },
+                    coarse: Shape::Tree { puffs: 1, rings: 4 },
+                    fine_color: [0.15, 0.65, 0.2],
+                    coarse_color: [0.1, 0.45, 0.35],
+                    position: [x, 0.0, z],
+                    scale: [0.9; 3],
+                    transition: true,
+                }
+            })
+            .collect();
+        objects.push(scenery(
+            [0.0, 0.5, -4.5],
+            [6.0, 3.0, 0.1],
+            [0.85, 0.85, 0.9],
+        ));
+        objects.push(scenery(
+            [0.0, -1.0, -1.5],
+            [6.0, 0.1, 4.0],
+            [0.55, 0.45, 0.35],
+        ));
+        DemoScene {
+            name: "trees".to_owned(),
+            camera: DemoCamera {
+                eye: [0.0, 1.2, 6.0],
+                target: [0.0, 0.0, -1.0],
+                moving_eye: [1.6, 1.5, 5.0],
+                fov_y: 0.8,
+            },
+            objects,
+        }
+    }
+}
+
+fn scenery(position: [f32; 3], scale: [f32; 3], color: [f32; 3]) -> DemoObject {
+    DemoObject {
+        fine: Shape::Cube,
+        coarse: Shape::Cube,
+        fine_color: color,
+        coarse_color: color,
+        position,
+        scale,
+        transition: false,
+    }
+}

@@ -1,0 +1,296 @@
+//! Pass cost as a ratio against the plainest pass doing the same memory traffic, measured in
+//! interleaved pairs so machine noise hits both alike: the combine pass against a copy of the
+//! same four textures, the bilateral upsample against a hardware-filtered bilinear fetch. Wall
+//! time per pass including submit and wait: read the ratio on a software GPU, not the
+//! milliseconds.
+
+use std::time::Instant;
+
+use glam::{Mat4, Vec3, Vec4};
+use serde::Serialize;
+
+use crate::gpu::GpuContext;
+use crate::gpu::frame_sequential::{CombinePass, LodBuffers};
+use crate::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use crate::gpu::gbuffer_scene::EdgeScene;
+use crate::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use crate::gpu::resources::{begin_color_pass, fullscreen_pipeline, texture_2d, uniform_buffer};
+use crate::gpu::scene::{GpuMesh, Mesh};
+use crate::reproject::new_to_old_matrix;
+use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary};
+use crate::visibility::{VisibilityPattern, visibility_texture};
+
+/// A pass timed against its baseline.
+#[derive(Clone, Debug, Serialize)]
+pub struct PassRatio {
+    /// The pass measured.
+    pub pass: String,
+    /// The baseline pass.
+    pub baseline: String,
+    /// Image size.
+    pub size: (u32, u32),
+    /// Median wall time of the pass, ms.
+    pub pass_ms: f64,
+    /// Median wall time of the baseline, ms.
+    pub baseline_ms: f64,
+    /// Median of the per-pair ratios.
+    pub ratio: f64,
+    /// Pairs timed.
+    pub pairs: usize,
+}
+
+/// Median (the upper one for even lengths); NaN when empty.
+pub fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Times `a` and `b` (each must wait for the GPU itself) in `pairs` interleaved pairs after a
+/// few warm-up rounds, alternating which goes first. Returns the medians of a, b and a/b.
+pub fn interleaved(a: &dyn Fn(), b: &dyn Fn(), pairs: usize) -> (f64, f64, f64) {
+    let time = |f: &dyn Fn()| {
+        let t = Instant::now();
+        f();
+        t.elapsed().as_secs_f64() * 1e3
+    };
+    for _ in 0..5 {
+        a();
+        b();
+    }
+    let (mut ta, mut tb, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
+    for i in 0..pairs.max(1) {
+        let (x, y) = if i % 2 == 0 {
+            let x = time(a);
+            (x, time(b))
+        } else {
+            let y = time(b);
+            (time(a), y)
+        };
+        ta.push(x);
+        tb.push(y);
+        ratio.push(x / y);
+    }
+    (median(&ta), median(&tb), median(&ratio))
+}
+
+fn plain_pass(
+    gpu: &GpuContext,
+    source: &str,
+    name: &str,
+) -> Result<wgpu::RenderPipeline, ShaderError> {
+    let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+        source,
+        file_path: name,
+        ..Default::default()
+    })?;
+    let module = gpu.shader_module(name, &composed);
+    Ok(fullscreen_pipeline(gpu, &module, FORMAT, name))
+}
+
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+const COPY4: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+@group(0) @binding(0) var a: texture_2d<f32>;
+@group(0) @binding(1) var b: texture_2d<u32>;
+@group(0) @binding(2) var c: texture_2d<f32>;
+@group(0) @binding(3) var d: texture_2d<u32>;
+@vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
+@fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
+    let p = vec2<u32>(v.position.xy);
+    let ids = textureLoad(b, p, 0).xy ^ textureLoad(d, p, 0).xy;
+    return textureLoad(a, p, 0) + textureLoad(c, p, 0) + vec4<f32>(f32(ids.x & 1u), f32(ids.y & 1u), 0.0, 0.0);
+}
+";
+
+const BILINEAR: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
+@group(0) @binding(0) var low_color: texture_2d<f32>;
+@group(0) @binding(1) var low_sampler: sampler;
+@group(0) @binding(2) var<uniform> scale: Scale;
+@vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
+@fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
+    return textureSampleLevel(low_color, low_sampler, v.uv * scale.uv_scale, 0.0);
+}
+";
+
+fn draw_fullscreen(
+    gpu: &GpuContext,
+    pipeline: &wgpu::RenderPipeline,
+    group: &wgpu::BindGroup,
+    target: &wgpu::TextureView,
+) {
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = begin_color_pass(&mut encoder, target, wgpu::Color::BLACK, "baseline");
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    gpu.wait_idle();
+}
+
+/// The combine pass against a plain pass reading the same four textures (two colors, two
+/// id/depth) at `size` x `size`, on two LOD buffers of a grid of spheres and boxes with a third
+/// of them in transition and the camera moved between the frames.
+pub fn combine_vs_copy(
+    gpu: &GpuContext,
+    size: u32,
+    pairs: usize,
+) -> Result<PassRatio, ShaderError> {
+    let buffers = LodBuffers::new(gpu, size, size, FORMAT);
+    let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
+    let renderer = LodBufferRenderer::new(gpu, FORMAT, &vis, 0.25)?;
+    let meshes = [
+        GpuMesh::new(gpu, &Mesh::sphere(16, 24)),
+        GpuMesh::new(gpu, &Mesh::cube()),
+    ];
+    let proj = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 0.1, 100.0);
+    let views = [0.0f32, 0.1]
+        .map(|x| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 3.0, 7.0), Vec3::ZERO, Vec3::Y));
+    for (i, view) in views.iter().enumerate() {
+        let items: Vec<LodDrawItem> = (0..15)
+            .map(|k| LodDrawItem {
+                mesh: &meshes[(k + i) % 2],
+                model: Mat4::from_translation(Vec3::new(
+                    (k % 5) as f32 * 2.0 - 4.0,
+                    0.0,
+                    -((k / 5) as f32) * 2.0,
+                )),
+                color: Vec4::new(0.8, 0.2, 0.2, 1.0),
+                id: if k % 3 == 0 { k as u32 + 1 } else { 0 },
+                tau: if k % 3 == 0 { 0.5 } else { 1.0 },
+            })
+            .collect();
+        renderer.render(gpu, &buffers, i, proj * *view, &items, wgpu::Color::BLACK);
+    }
+    let target = texture_2d(
+        gpu,
+        (size, size),
+        FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+        "target",
+    );
+    let target_view = target.create_view(&Default::default());
+    let combine = CombinePass::new(gpu, FORMAT, false)?;
+    let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
+    let copy4 = plain_pass(gpu, COPY4, "copy4.wgsl")?;
+    let views4 = [
+        buffers.color(1),
+        buffers.id_depth(1),
+        buffers.color(0),
+        buffers.id_depth(0),
+    ]
+    .map(|t| t.create_view(&Default::default()));
+    let entries: Vec<wgpu::BindGroupEntry> = views4
+        .iter()
+        .enumerate()
+        .map(|(i, v)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: wgpu::BindingResource::TextureView(v),
+        })
+        .collect();
+    let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &copy4.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let run_combine = || {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        combine.encode(gpu, &mut encoder, &buffers, 1, m, &target_view);
+        gpu.queue.submit([encoder.finish()]);
+        gpu.wait_idle();
+    };
+    let run_copy = || draw_fullscreen(gpu, &copy4, &group, &target_view);
+    let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs);
+    Ok(PassRatio {
+        pass: "combine (frame-sequential)".to_owned(),
+        baseline: "plain copy of the same 4 textures".to_owned(),
+        size: (size, size),
+        pass_ms,
+        baseline_ms,
+        ratio,
+        pairs,
+    })
+}
+
+/// The bilateral upsample pass against a hardware-filtered bilinear pass over the same low-res
+/// color, on the edge scene at resize factor `r`.
+pub fn upsample_vs_bilinear(
+    gpu: &GpuContext,
+    size: (u32, u32),
+    r: f32,
+    pairs: usize,
+) -> Result<PassRatio, ShaderError> {
+    let (w, h) = size;
+    let scene = EdgeScene::new(gpu, FORMAT, w as f32 / h as f32)?;
+    let full = LowResBuffer::new(gpu, w, h, FORMAT);
+    scene.render(gpu, &full, 1.0);
+    let low = LowResBuffer::new(gpu, w, h, FORMAT);
+    scene.render(gpu, &low, r);
+    let upsample = UpsamplePass::new(gpu, FORMAT)?;
+    let target = texture_2d(
+        gpu,
+        size,
+        FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+        "target",
+    );
+    let view = target.create_view(&Default::default());
+    let bilinear = plain_pass(gpu, BILINEAR, "bilinear.wgsl")?;
+    let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    });
+    let scale = uniform_buffer(gpu, 16, "scale");
+    let (vw, vh) = low.viewport(r);
+    let s = [vw as f32 / w as f32, vh as f32 / h as f32, 0.0, 0.0];
+    gpu.queue.write_buffer(&scale, 0, bytemuck::cast_slice(&s));
+    let low_view = low.color().create_view(&Default::default());
+    let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &bilinear.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&low_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Sampler(&sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: scale.as_entire_binding(),
+            },
+        ],
+    });
+    let run_bilateral = || {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        upsample.encode(
+            gpu,
+            &mut encoder,
+            &low,
+            r,
+            full.geometry(),
+            0.25,
+            0.4,
+            &view,
+        );
+        gpu.queue.submit([encoder.finish()]);
+        gpu.wait_idle();
+    };
+    let run_bilinear = || draw_fullscreen(gpu, &bilinear, &group, &view);
+    let (pass_ms, baseline_ms, ratio) = interleaved(&run_bilateral, &run_bilinear, pairs);
+    Ok(PassRatio {
+        pass: format!("bilateral upsample (r = {r})"),
+        baseline: "bilinear upsample (hardware filter)".to_owned(),
+        size,
+        pass_ms,
+        baseline_ms,
+        ratio,
+        pairs,
+    })
+}

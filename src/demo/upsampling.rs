@@ -1,0 +1,243 @@
+//! Framebuffer LOD on the edge scene: PSNR and SSIM against the full-resolution reference at
+//! several resize factors for bilinear, bilateral and fine-grained resizing, comparison sheets
+//! with difference heat maps, whole-frame speed-ups, and the framerate controllers.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::DemoError;
+use super::timing::median;
+use crate::framebuffer_lod::{
+    FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
+    RlsController, StepController, multiply_rgba8, psnr_rgba8, simulate, ssim_rgba8, step_response,
+};
+use crate::gpu::GpuContext;
+use crate::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use crate::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
+use crate::gpu::readback::read_texture_rgba8;
+use crate::gpu::resources::texture_2d;
+
+/// Resize factors the demo measures.
+pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];
+
+/// Edge-stopping parameters of the bilateral filter in the demo.
+pub const SIGMA_Z: f32 = 0.25;
+/// See [`SIGMA_Z`].
+pub const SIGMA_N: f32 = 0.4;
+
+/// Quality and speed of one resize factor.
+#[derive(Clone, Debug, Serialize)]
+pub struct UpsampleRow {
+    /// Resize factor r (the low-res buffer is 1/r of the size in each direction).
+    pub r: f32,
+    /// PSNR (dB) of bilinear, bilateral and fine-grained resizing.
+    pub psnr: [f32; 3],
+    /// SSIM of the same three.
+    pub ssim: [f32; 3],
+    /// Whole-frame speed-up over rendering at full resolution (median wall time ratio) for the
+    /// bilateral route and the fine-grained route.
+    pub speedup: [f64; 2],
+}
+
+/// Method names in the order of [`UpsampleRow::psnr`].
+pub const METHODS: [&str; 3] = ["bilinear", "bilateral", "fine-grained"];
+
+fn heat(image: &[u8], reference: &[u8]) -> Vec<u8> {
+    image
+        .chunks(4)
+        .zip(reference.chunks(4))
+        .flat_map(|(a, b)| {
+            let e = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+            let v = (u32::from(e) * 4).min(255) as u8;
+            [v, v / 3, 255 - v, 255]
+        })
+        .collect()
+}
+
+/// Renders the comparisons at `size`, writes `upsample/r<r>.png` sheets (reference, bilinear,
+/// bilateral, fine-grained on top; their |error| x 4 below), and times whole frames over
+/// `rounds` rounds.
+pub fn measure_upsampling(
+    gpu: &GpuContext,
+    size: (u32, u32),
+    rounds: usize,
+    out: &Path,
+    tick: &mut dyn FnMut(&str),
+) -> Result<Vec<UpsampleRow>, DemoError> {
+    let (w, h) = size;
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
+    let full = LowResBuffer::new(gpu, w, h, format);
+    scene.render(gpu, &full, 1.0);
+    let reference = read_texture_rgba8(gpu, full.color());
+    let low = LowResBuffer::new(gpu, w, h, format);
+    let albedo = LowResBuffer::new(gpu, w, h, format);
+    let upsample = UpsamplePass::new(gpu, format)?;
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target = texture_2d(gpu, size, format, usage, "upsampled");
+    let view = target.create_view(&Default::default());
+    let upsample_with = |r: f32, sz: f32, sn: f32| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        upsample.encode(gpu, &mut encoder, &low, r, full.geometry(), sz, sn, &view);
+        gpu.queue.submit([encoder.finish()]);
+    };
+    let mut rows = Vec::new();
+    for r in RESIZE_FACTORS {
+        scene.render(gpu, &low, r);
+        upsample_with(r, f32::INFINITY, f32::INFINITY);
+        let bilinear = read_texture_rgba8(gpu, &target);
+        upsample_with(r, SIGMA_Z, SIGMA_N);
+        let bilateral = read_texture_rgba8(gpu, &target);
+        // Fine-grained: only the lighting goes through the low-res buffer; albedo at full res.
+        scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
+        upsample_with(r, SIGMA_Z, SIGMA_N);
+        let lighting = read_texture_rgba8(gpu, &target);
+        scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
+        let fine = multiply_rgba8(&lighting, &read_texture_rgba8(gpu, albedo.color()));
+        let images = [bilinear, bilateral, fine];
+        let psnr = images.clone().map(|i| psnr_rgba8(&i, &reference));
+        let ssim = images.clone().map(|i| ssim_rgba8(&i, &reference, w));
+        let mut sheet = image::RgbaImage::new(w * 4, h * 2);
+        let mut tiles = vec![(0, 0, reference.clone())];
+        for (k, img) in images.iter().enumerate() {
+            tiles.push((k as u32 + 1, 0, img.clone()));
+            tiles.push((k as u32 + 1, 1, heat(img, &reference)));
+        }
+        for (x, y, pixels) in tiles {
+            let tile = image::RgbaImage::from_raw(w, h, pixels)
+                .ok_or_else(|| DemoError::Internal("tile of the wrong size".to_owned()))?;
+            image::imageops::replace(&mut sheet, &tile, i64::from(x * w), i64::from(y * h));
+        }
+        super::save(&sheet, &out.join(format!("upsample/r{r}.png")))?;
+        rows.push(UpsampleRow {
+            r,
+            psnr,
+            ssim,
+            speedup: [0.0; 2],
+        });
+        tick(&format!("r = {r}"));
+    }
+    // Whole frames: full-res render vs low-res render + upsample (+ full-res albedo for the
+    // fine-grained route), interleaved round by round.
+    let time = |f: &dyn Fn()| {
+        let t = std::time::Instant::now();
+        f();
+        gpu.wait_idle();
+        t.elapsed().as_secs_f64() * 1e3
+    };
+    let mut base = Vec::new();
+    let mut times = vec![[Vec::new(), Vec::new()]; RESIZE_FACTORS.len()];
+    for round in 0..rounds + 2 {
+        let t0 = time(&|| scene.render(gpu, &full, 1.0));
+        let mut ts = Vec::new();
+        for &r in &RESIZE_FACTORS {
+            let a = time(&|| {
+                scene.render(gpu, &low, r);
+                upsample_with(r, SIGMA_Z, SIGMA_N);
+            });
+            let b = time(&|| {
+                scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
+                upsample_with(r, SIGMA_Z, SIGMA_N);
+                scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
+            });
+            ts.push([a, b]);
+        }
+        if round >= 2 {
+            base.push(t0);
+            for (k, t) in ts.into_iter().enumerate() {
+                times[k][0].push(t[0]);
+                times[k][1].push(t[1]);
+            }
+        }
+    }
+    let base = median(&base);
+    for (row, t) in rows.iter_mut().zip(&times) {
+        row.speedup = [base / median(&t[0]), base / median(&t[1])];
+    }
+    tick("timing");
+    Ok(rows)
+}
+
+/// One controller under a workload step.
+#[derive(Clone, Debug, Serialize)]
+pub struct ControllerRow {
+    /// Controller.
+    pub name: String,
+    /// Median frames to settle within 5 % of the target after the step (None: never).
+    pub settling_frames: Option<f32>,
+    /// Median overshoot (fraction of the target).
+    pub overshoot: f32,
+    /// Median spread after settling (fraction of the target).
+    pub spread: f32,
+    /// Frame times of seed 1 over the whole run (ms), for the plot.
+    pub curve: Vec<f32>,
+}
+
+/// Frame-time target of the controller simulation (ms).
+pub const TARGET_MS: f32 = 16.7;
+/// Frames in the controller simulation; the workload doubles over frames 60..160.
+pub const CONTROLLER_FRAMES: usize = 220;
+
+fn controllers() -> Vec<(&'static str, Box<dyn ResizeController>)> {
+    let limits = ResizeLimits::default();
+    vec![
+        ("fixed r = 1.6", Box::new(FixedController { r: 1.6 })),
+        (
+            "paper (calibrated K)",
+            Box::new(PaperController::new(TARGET_MS, 40.0, limits)),
+        ),
+        (
+            "lodkit (online K, C)",
+            Box::new(RlsController::new(TARGET_MS, limits)),
+        ),
+        (
+            "step heuristic",
+            Box::new(StepController::new(TARGET_MS, limits)),
+        ),
+    ]
+}
+
+/// Simulates the controllers (t = K workload / r^2 + C + 3 % noise, K = 40 ms, C = 3 ms) with
+/// the workload doubling at frame 60 and back at 160; medians over `seeds` noise seeds.
+pub fn measure_controllers(seeds: u64) -> Vec<ControllerRow> {
+    let model = FrameTimeModel {
+        k: 40.0,
+        c: 3.0,
+        noise: 0.03,
+    };
+    let workload = |f: usize| if (60..160).contains(&f) { 2.0 } else { 1.0 };
+    let median32 = |v: &mut Vec<f32>| {
+        v.sort_by(f32::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f32::NAN)
+    };
+    let names: Vec<&str> = controllers().iter().map(|c| c.0).collect();
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            let (mut settle, mut over, mut spread) = (Vec::new(), Vec::new(), Vec::new());
+            for seed in 0..seeds.max(1) {
+                let mut c = controllers().swap_remove(i).1;
+                let frames = simulate(c.as_mut(), &model, workload, 160, seed);
+                let s = step_response(&frames, 60, TARGET_MS, 0.05);
+                settle.push(s.settling_frames.map_or(f32::INFINITY, |s| s as f32));
+                over.push(s.overshoot);
+                spread.push(s.spread);
+            }
+            let mut c = controllers().swap_remove(i).1;
+            let curve = simulate(c.as_mut(), &model, workload, CONTROLLER_FRAMES, 1)
+                .iter()
+                .map(|f| f.measured)
+                .collect();
+            let s = median32(&mut settle);
+            ControllerRow {
+                name: (*name).to_owned(),
+                settling_frames: s.is_finite().then_some(s),
+                overshoot: median32(&mut over),
+                spread: median32(&mut spread),
+                curve,
+            }
+        })
+        .collect()
+}
