@@ -7,28 +7,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use lodkit::shaders::{self, ComposeDescriptor, ExportOptions, ExportTarget, ShaderLibrary};
-
-const USER_SHADER: &str = "#import lodkit::normal_distance::foreshortened_normal_distance
-#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
-
-@vertex
-fn vs(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
-
-@fragment
-fn fs(v: FullscreenVertex) -> @location(0) vec4<f32> {
-    return vec4<f32>(foreshortened_normal_distance(vec3(v.uv, 1.0), vec3(0.0, 0.0, 1.0)));
-}
-";
+use lodkit::demo::cpu::{USER_SHADER, compose_user_shader};
+use lodkit::shaders::{self, ExportOptions, ExportTarget, ShaderLibrary};
 
 fn compose(library: &mut ShaderLibrary) -> shaders::Composed {
-    library
-        .compose(&ComposeDescriptor {
-            source: USER_SHADER,
-            file_path: "user.wgsl",
-            ..Default::default()
-        })
-        .expect("composes")
+    compose_user_shader(library).expect("composes")
 }
 
 fn benches(c: &mut Criterion) {

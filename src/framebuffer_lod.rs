@@ -488,7 +488,7 @@ pub fn multiply_rgba8(a: &[u8], b: &[u8]) -> Vec<u8> {
 pub fn ssim_rgba8(a: &[u8], b: &[u8], width: u32) -> f32 {
     const WIN: usize = 8;
     let w = width as usize;
-    if a.len() != b.len() || w < WIN || a.len() % (4 * w) != 0 || a.len() / (4 * w) < WIN {
+    if a.len() != b.len() || w < WIN || !a.len().is_multiple_of(4 * w) || a.len() / (4 * w) < WIN {
         return f32::NAN;
     }
     let h = a.len() / (4 * w);

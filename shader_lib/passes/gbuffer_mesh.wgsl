@@ -4,7 +4,9 @@
 //
 // The shading has a high-frequency but smooth term (a procedural stripe pattern in object space
 // over Lambert lighting), the kind of detail resizing blurs and bilateral upsampling keeps from
-// bleeding across silhouettes and creases.
+// bleeding across silhouettes and creases. `camera.light_dir.w` adds synthetic shading cost: that
+// many directions of a smooth sky term (0: a constant ambient), standing in for the expensive,
+// low-frequency shading that framebuffer LOD saves.
 //
 // Entry points:
 //   vs_main   @location(0) position, @location(1) normal (object space)
@@ -22,7 +24,7 @@
 struct GCamera {
     view_proj: mat4x4<f32>,
     view: mat4x4<f32>,
-    /// World-space direction toward the light (w unused).
+    /// xyz: world-space direction toward the light; w: sky directions to sum (0: none).
     light_dir: vec4<f32>,
 }
 
@@ -56,7 +58,14 @@ fn fs_main(in: VertexOut) -> GBufferOutput {
     let n = normalize(in.world_normal);
     let lambert = max(dot(n, normalize(camera.light_dir.xyz)), 0.0);
     let stripes = 0.5 + 0.5 * sin(18.0 * (in.object_pos.x + in.object_pos.y));
-    let lighting = vec3<f32>(0.3 + 0.7 * lambert);
+    let work = u32(max(camera.light_dir.w, 0.0));
+    var sky = 0.0;
+    for (var k = 0u; k < work; k++) {
+        let a = f32(k) * 2.399963;
+        sky += max(dot(n, normalize(vec3<f32>(cos(a), 1.0, sin(a)))), 0.0);
+    }
+    let ambient = select(0.3, 0.45 * sky / f32(max(work, 1u)), work > 0u);
+    let lighting = vec3<f32>(ambient + 0.7 * lambert);
     let albedo = draw.color.rgb * (0.6 + 0.4 * stripes);
 #ifdef GBUFFER_MESH_LIGHTING_ONLY
     let color = lighting;

@@ -10,6 +10,7 @@
 //! # Ok::<(), lodkit::demo::DemoError>(())
 //! ```
 
+pub mod cpu;
 pub mod plots;
 pub mod render;
 pub mod report;
@@ -146,6 +147,8 @@ pub struct DemoReport {
     pub pass_ratios: Vec<timing::PassRatio>,
     /// Framerate controllers.
     pub controllers: Vec<upsampling::ControllerRow>,
+    /// Host-side figures (composition, selection).
+    pub cpu: Vec<cpu::CpuFigure>,
     /// Whether the plots have text (a font was found).
     pub plot_text: bool,
     /// Wall time of the whole run, seconds.
@@ -263,8 +266,9 @@ pub fn run_on(
         timing::upsample_vs_bilinear(gpu, options.size, 2.0, options.timing_pairs)?,
     ];
     bar.inc(1);
-    bar.set_message("controllers");
+    bar.set_message("controllers and host-side figures");
     let controllers = upsampling::measure_controllers(50);
+    let cpu = cpu::cpu_figures(15)?;
     bar.inc(1);
     let info = gpu.adapter.get_info();
     let now = std::time::SystemTime::now()
@@ -283,6 +287,7 @@ pub fn run_on(
         upsampling,
         pass_ratios,
         controllers,
+        cpu,
         plot_text: plots::plot_font().is_some(),
         seconds: 0.0,
     };

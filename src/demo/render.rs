@@ -370,13 +370,11 @@ impl<'a> SceneRenderer<'a> {
             self.combine
                 .encode(gpu, &mut encoder, &self.buffers, index, m, &target);
             gpu.queue.submit([encoder.finish()]);
-            if frame == middle {
-                if let Some(f) = on_sources.as_mut() {
-                    let newer = read_lod_image(gpu, &self.buffers, index);
-                    let older = read_lod_image(gpu, &self.buffers, 1 - index);
-                    let sources = combine_images(&newer, &older, &m, DepthConvention::Standard);
-                    f(sources.iter().map(|p| p.source).collect());
-                }
+            if let Some(f) = on_sources.as_mut().filter(|_| frame == middle) {
+                let newer = read_lod_image(gpu, &self.buffers, index);
+                let older = read_lod_image(gpu, &self.buffers, 1 - index);
+                let sources = combine_images(&newer, &older, &m, DepthConvention::Standard);
+                f(sources.iter().map(|p| p.source).collect());
             }
             if wanted(frame) {
                 // The combine pass shades every pixel once more.

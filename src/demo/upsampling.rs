@@ -21,6 +21,11 @@ use crate::gpu::resources::texture_2d;
 /// Resize factors the demo measures.
 pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];
 
+/// Synthetic shading work of the edge scene in the demo (sky directions per fragment): the
+/// expensive low-frequency shading framebuffer LOD is meant for (Yang et al. measure heavy pixel
+/// shaders). The scene costs little to shade without it.
+pub const SHADING_WORK: u32 = 64;
+
 /// Edge-stopping parameters of the bilateral filter in the demo.
 pub const SIGMA_Z: f32 = 0.25;
 /// See [`SIGMA_Z`].
@@ -67,7 +72,8 @@ pub fn measure_upsampling(
 ) -> Result<Vec<UpsampleRow>, DemoError> {
     let (w, h) = size;
     let format = wgpu::TextureFormat::Rgba8Unorm;
-    let scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
+    let mut scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
+    scene.set_shading_work(SHADING_WORK);
     let full = LowResBuffer::new(gpu, w, h, format);
     scene.render(gpu, &full, 1.0);
     let reference = read_texture_rgba8(gpu, full.color());

@@ -21,7 +21,8 @@ pub struct GCameraUniform {
     pub view_proj: [[f32; 4]; 4],
     /// World to view.
     pub view: [[f32; 4]; 4],
-    /// World-space direction toward the light.
+    /// xyz: world-space direction toward the light; w: synthetic shading work (sky directions
+    /// summed per fragment, 0 = none).
     pub light_dir: [f32; 4],
 }
 
@@ -66,6 +67,7 @@ pub struct GBufferRenderer {
     camera_group: wgpu::BindGroup,
     draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
+    shading_work: u32,
 }
 
 impl GBufferRenderer {
@@ -116,7 +118,15 @@ impl GBufferRenderer {
             camera_group,
             draws,
             draw_group,
+            shading_work: 0,
         })
+    }
+
+    /// Sets the synthetic shading work per fragment: `n` directions of a smooth sky term (0, the
+    /// default: a constant ambient). It stands in for expensive low-frequency shading when
+    /// measuring what framebuffer LOD saves.
+    pub fn set_shading_work(&mut self, n: u32) {
+        self.shading_work = n;
     }
 
     /// Renders `items` into `target` at resize factor `r` (the viewport shrinks with r; the
@@ -136,7 +146,9 @@ impl GBufferRenderer {
         let camera = GCameraUniform {
             view_proj: (proj * view).to_cols_array_2d(),
             view: view.to_cols_array_2d(),
-            light_dir: Vec3::new(0.5, 0.8, 0.4).extend(0.0).to_array(),
+            light_dir: Vec3::new(0.5, 0.8, 0.4)
+                .extend(self.shading_work as f32)
+                .to_array(),
         };
         gpu.queue
             .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
@@ -192,6 +204,13 @@ impl EdgeScene {
             cube: GpuMesh::new(gpu, &super::scene::Mesh::cube()),
             aspect,
         })
+    }
+
+    /// Sets the synthetic shading work of every term (see [`GBufferRenderer::set_shading_work`]).
+    pub fn set_shading_work(&mut self, n: u32) {
+        for r in &mut self.renderers {
+            r.set_shading_work(n);
+        }
     }
 
     /// Renders the full shading into `target` at resize factor `r`.
