@@ -135,6 +135,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect(),
         markers: false,
         reference: None,
+        y_from_zero: false,
     };
     line_chart(&file, &chart)?;
     println!("wrote {}", file.display());

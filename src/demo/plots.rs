@@ -33,6 +33,8 @@ pub struct Chart {
     pub markers: bool,
     /// A horizontal reference line (e.g. a frame-time target).
     pub reference: Option<f32>,
+    /// Start the y axis at 0 (else at the smallest value, with a margin).
+    pub y_from_zero: bool,
 }
 
 const FONT_CANDIDATES: [&str; 6] = [
@@ -77,7 +79,7 @@ pub fn line_chart(path: &Path, chart: &Chart) -> Result<(), DemoError> {
     }
     let text = plot_font().is_some();
     let points = chart.series.iter().flat_map(|s| s.points.iter());
-    let (mut x0, mut x1, mut y0, mut y1) = (f32::MAX, f32::MIN, 0.0f32, f32::MIN);
+    let (mut x0, mut x1, mut y0, mut y1) = (f32::MAX, f32::MIN, f32::MAX, f32::MIN);
     for &(x, y) in points.filter(|p| p.0.is_finite() && p.1.is_finite()) {
         x0 = x0.min(x);
         x1 = x1.max(x);
@@ -85,15 +87,24 @@ pub fn line_chart(path: &Path, chart: &Chart) -> Result<(), DemoError> {
         y1 = y1.max(y);
     }
     if let Some(r) = chart.reference {
+        y0 = y0.min(r);
         y1 = y1.max(r);
     }
     if x0 >= x1 {
-        (x0, x1) = (0.0, 1.0);
+        (x0, x1) = (x0.min(0.0), x0.max(0.0) + 1.0);
     }
-    if y1 <= y0 {
-        y1 = y0 + 1.0;
+    if y0 > y1 {
+        (y0, y1) = (0.0, 1.0);
     }
-    let y1 = y1 + (y1 - y0) * 0.08;
+    let pad = ((y1 - y0) * 0.08).max(1e-3);
+    let y0 = if chart.y_from_zero {
+        y0.min(0.0)
+    } else {
+        y0 - pad
+    };
+    let y1 = y1 + pad;
+    let xpad = if chart.markers { (x1 - x0) * 0.04 } else { 0.0 };
+    let (x0, x1) = (x0 - xpad, x1 + xpad);
     let root = BitMapBackend::new(path, (900, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(plot_error)?;
     let mut builder = ChartBuilder::on(&root);

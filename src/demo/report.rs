@@ -48,6 +48,7 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
                 series,
                 markers: false,
                 reference: None,
+                y_from_zero: true,
             };
             line_chart(
                 &out.join(format!("plots/change-{scene}-{camera}.png")),
@@ -71,6 +72,7 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
             series: by_r,
             markers: true,
             reference: None,
+            y_from_zero: false,
         },
     )?;
     let by_speed = [(1usize, 0usize), (2, 1)]
@@ -92,6 +94,7 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
             series: by_speed,
             markers: true,
             reference: None,
+            y_from_zero: false,
         },
     )?;
     let curves = report
@@ -116,6 +119,7 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
             series: curves,
             markers: false,
             reference: Some(TARGET_MS),
+            y_from_zero: true,
         },
     )
 }

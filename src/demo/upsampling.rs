@@ -61,8 +61,8 @@ fn heat(image: &[u8], reference: &[u8]) -> Vec<u8> {
 }
 
 /// Renders the comparisons at `size`, writes `upsample/r<r>.png` sheets (reference, bilinear,
-/// bilateral, fine-grained on top; their |error| x 4 below), and times whole frames over
-/// `rounds` rounds.
+/// bilateral, fine-grained on top; their |error| x 4 below, blue none, red 64/255 or more), and
+/// times whole frames over `rounds` rounds.
 pub fn measure_upsampling(
     gpu: &GpuContext,
     size: (u32, u32),
@@ -104,7 +104,7 @@ pub fn measure_upsampling(
         let images = [bilinear, bilateral, fine];
         let psnr = images.clone().map(|i| psnr_rgba8(&i, &reference));
         let ssim = images.clone().map(|i| ssim_rgba8(&i, &reference, w));
-        let mut sheet = image::RgbaImage::new(w * 4, h * 2);
+        let mut sheet = image::RgbaImage::from_pixel(w * 4, h * 2, image::Rgba([24, 24, 32, 255]));
         let mut tiles = vec![(0, 0, reference.clone())];
         for (k, img) in images.iter().enumerate() {
             tiles.push((k as u32 + 1, 0, img.clone()));
