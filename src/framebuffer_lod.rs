@@ -476,7 +476,9 @@ pub fn multiply_rgba8(a: &[u8], b: &[u8]) -> Vec<u8> {
 /// Mean structural similarity (SSIM, Wang et al. 2004) of two RGBA8 images of `width` pixels per
 /// row, on luma (Rec. 601) over 8x8 windows every 4 pixels, with the usual constants
 /// (K1 = 0.01, K2 = 0.03, L = 255): 1 for equal images, lower as structure differs. NaN when
-/// the sizes differ or the images are smaller than one window.
+/// the sizes differ or the images are smaller than one window. The windows are uniform (not
+/// Gaussian) and use population variances, so figures differ slightly from reference
+/// implementations with an 11x11 Gaussian.
 ///
 /// ```
 /// # use lodkit::framebuffer_lod::ssim_rgba8;
@@ -484,6 +486,11 @@ pub fn multiply_rgba8(a: &[u8], b: &[u8]) -> Vec<u8> {
 /// assert!((ssim_rgba8(&a, &a, 16) - 1.0).abs() < 1e-6);
 /// let flat = vec![128u8; a.len()];
 /// assert!(ssim_rgba8(&a, &flat, 16) < 0.2);
+/// // Two flat grays: no structure, only the luminance term (2 ma mb + C1) / (ma^2 + mb^2 + C1).
+/// let (g100, g150) = (vec![100u8; 16 * 16 * 4], vec![150u8; 16 * 16 * 4]);
+/// let c1 = (0.01f64 * 255.0).powi(2);
+/// let expected = (2.0 * 100.0 * 150.0 + c1) / (100.0f64.powi(2) + 150.0f64.powi(2) + c1);
+/// assert!((f64::from(ssim_rgba8(&g100, &g150, 16)) - expected).abs() < 1e-4);
 /// ```
 pub fn ssim_rgba8(a: &[u8], b: &[u8], width: u32) -> f32 {
     const WIN: usize = 8;

@@ -96,7 +96,7 @@ enum Command {
         /// A RON scene to measure instead of the built-in ones.
         #[arg(long)]
         scene: Option<PathBuf>,
-        /// Interleaved pairs per pass-time ratio.
+        /// Interleaved pairs per pass-time ratio (a quarter of it: whole-frame timing rounds).
         #[arg(long, default_value_t = 40)]
         pairs: usize,
         /// Also write benchmarks.md and quality.md into this folder (e.g. `docs`).
@@ -174,9 +174,10 @@ fn demo(options: lodkit::demo::DemoOptions) -> ExitCode {
         Err(e) => {
             eprintln!("error: {e}");
             match e {
-                DemoError::Options(_) | DemoError::Scene(_) | DemoError::Io { .. } => {
-                    ExitCode::from(2)
-                }
+                DemoError::Options(_)
+                | DemoError::Scene(_)
+                | DemoError::Io { .. }
+                | DemoError::Plot(_) => ExitCode::from(2),
                 _ => ExitCode::from(1),
             }
         }

@@ -38,12 +38,30 @@ pub struct DemoOptions {
     pub frames: usize,
     /// A RON scene to measure instead of the built-in ones.
     pub scene: Option<PathBuf>,
-    /// Interleaved pairs per pass-time ratio and rounds of whole-frame timing.
+    /// Interleaved pairs per pass-time ratio (1..=10000); a quarter of it (at least 3) is the
+    /// number of rounds of whole-frame timing.
     pub timing_pairs: usize,
     /// Folder to write `benchmarks.md` and `quality.md` into.
     pub docs: Option<PathBuf>,
     /// Show a progress bar on the terminal.
     pub progress: bool,
+}
+
+impl DemoOptions {
+    /// The `lodkit demo` command line that runs these options.
+    pub fn command_line(&self) -> String {
+        let mut s = format!(
+            "lodkit demo --size {}x{} --frames {} --pairs {}",
+            self.size.0, self.size.1, self.frames, self.timing_pairs
+        );
+        if let Some(scene) = &self.scene {
+            s.push_str(&format!(" --scene {}", scene.display()));
+        }
+        if let Some(docs) = &self.docs {
+            s.push_str(&format!(" --docs {}", docs.display()));
+        }
+        s
+    }
 }
 
 impl Default for DemoOptions {
@@ -131,6 +149,8 @@ pub struct DemoReport {
     pub device_type: String,
     /// UTC date of the run, YYYY-MM-DD.
     pub date: String,
+    /// The command line that reproduces the run.
+    pub command: String,
     /// Image size.
     pub size: (u32, u32),
     /// Transition length in frames.
@@ -155,6 +175,9 @@ pub struct DemoReport {
     pub seconds: f64,
 }
 
+/// The most memory the frames of one run may take.
+pub const MAX_FRAME_MEMORY_MIB: u64 = 2048;
+
 fn check_options(o: &DemoOptions) -> Result<(), DemoError> {
     let (w, h) = o.size;
     if !(64..=4096).contains(&w) || !(64..=4096).contains(&h) {
@@ -165,6 +188,22 @@ fn check_options(o: &DemoOptions) -> Result<(), DemoError> {
     if !(4..=600).contains(&o.frames) {
         return Err(DemoError::Options(format!(
             "--frames {}: must be within 4..=600",
+            o.frames
+        )));
+    }
+    if !(1..=10_000).contains(&o.timing_pairs) {
+        return Err(DemoError::Options(format!(
+            "--pairs {}: must be within 1..=10000",
+            o.timing_pairs
+        )));
+    }
+    // A moving-camera reference run is kept whole (RGBA8 frames).
+    let frames = o.frames as u64 + 2 * render::LEAD_FRAMES as u64 + 1;
+    let mib = (u64::from(w) * u64::from(h) * 4 * frames) >> 20;
+    if mib > MAX_FRAME_MEMORY_MIB {
+        return Err(DemoError::Options(format!(
+            "--size {w}x{h} with --frames {} keeps {mib} MiB of frames, more than \
+             {MAX_FRAME_MEMORY_MIB} MiB: lower one of them",
             o.frames
         )));
     }
@@ -234,7 +273,7 @@ pub fn run_on(
     let mut counter = String::new();
     for scene in scenes {
         scene.check().map_err(|message| SceneError::Invalid {
-            path: scene.name.clone(),
+            path: format!("scene `{}`", scene.name),
             message,
         })?;
         bar.set_message(format!("scene {}", scene.name));
@@ -267,7 +306,7 @@ pub fn run_on(
     ];
     bar.inc(1);
     bar.set_message("controllers and host-side figures");
-    let controllers = upsampling::measure_controllers(50);
+    let controllers = upsampling::measure_controllers(upsampling::CONTROLLER_SEEDS);
     let cpu = cpu::cpu_figures(15)?;
     bar.inc(1);
     let info = gpu.adapter.get_info();
@@ -279,6 +318,7 @@ pub fn run_on(
         backend: format!("{:?}", info.backend),
         device_type: format!("{:?}", info.device_type),
         date: utc_date(now),
+        command: options.command_line(),
         size: options.size,
         frames: options.frames,
         counter,

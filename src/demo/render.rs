@@ -317,7 +317,6 @@ impl<'a> SceneRenderer<'a> {
             .iter()
             .map(|_| scheduler.insert(0))
             .collect();
-        let seconds = self.frames as f32 / 30.0;
         let clear = match spec.background {
             Background::Scene => CLEAR,
             Background::Flat(c) => c,
@@ -328,12 +327,18 @@ impl<'a> SceneRenderer<'a> {
             if frame > 0 {
                 scheduler.advance(1.0 / 30.0);
             }
-            if frame == LEAD_FRAMES && spec.transition {
-                for (o, key) in self.scene.objects.iter().zip(&keys) {
-                    if o.transition {
-                        // A fresh scheduler has ids to spare: this cannot fail.
-                        let _ = scheduler.begin_transition(*key, 1, Drive::Time { seconds });
-                    }
+            // Progress is set from the frame number, exactly as the single-frame techniques
+            // get it (a time drive sums dt and could end a frame late).
+            for (o, key) in self.scene.objects.iter().zip(&keys) {
+                if !(o.transition && spec.transition) {
+                    continue;
+                }
+                // A fresh scheduler has ids to spare and the keys are live: these cannot fail.
+                if frame == LEAD_FRAMES {
+                    let _ = scheduler.begin_transition(*key, 1, Drive::Progress);
+                }
+                if frame >= LEAD_FRAMES {
+                    let _ = scheduler.set_progress(*key, self.progress(frame));
                 }
             }
             let (view, proj) = self.camera(frame, spec.moving);

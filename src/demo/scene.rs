@@ -24,6 +24,9 @@ use crate::gpu::scene::Mesh;
 /// The most objects a scene may have (each transition draws two items per object).
 pub const MAX_OBJECTS: usize = 100;
 
+/// The most triangles a scene may have, counting both LODs of every object.
+pub const MAX_TRIANGLES: u64 = 4_000_000;
+
 /// A scene of the transition harness.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -140,6 +143,18 @@ impl Shape {
         }
     }
 
+    /// Triangles of the shape's mesh, without building it.
+    pub fn triangles(self) -> u64 {
+        let sphere = |rings: u32, segments: u32| 2 * u64::from(rings) * u64::from(segments);
+        match self {
+            Shape::Sphere { rings, segments } => sphere(rings.max(2), segments.max(3)),
+            Shape::Cube => 12,
+            Shape::Tree { puffs, rings } => {
+                12 + u64::from(puffs) * sphere(rings.max(2), rings.saturating_mul(2).max(3))
+            }
+        }
+    }
+
     fn check(self) -> Result<(), String> {
         match self {
             Shape::Sphere { rings, segments } if !(2..=256).contains(&rings) => Err(format!(
@@ -246,14 +261,32 @@ impl DemoScene {
         if !finite(&c.eye) || !finite(&c.target) || !finite(&c.moving_eye) {
             return Err("camera: eye, target and moving_eye must be finite".to_owned());
         }
-        if Vec3::from(c.eye) == Vec3::from(c.target)
-            || Vec3::from(c.moving_eye) == Vec3::from(c.target)
-        {
-            return Err("camera: the eye must not sit on the target".to_owned());
+        let target = Vec3::from(c.target);
+        for (field, eye) in [("eye", c.eye), ("moving_eye", c.moving_eye)] {
+            let dir = target - Vec3::from(eye);
+            if dir.length() < 1e-3 || dir.normalize().cross(Vec3::Y).length() < 1e-3 {
+                return Err(format!(
+                    "camera.{field} = {eye:?} looks straight up or down at the target (or sits \
+                     on it): the camera's up axis is +Y"
+                ));
+            }
+        }
+        // The moving camera goes along the segment from eye to moving_eye.
+        let (a, b) = (Vec3::from(c.eye), Vec3::from(c.moving_eye));
+        let s = ((target - a).dot(b - a) / (b - a).length_squared().max(1e-12)).clamp(0.0, 1.0);
+        let closest = a.lerp(b, s);
+        let dir = target - closest;
+        if dir.length() < 1e-3 || dir.normalize().cross(Vec3::Y).length() < 1e-3 {
+            return Err(format!(
+                "camera: the path from eye to moving_eye passes through the target or straight \
+                 above or below it (at {:?})",
+                closest.to_array()
+            ));
         }
         if !(c.fov_y > 0.01 && c.fov_y < 3.1) {
             return Err(format!("camera.fov_y = {} is outside (0.01, 3.1)", c.fov_y));
         }
+        let mut triangles = 0u64;
         for (i, o) in self.objects.iter().enumerate() {
             let at = |m: String| format!("objects[{i}].{m}");
             o.fine.check().map_err(|m| at(format!("fine: {m}")))?;
@@ -264,6 +297,7 @@ impl DemoScene {
             if !o.scale.iter().all(|s| s.is_finite() && *s > 0.0) {
                 return Err(at(format!("scale = {:?} must be > 0", o.scale)));
             }
+            triangles += o.fine.triangles() + o.coarse.triangles();
             for (field, rgb) in [
                 ("fine_color", o.fine_color),
                 ("coarse_color", o.coarse_color),
@@ -272,6 +306,12 @@ impl DemoScene {
                     return Err(at(format!("{field} = {rgb:?} is outside 0..=1")));
                 }
             }
+        }
+        if triangles > MAX_TRIANGLES {
+            return Err(format!(
+                "objects: {triangles} triangles over both LODs of every object, at most \
+                 {MAX_TRIANGLES}"
+            ));
         }
         Ok(())
     }

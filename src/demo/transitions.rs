@@ -28,13 +28,14 @@ pub struct TransitionMetrics {
     pub see_through: f32,
     /// Triangles submitted over the transition, relative to a hard switch.
     pub triangles_vs_hard: f64,
-    /// Counted fragments over the transition, relative to a hard switch.
-    pub fragments_vs_hard: f64,
+    /// Counted fragments over the transition, relative to a hard switch (None when the
+    /// adapter's counter is not a count).
+    pub fragments_vs_hard: Option<f64>,
     /// Triangles submitted over the transition.
     pub triangles: u64,
     /// Counted fragments over the transition (frame-sequential: plus one per pixel for the
-    /// combine pass).
-    pub fragments: u64,
+    /// combine pass); None when the adapter's counter is not a count.
+    pub fragments: Option<u64>,
     /// Per-frame change attributable to the transition, static camera (mean |delta| per channel,
     /// 0..1), from frame 1 on.
     pub change_static: Vec<f32>,
@@ -87,8 +88,9 @@ fn strip_frames(renderer: &SceneRenderer) -> Vec<usize> {
 }
 
 /// Runs `technique` with the static or moving camera, with and without transition, and returns
-/// the per-frame change, the frames of the strip, and triangles and fragments over the
-/// transition.
+/// the per-frame change and triangles and fragments over the transition, drawing the strip into
+/// `images`. Only the reference run of a moving camera is kept whole (a frame-sequential run
+/// cannot be interleaved with another); the transition run streams.
 fn change_run(
     gpu: &GpuContext,
     renderer: &SceneRenderer,
@@ -98,46 +100,77 @@ fn change_run(
     size: (u32, u32),
 ) -> Result<(Vec<f32>, u64, u64), DemoError> {
     let all = |_: usize| true;
-    let mut frames: Vec<Frame> = Vec::new();
     let spec = RunSpec {
         technique,
         moving,
         transition: true,
         background: Background::Scene,
     };
-    renderer.run(gpu, spec, &all, &mut |_, f| frames.push(f), None);
-    let mut reference: Vec<Frame> = Vec::new();
-    let spec = RunSpec {
+    let reference_spec = RunSpec {
         transition: false,
         ..spec
     };
+    let mut reference: Vec<Vec<u8>> = Vec::new();
     if moving {
-        renderer.run(gpu, spec, &all, &mut |_, f| reference.push(f), None);
+        renderer.run(
+            gpu,
+            reference_spec,
+            &all,
+            &mut |_, f| reference.push(f.pixels),
+            None,
+        );
     } else {
         // A static camera without transition renders the same picture every frame.
         let first = |f: usize| f == 0;
-        renderer.run(gpu, spec, &first, &mut |_, f| reference.push(f), None);
-        let one = reference[0].clone();
-        reference.resize(frames.len(), one);
+        renderer.run(
+            gpu,
+            reference_spec,
+            &first,
+            &mut |_, f| reference.push(f.pixels),
+            None,
+        );
     }
-    let change = (1..frames.len())
-        .map(|f| {
-            transition_change(
-                &frames[f - 1].pixels,
-                &frames[f].pixels,
-                &reference[f - 1].pixels,
-                &reference[f].pixels,
-            )
-        })
-        .collect();
+    let reference_at = |f: usize| reference.get(f).or(reference.last());
     let span = LEAD_FRAMES..=LEAD_FRAMES + renderer.transition_frames();
-    let triangles = frames[span.clone()].iter().map(|f| f.triangles).sum();
-    let fragments = frames[span].iter().map(|f| f.fragments).sum();
-    for (slot, f) in strip_frames(renderer).into_iter().enumerate() {
-        let tile = to_image(size, frames[f].pixels.clone())?;
-        image::imageops::replace(&mut images.strip, &tile, i64::from(slot as u32 * size.0), 0);
+    let strip = strip_frames(renderer);
+    let (mut change, mut triangles, mut fragments) = (Vec::new(), 0u64, 0u64);
+    let mut previous: Option<Vec<u8>> = None;
+    let mut failed = None;
+    renderer.run(
+        gpu,
+        spec,
+        &all,
+        &mut |f, frame: Frame| {
+            if let (Some(prev), Some(r0), Some(r1)) = (
+                &previous,
+                reference_at(f.saturating_sub(1)),
+                reference_at(f),
+            ) {
+                change.push(transition_change(prev, &frame.pixels, r0, r1));
+            }
+            if span.contains(&f) {
+                triangles += frame.triangles;
+                fragments += frame.fragments;
+            }
+            if let Some(slot) = strip.iter().position(|&s| s == f) {
+                match to_image(size, frame.pixels.clone()) {
+                    Ok(tile) => image::imageops::replace(
+                        &mut images.strip,
+                        &tile,
+                        i64::from(slot as u32 * size.0),
+                        0,
+                    ),
+                    Err(e) => failed = Some(e),
+                }
+            }
+            previous = Some(frame.pixels);
+        },
+        None,
+    );
+    match failed {
+        Some(e) => Err(e),
+        None => Ok((change, triangles, fragments)),
     }
-    Ok((change, triangles, fragments))
 }
 
 /// See-through at the middle frame: renders it over black and over white scenery; interior
@@ -213,6 +246,7 @@ pub fn measure_scene(
     tick: &mut dyn FnMut(&str),
 ) -> Result<Vec<TransitionMetrics>, DemoError> {
     let masks = renderer.lod_masks(gpu);
+    let counts = renderer.counter().kind().is_count();
     let mut rows: Vec<TransitionMetrics> = Vec::new();
     for technique in Technique::ALL {
         let name = technique.name();
@@ -263,9 +297,9 @@ pub fn measure_scene(
             pop_moving: pop(&moving_change),
             see_through: share,
             triangles_vs_hard: 0.0,
-            fragments_vs_hard: 0.0,
+            fragments_vs_hard: None,
             triangles: cost.0,
-            fragments: cost.1,
+            fragments: counts.then_some(cost.1),
             change_static: static_change,
             change_moving: moving_change,
         });
@@ -274,11 +308,11 @@ pub fn measure_scene(
     let hard = rows
         .iter()
         .find(|r| r.technique == "hard-switch")
-        .map(|r| (r.triangles.max(1), r.fragments.max(1)));
+        .map(|r| (r.triangles.max(1), r.fragments.map(|f| f.max(1))));
     if let Some((t, f)) = hard {
         for r in &mut rows {
             r.triangles_vs_hard = r.triangles as f64 / t as f64;
-            r.fragments_vs_hard = r.fragments as f64 / f as f64;
+            r.fragments_vs_hard = r.fragments.zip(f).map(|(a, b)| a as f64 / b as f64);
         }
     }
     Ok(rows)

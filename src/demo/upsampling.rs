@@ -124,8 +124,24 @@ pub fn measure_upsampling(
         });
         tick(&format!("r = {r}"));
     }
-    // Whole frames: full-res render vs low-res render + upsample (+ full-res albedo for the
-    // fine-grained route), interleaved round by round.
+    // Whole frames, interleaved round by round: full-res shading against a full-res geometry
+    // prepass (with the cheap albedo) + low-res shading + upsample, and against the fine-grained
+    // route (low-res lighting + full-res albedo, which writes the geometry too, + upsample).
+    let prepass = LowResBuffer::new(gpu, w, h, format);
+    let upsample_from = |r: f32, geometry: &wgpu::Texture| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        upsample.encode(
+            gpu,
+            &mut encoder,
+            &low,
+            r,
+            geometry,
+            SIGMA_Z,
+            SIGMA_N,
+            &view,
+        );
+        gpu.queue.submit([encoder.finish()]);
+    };
     let time = |f: &dyn Fn()| {
         let t = std::time::Instant::now();
         f();
@@ -139,13 +155,14 @@ pub fn measure_upsampling(
         let mut ts = Vec::new();
         for &r in &RESIZE_FACTORS {
             let a = time(&|| {
+                scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo);
                 scene.render(gpu, &low, r);
-                upsample_with(r, SIGMA_Z, SIGMA_N);
+                upsample_from(r, prepass.geometry());
             });
             let b = time(&|| {
-                scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
-                upsample_with(r, SIGMA_Z, SIGMA_N);
                 scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
+                scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
+                upsample_from(r, albedo.geometry());
             });
             ts.push([a, b]);
         }
@@ -179,6 +196,9 @@ pub struct ControllerRow {
     /// Frame times of seed 1 over the whole run (ms), for the plot.
     pub curve: Vec<f32>,
 }
+
+/// Noise seeds the controller medians are taken over.
+pub const CONTROLLER_SEEDS: u64 = 50;
 
 /// Frame-time target of the controller simulation (ms).
 pub const TARGET_MS: f32 = 16.7;

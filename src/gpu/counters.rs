@@ -9,11 +9,16 @@ use super::readback::read_buffer;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CounterKind {
     /// Fragment-shader invocations (pipeline statistics query): every fragment shaded,
-    /// including the ones a dither discards or the depth test rejects late.
+    /// including the ones a dither discards or the depth test rejects late, and, as the driver
+    /// counts them, helper invocations (lavapipe: 12.5 % over the pixel count of a fullscreen
+    /// triangle).
     FragmentInvocations,
-    /// Samples that passed the depth test (occlusion query). On GL backends this may be a
-    /// yes/no answer rather than a count.
+    /// Samples that passed the depth test (occlusion query). wgpu does not ask Vulkan for
+    /// precise occlusion queries, so a driver may round (lavapipe counts exactly).
     SamplesPassed,
+    /// Whether any sample passed (occlusion query on wgpu's GL backend, which only answers
+    /// yes or no): not a count.
+    AnySamplesPassed,
 }
 
 impl CounterKind {
@@ -22,7 +27,13 @@ impl CounterKind {
         match self {
             Self::FragmentInvocations => "fragment-shader invocations (pipeline statistics)",
             Self::SamplesPassed => "samples passed (occlusion query)",
+            Self::AnySamplesPassed => "none: the GL backend's occlusion query only says yes or no",
         }
+    }
+
+    /// Whether the reading is a count (false for [`CounterKind::AnySamplesPassed`]).
+    pub fn is_count(self) -> bool {
+        self != Self::AnySamplesPassed
     }
 }
 
@@ -49,6 +60,8 @@ impl FragmentCounter {
                     wgpu::PipelineStatisticsTypes::FRAGMENT_SHADER_INVOCATIONS,
                 ),
             )
+        } else if gpu.adapter.get_info().backend == wgpu::Backend::Gl {
+            (CounterKind::AnySamplesPassed, wgpu::QueryType::Occlusion)
         } else {
             (CounterKind::SamplesPassed, wgpu::QueryType::Occlusion)
         };
@@ -74,14 +87,14 @@ impl FragmentCounter {
     /// The query set to put in `RenderPassDescriptor::occlusion_query_set` (only for occlusion
     /// counting; `None` otherwise).
     pub fn occlusion_query_set(&self) -> Option<&wgpu::QuerySet> {
-        (self.kind == CounterKind::SamplesPassed).then_some(&self.set)
+        (self.kind != CounterKind::FragmentInvocations).then_some(&self.set)
     }
 
     /// Starts counting in `pass` (call once per pass, before the draws).
     pub fn begin(&self, pass: &mut wgpu::RenderPass<'_>) {
         match self.kind {
             CounterKind::FragmentInvocations => pass.begin_pipeline_statistics_query(&self.set, 0),
-            CounterKind::SamplesPassed => pass.begin_occlusion_query(0),
+            _ => pass.begin_occlusion_query(0),
         }
     }
 
@@ -89,7 +102,7 @@ impl FragmentCounter {
     pub fn end(&self, pass: &mut wgpu::RenderPass<'_>) {
         match self.kind {
             CounterKind::FragmentInvocations => pass.end_pipeline_statistics_query(),
-            CounterKind::SamplesPassed => pass.end_occlusion_query(),
+            _ => pass.end_occlusion_query(),
         }
     }
 
