@@ -308,28 +308,13 @@ const FLAT: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_ve
 @fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> { return vec4<f32>(v.uv, 0.0, 1.0); }
 ";
 
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
 /// Counts one fullscreen triangle over a `w` x `h` target.
 fn count_fullscreen(gpu: &lodkit::gpu::GpuContext, w: u32, h: u32) -> (CounterKind, u64) {
-    use lodkit::gpu::resources::{fullscreen_pipeline, texture_2d};
-    use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
-    let format = wgpu::TextureFormat::Rgba8Unorm;
-    let composed = ShaderLibrary::new()
-        .unwrap()
-        .compose(&ComposeDescriptor {
-            source: FLAT,
-            file_path: "flat.wgsl",
-            ..Default::default()
-        })
-        .unwrap();
-    let module = gpu.shader_module("flat", &composed);
-    let pipeline = fullscreen_pipeline(gpu, &module, format, "flat");
-    let target = texture_2d(
-        gpu,
-        (w, h),
-        format,
-        wgpu::TextureUsages::RENDER_ATTACHMENT,
-        "t",
-    );
+    let pipeline = lodkit::demo::timing::plain_pass(gpu, FLAT, "flat.wgsl").unwrap();
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    let target = lodkit::gpu::resources::texture_2d(gpu, (w, h), FORMAT, usage, "t");
     let view = target.create_view(&Default::default());
     let counter = FragmentCounter::new(gpu);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());

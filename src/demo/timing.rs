@@ -74,7 +74,9 @@ pub fn interleaved(a: &dyn Fn(), b: &dyn Fn(), pairs: usize) -> (f64, f64, f64) 
     (median(&ta), median(&tb), median(&ratio))
 }
 
-fn plain_pass(
+/// A fullscreen pipeline (`vs_main`, `fs_main`, RGBA8 target) from WGSL `source` that may
+/// import lodkit modules; `name` labels it and names the file in errors.
+pub fn plain_pass(
     gpu: &GpuContext,
     source: &str,
     name: &str,
