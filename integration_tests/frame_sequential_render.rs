@@ -85,6 +85,7 @@ fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
                 b: 0.1,
                 a: 1.0,
             },
+            None,
         );
     }
     let newer = scheduler.buffer_index();

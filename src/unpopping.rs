@@ -53,6 +53,16 @@ pub struct LodRenderState {
     pub blend: bool,
 }
 
+impl LodRenderState {
+    /// Drawn opaque: depth-tested, writing depth, not blended.
+    pub const OPAQUE: LodRenderState = LodRenderState {
+        alpha: 1.0,
+        depth_test: true,
+        depth_write: true,
+        blend: false,
+    };
+}
+
 /// Which of the two LODs of a transition.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LodRole {
@@ -84,13 +94,6 @@ impl TransitionPlan {
     }
 }
 
-const OPAQUE: LodRenderState = LodRenderState {
-    alpha: 1.0,
-    depth_test: true,
-    depth_write: true,
-    blend: false,
-};
-
 fn blended(alpha: f32) -> LodRenderState {
     LodRenderState {
         alpha,
@@ -112,7 +115,7 @@ fn blended(alpha: f32) -> LodRenderState {
 pub fn unpopping_plan(t: f32) -> TransitionPlan {
     let state = |incoming| {
         if unpopping_is_opaque(t, incoming) {
-            OPAQUE
+            LodRenderState::OPAQUE
         } else {
             blended(unpopping_alpha(t, incoming))
         }

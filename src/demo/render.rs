@@ -240,12 +240,6 @@ impl<'a> SceneRenderer<'a> {
     ) -> Frame {
         let (view, proj) = self.camera(frame, spec.moving);
         let t = self.progress(frame);
-        let opaque = LodRenderState {
-            alpha: 1.0,
-            depth_test: true,
-            depth_write: true,
-            blend: false,
-        };
         let mut items: Vec<DrawItem> = Vec::new();
         let mut blended: Vec<(f32, DrawItem)> = Vec::new();
         for (i, o) in self.scene.objects.iter().enumerate() {
@@ -256,7 +250,7 @@ impl<'a> SceneRenderer<'a> {
                     mesh: fine.0,
                     model,
                     color: fine.1,
-                    state: opaque,
+                    state: LodRenderState::OPAQUE,
                     dither_alpha: None,
                 });
                 continue;
@@ -284,7 +278,7 @@ impl<'a> SceneRenderer<'a> {
             Background::Scene => CLEAR,
             Background::Flat(c) => c,
         };
-        let fragments = self.single[usize::from(blue)].render_counted(
+        let fragments = self.single[usize::from(blue)].render(
             gpu,
             &self.target,
             color(clear),
@@ -358,7 +352,7 @@ impl<'a> SceneRenderer<'a> {
                 })
                 .collect();
             let index = scheduler.buffer_index();
-            let (triangles, fragments) = renderer.render_counted(
+            let (triangles, fragments) = renderer.render(
                 gpu,
                 &self.buffers,
                 index,
@@ -405,12 +399,6 @@ impl<'a> SceneRenderer<'a> {
     pub fn lod_masks(&self, gpu: &GpuContext) -> [Vec<bool>; 2] {
         let (view, proj) = self.camera(LEAD_FRAMES + self.frames / 2, false);
         [0usize, 1].map(|lod| {
-            let opaque = LodRenderState {
-                alpha: 1.0,
-                depth_test: true,
-                depth_write: true,
-                blend: false,
-            };
             let items: Vec<DrawItem> = self
                 .scene
                 .objects
@@ -422,7 +410,7 @@ impl<'a> SceneRenderer<'a> {
                         mesh: &self.meshes[i][k],
                         model: self.scene.model(i),
                         color: if o.transition { Vec4::ONE } else { Vec4::ZERO },
-                        state: opaque,
+                        state: LodRenderState::OPAQUE,
                         dither_alpha: None,
                     }
                 })
@@ -434,6 +422,7 @@ impl<'a> SceneRenderer<'a> {
                 proj * view,
                 LIGHT,
                 &items,
+                None,
             );
             read_texture_rgba8(gpu, &self.target.color)
                 .chunks(4)

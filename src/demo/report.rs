@@ -136,114 +136,199 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
     )
 }
 
+/// A table of the report, written as Markdown (docs) or HTML (`index.html`).
+struct Table {
+    header: &'static [&'static str],
+    rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    fn markdown(&self) -> String {
+        let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
+        let header: Vec<String> = self.header.iter().map(|h| h.to_string()).collect();
+        let mut s = line(&header);
+        s.push_str(&line(&vec!["---".to_owned(); header.len()]));
+        for r in &self.rows {
+            s.push_str(&line(r));
+        }
+        s
+    }
+
+    fn html(&self) -> String {
+        let mut s = String::from("<table>\n<tr>");
+        for h in self.header {
+            let _ = write!(s, "<th>{}</th>", esc(h));
+        }
+        s.push_str("</tr>\n");
+        for r in &self.rows {
+            s.push_str("<tr>");
+            for cell in r {
+                let _ = write!(s, "<td>{}</td>", esc(cell));
+            }
+            s.push_str("</tr>\n");
+        }
+        s.push_str("</table>\n");
+        s
+    }
+}
+
+/// The transition metrics of `scene`: quality (pop, see-through) or cost.
+fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
+    let rows = report.transitions.iter().filter(|t| t.scene == scene);
+    if cost {
+        Table {
+            header: &[
+                "technique",
+                "triangles",
+                "vs hard switch",
+                "fragments",
+                "vs hard switch",
+            ],
+            rows: rows
+                .map(|t| {
+                    vec![
+                        t.technique.clone(),
+                        t.triangles.to_string(),
+                        format!("{:.3}x", t.triangles_vs_hard),
+                        t.fragments.map_or("n/a".to_owned(), |f| f.to_string()),
+                        times(t.fragments_vs_hard),
+                    ]
+                })
+                .collect(),
+        }
+    } else {
+        Table {
+            header: &["technique", "pop (static)", "pop (moving)", "see-through"],
+            rows: rows
+                .map(|t| {
+                    vec![
+                        t.technique.clone(),
+                        format!("{:.3}", t.pop_static),
+                        format!("{:.3}", t.pop_moving),
+                        pct(t.see_through),
+                    ]
+                })
+                .collect(),
+        }
+    }
+}
+
 /// Markdown tables of the transition metrics, one per scene.
 fn transition_tables(report: &DemoReport, cost: bool) -> String {
     let mut s = String::new();
     for scene in &report.scenes {
         let _ = writeln!(s, "\n### Scene `{scene}`\n");
-        if cost {
-            s.push_str("| technique | triangles | vs hard switch | fragments | vs hard switch |\n|---|---|---|---|---|\n");
-        } else {
-            s.push_str(
-                "| technique | pop (static) | pop (moving) | see-through |\n|---|---|---|---|\n",
-            );
-        }
-        for t in report.transitions.iter().filter(|t| &t.scene == scene) {
-            if cost {
-                let _ = writeln!(
-                    s,
-                    "| {} | {} | {:.3}x | {} | {} |",
-                    t.technique,
-                    t.triangles,
-                    t.triangles_vs_hard,
-                    t.fragments.map_or("n/a".to_owned(), |f| f.to_string()),
-                    times(t.fragments_vs_hard)
-                );
-            } else {
-                let _ = writeln!(
-                    s,
-                    "| {} | {:.3} | {:.3} | {} |",
-                    t.technique,
-                    t.pop_static,
-                    t.pop_moving,
-                    pct(t.see_through)
-                );
-            }
-        }
+        s.push_str(&transition_table(report, scene, cost).markdown());
     }
     s
 }
 
-fn upsample_table(report: &DemoReport) -> String {
-    let mut s = String::from(
-        "| r | PSNR bilinear | PSNR bilateral | PSNR fine-grained | SSIM bilinear | SSIM bilateral | SSIM fine-grained |\n|---|---|---|---|---|---|---|\n",
-    );
-    for u in &report.upsampling {
-        let _ = writeln!(
-            s,
-            "| {} | {:.2} dB | {:.2} dB | {:.2} dB | {:.4} | {:.4} | {:.4} |",
-            u.r, u.psnr[0], u.psnr[1], u.psnr[2], u.ssim[0], u.ssim[1], u.ssim[2]
-        );
+fn upsample_table(report: &DemoReport) -> Table {
+    Table {
+        header: &[
+            "r",
+            "PSNR bilinear",
+            "PSNR bilateral",
+            "PSNR fine-grained",
+            "SSIM bilinear",
+            "SSIM bilateral",
+            "SSIM fine-grained",
+        ],
+        rows: report
+            .upsampling
+            .iter()
+            .map(|u| {
+                let mut row = vec![u.r.to_string()];
+                row.extend(u.psnr.iter().map(|p| format!("{p:.2} dB")));
+                row.extend(u.ssim.iter().map(|v| format!("{v:.4}")));
+                row
+            })
+            .collect(),
     }
-    s
 }
 
-fn speed_table(report: &DemoReport) -> String {
-    let mut s = String::from(
-        "| r | whole frame, bilateral route | whole frame, fine-grained route |\n|---|---|---|\n",
-    );
-    for u in &report.upsampling {
-        let _ = writeln!(
-            s,
-            "| {} | {:.2}x | {:.2}x |",
-            u.r, u.speedup[0], u.speedup[1]
-        );
+fn speed_table(report: &DemoReport) -> Table {
+    Table {
+        header: &[
+            "r",
+            "whole frame, bilateral route",
+            "whole frame, fine-grained route",
+        ],
+        rows: report
+            .upsampling
+            .iter()
+            .map(|u| {
+                let mut row = vec![u.r.to_string()];
+                row.extend(u.speedup.iter().map(|x| format!("{x:.2}x")));
+                row
+            })
+            .collect(),
     }
-    s
 }
 
-fn ratio_table(report: &DemoReport) -> String {
-    let mut s = String::from(
-        "| pass | baseline | size | pass ms | baseline ms | median ratio | pairs |\n|---|---|---|---|---|---|---|\n",
-    );
-    for p in &report.pass_ratios {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {}x{} | {:.3} | {:.3} | {:.3} | {} |",
-            p.pass, p.baseline, p.size.0, p.size.1, p.pass_ms, p.baseline_ms, p.ratio, p.pairs
-        );
+fn ratio_table(report: &DemoReport) -> Table {
+    Table {
+        header: &[
+            "pass",
+            "baseline",
+            "size",
+            "pass ms",
+            "baseline ms",
+            "median ratio",
+            "pairs",
+        ],
+        rows: report
+            .pass_ratios
+            .iter()
+            .map(|p| {
+                vec![
+                    p.pass.clone(),
+                    p.baseline.clone(),
+                    format!("{}x{}", p.size.0, p.size.1),
+                    format!("{:.3}", p.pass_ms),
+                    format!("{:.3}", p.baseline_ms),
+                    format!("{:.3}", p.ratio),
+                    p.pairs.to_string(),
+                ]
+            })
+            .collect(),
     }
-    s
 }
 
-fn controller_table(report: &DemoReport) -> String {
-    let mut s =
-        String::from("| controller | settling frames | overshoot | spread |\n|---|---|---|---|\n");
-    for c in &report.controllers {
-        let settle = c
-            .settling_frames
-            .map_or("never".to_owned(), |f| format!("{f}"));
-        let _ = writeln!(
-            s,
-            "| {} | {settle} | {} | {} |",
-            c.name,
-            pct(c.overshoot),
-            pct(c.spread)
-        );
+fn controller_table(report: &DemoReport) -> Table {
+    Table {
+        header: &["controller", "settling frames", "overshoot", "spread"],
+        rows: report
+            .controllers
+            .iter()
+            .map(|c| {
+                vec![
+                    c.name.clone(),
+                    c.settling_frames
+                        .map_or("never".to_owned(), |f| format!("{f}")),
+                    pct(c.overshoot),
+                    pct(c.spread),
+                ]
+            })
+            .collect(),
     }
-    s
 }
 
-fn cpu_table(report: &DemoReport) -> String {
-    let mut s = String::from("| what | median | runs |\n|---|---|---|\n");
-    for c in &report.cpu {
-        let _ = writeln!(
-            s,
-            "| {} | {:.2} {} | {} |",
-            c.what, c.median, c.unit, c.runs
-        );
+fn cpu_table(report: &DemoReport) -> Table {
+    Table {
+        header: &["what", "median", "runs"],
+        rows: report
+            .cpu
+            .iter()
+            .map(|c| {
+                vec![
+                    c.what.clone(),
+                    format!("{:.2} {}", c.median, c.unit),
+                    c.runs.to_string(),
+                ]
+            })
+            .collect(),
     }
-    s
 }
 
 fn header(report: &DemoReport, what: &str) -> String {
@@ -283,49 +368,32 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
         q,
         "Edge scene with synthetic shading work (a smooth sky term summed over {SHADING_WORK} directions per fragment, the expensive low-frequency shading framebuffer LOD is for), full-resolution frame as reference; bilateral sigma_z = {SIGMA_Z}, sigma_n = {SIGMA_N}; fine-grained resizing sends only the lighting through the low-res buffer and multiplies by full-resolution albedo.\n"
     );
-    q.push_str(&upsample_table(report));
+    q.push_str(&upsample_table(report).markdown());
     q.push_str("\n## Framerate control\n\nSimulated frame time t = K workload / r^2 + C with 3 % noise (K = 40 ms, C = 3 ms), ");
     let _ = writeln!(
         q,
         "target {TARGET_MS} ms, workload doubling at frame 60; medians over {CONTROLLER_SEEDS} seeds.\n"
     );
-    q.push_str(&controller_table(report));
+    q.push_str(&controller_table(report).markdown());
     write(&docs.join("quality.md"), &q)?;
     let mut b = header(report, "Benchmarks");
     b.push_str("\n## Cost of a transition\n\nTriangles submitted and fragments counted over the transition's frames, static camera. Frame-sequential adds one fullscreen combine pass (one fragment per pixel, included).\n");
     b.push_str(&transition_tables(report, true));
     b.push_str("\n## Pass time ratios\n\nEach pass against the plainest pass with the same memory traffic, timed in interleaved pairs; the figure is the median of the per-pair ratios.\n\n");
-    b.push_str(&ratio_table(report));
+    b.push_str(&ratio_table(report).markdown());
     b.push_str("\n## Framebuffer LOD: whole-frame speed-up\n\n");
     let _ = writeln!(
         b,
         "Median wall time of a full-resolution frame over a framebuffer-LOD frame: the full-resolution geometry prepass the upsampling needs (depth and normals, with the cheap albedo), the low-res shading pass and the upsample pass (fine-grained: the low-res lighting pass, the full-resolution albedo pass that also writes the geometry, and the upsample). Edge scene with {SHADING_WORK} sky directions of shading work per fragment.\n"
     );
-    b.push_str(&speed_table(report));
+    b.push_str(&speed_table(report).markdown());
     b.push_str("\n## Host side (CPU)\n\nMedians of repeated runs in the same process (the machine's CPU, not the GPU). The criterion benches measure the same workloads more thoroughly: `cargo bench --bench compose`, `cargo bench --bench select`; `cargo bench --bench combine` and `--bench upsample` print the pass ratios above on their own.\n\n");
-    b.push_str(&cpu_table(report));
+    b.push_str(&cpu_table(report).markdown());
     write(&docs.join("benchmarks.md"), &b)
 }
 
 fn img(src: &str, alt: &str) -> String {
     format!("<figure><img src=\"{src}\" alt=\"{alt}\"><figcaption>{alt}</figcaption></figure>\n")
-}
-
-fn md_table_to_html(md: &str) -> String {
-    let mut s = String::from("<table>\n");
-    for (i, line) in md.lines().filter(|l| l.starts_with('|')).enumerate() {
-        if i == 1 {
-            continue;
-        }
-        let tag = if i == 0 { "th" } else { "td" };
-        s.push_str("<tr>");
-        for cell in line.trim_matches('|').split('|') {
-            let _ = write!(s, "<{tag}>{}</{tag}>", esc(&cell.trim().replace('`', "")));
-        }
-        s.push_str("</tr>\n");
-    }
-    s.push_str("</table>\n");
-    s
 }
 
 /// Writes `report.json` and `index.html` into `out`.
@@ -357,22 +425,8 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
             .iter()
             .filter(|t| &t.scene == scene)
             .collect();
-        let mut md = String::from(
-            "| technique | pop (static) | pop (moving) | see-through | triangles vs hard | fragments vs hard |\n|---|---|---|---|---|---|\n",
-        );
-        for t in &rows {
-            let _ = writeln!(
-                md,
-                "| {} | {:.3} | {:.3} | {} | {:.3}x | {} |",
-                t.technique,
-                t.pop_static,
-                t.pop_moving,
-                pct(t.see_through),
-                t.triangles_vs_hard,
-                times(t.fragments_vs_hard)
-            );
-        }
-        h.push_str(&md_table_to_html(&md));
+        h.push_str(&transition_table(report, scene, false).html());
+        h.push_str(&transition_table(report, scene, true).html());
         for camera in ["static", "moving"] {
             h.push_str(&img(
                 &format!("plots/change-{scene}-{camera}.png"),
@@ -403,8 +457,8 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
         }
     }
     h.push_str("<h2>Framebuffer LOD</h2>\n");
-    h.push_str(&md_table_to_html(&upsample_table(report)));
-    h.push_str(&md_table_to_html(&speed_table(report)));
+    h.push_str(&upsample_table(report).html());
+    h.push_str(&speed_table(report).html());
     h.push_str(&img(
         "plots/psnr-vs-r.png",
         "PSNR against the resize factor",
@@ -423,11 +477,11 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
         ));
     }
     h.push_str("<h2>Pass time ratios</h2>\n");
-    h.push_str(&md_table_to_html(&ratio_table(report)));
+    h.push_str(&ratio_table(report).html());
     h.push_str("<h2>Host side (CPU)</h2>\n");
-    h.push_str(&md_table_to_html(&cpu_table(report)));
+    h.push_str(&cpu_table(report).html());
     h.push_str("<h2>Framerate control</h2>\n");
-    h.push_str(&md_table_to_html(&controller_table(report)));
+    h.push_str(&controller_table(report).html());
     h.push_str(&img(
         "plots/controllers.png",
         "frame time of each controller",

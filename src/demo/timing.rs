@@ -9,12 +9,15 @@ use std::time::Instant;
 use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
 
+use super::upsampling::{SIGMA_N, SIGMA_Z};
 use crate::gpu::GpuContext;
 use crate::gpu::frame_sequential::{CombinePass, LodBuffers};
 use crate::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use crate::gpu::gbuffer_scene::EdgeScene;
 use crate::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
-use crate::gpu::resources::{begin_color_pass, fullscreen_pipeline, texture_2d, uniform_buffer};
+use crate::gpu::resources::{
+    begin_color_pass, fullscreen_pipeline, texture_2d, textures_and_uniform, uniform_buffer,
+};
 use crate::gpu::scene::{GpuMesh, Mesh};
 use crate::reproject::new_to_old_matrix;
 use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary};
@@ -46,14 +49,17 @@ pub fn median(v: &[f64]) -> f64 {
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
+/// Wall time of `f` in milliseconds.
+pub fn wall_ms(f: &dyn Fn()) -> f64 {
+    let t = Instant::now();
+    f();
+    t.elapsed().as_secs_f64() * 1e3
+}
+
 /// Times `a` and `b` (each must wait for the GPU itself) in `pairs` interleaved pairs after a
 /// few warm-up rounds, alternating which goes first. Returns the medians of a, b and a/b.
 pub fn interleaved(a: &dyn Fn(), b: &dyn Fn(), pairs: usize) -> (f64, f64, f64) {
-    let time = |f: &dyn Fn()| {
-        let t = Instant::now();
-        f();
-        t.elapsed().as_secs_f64() * 1e3
-    };
+    let time = wall_ms;
     for _ in 0..5 {
         a();
         b();
@@ -165,7 +171,15 @@ pub fn combine_vs_copy(
                 tau: if k % 3 == 0 { 0.5 } else { 1.0 },
             })
             .collect();
-        renderer.render(gpu, &buffers, i, proj * *view, &items, wgpu::Color::BLACK);
+        renderer.render(
+            gpu,
+            &buffers,
+            i,
+            proj * *view,
+            &items,
+            wgpu::Color::BLACK,
+            None,
+        );
     }
     let target = texture_2d(
         gpu,
@@ -178,26 +192,14 @@ pub fn combine_vs_copy(
     let combine = CombinePass::new(gpu, FORMAT, false)?;
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
     let copy4 = plain_pass(gpu, COPY4, "copy4.wgsl")?;
-    let views4 = [
+    let textures = [
         buffers.color(1),
         buffers.id_depth(1),
         buffers.color(0),
         buffers.id_depth(0),
-    ]
-    .map(|t| t.create_view(&Default::default()));
-    let entries: Vec<wgpu::BindGroupEntry> = views4
-        .iter()
-        .enumerate()
-        .map(|(i, v)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: wgpu::BindingResource::TextureView(v),
-        })
-        .collect();
-    let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &copy4.get_bind_group_layout(0),
-        entries: &entries,
-    });
+    ];
+    let layout = copy4.get_bind_group_layout(0);
+    let group = textures_and_uniform(gpu, &layout, &textures, None, "copy4");
     let run_combine = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         combine.encode(gpu, &mut encoder, &buffers, 1, m, &target_view);
@@ -277,8 +279,8 @@ pub fn upsample_vs_bilinear(
             &low,
             r,
             full.geometry(),
-            0.25,
-            0.4,
+            SIGMA_Z,
+            SIGMA_N,
             &view,
         );
         gpu.queue.submit([encoder.finish()]);

@@ -71,11 +71,6 @@ pub fn pop(change: &[f32]) -> f32 {
     change.iter().copied().fold(0.0, f32::max) / total
 }
 
-/// Images of one technique's run, written by [`measure_scene`].
-struct Images {
-    strip: image::RgbaImage,
-}
-
 fn to_image(size: (u32, u32), pixels: Vec<u8>) -> Result<image::RgbaImage, DemoError> {
     image::RgbaImage::from_raw(size.0, size.1, pixels)
         .ok_or_else(|| DemoError::Internal("frame of the wrong size".to_owned()))
@@ -87,75 +82,90 @@ fn strip_frames(renderer: &SceneRenderer) -> Vec<usize> {
     (0..7).map(|k| LEAD_FRAMES + (k * n + 3) / 6).collect()
 }
 
-/// Runs `technique` with the static or moving camera, with and without transition, and returns
-/// the per-frame change and triangles and fragments over the transition, drawing the strip into
-/// `images`. Only the reference run of a moving camera is kept whole (a frame-sequential run
-/// cannot be interleaved with another); the transition run streams.
-fn change_run(
+/// The frames of a run without transition, which camera motion is measured against: every frame
+/// for the moving camera, the one picture of the static camera. All single-frame techniques
+/// draw the same frames without a transition (the fine LOD, opaque), and so do both
+/// frame-sequential patterns, so one run per family and camera serves them all.
+fn reference_run(
     gpu: &GpuContext,
     renderer: &SceneRenderer,
     technique: Technique,
     moving: bool,
-    images: &mut Images,
+) -> Vec<Vec<u8>> {
+    let spec = RunSpec {
+        technique,
+        moving,
+        transition: false,
+        background: Background::Scene,
+    };
+    let wanted = |f: usize| moving || f == 0;
+    let mut frames = Vec::new();
+    renderer.run(gpu, spec, &wanted, &mut |_, f| frames.push(f.pixels), None);
+    frames
+}
+
+/// What one transition run measured.
+struct TransitionRun {
+    change: Vec<f32>,
+    triangles: u64,
+    fragments: u64,
+    strip: image::RgbaImage,
+    sources: Option<Vec<PixelSource>>,
+}
+
+/// Runs `technique` with the static or moving camera against `reference` (see
+/// [`reference_run`]), streaming: the per-frame change, triangles and fragments over the
+/// transition, the strip, and for frame-sequential the combine rule of the middle frame.
+fn transition_run(
+    gpu: &GpuContext,
+    renderer: &SceneRenderer,
+    technique: Technique,
+    moving: bool,
+    reference: &[Vec<u8>],
     size: (u32, u32),
-) -> Result<(Vec<f32>, u64, u64), DemoError> {
-    let all = |_: usize| true;
+) -> Result<TransitionRun, DemoError> {
     let spec = RunSpec {
         technique,
         moving,
         transition: true,
         background: Background::Scene,
     };
-    let reference_spec = RunSpec {
-        transition: false,
-        ..spec
-    };
-    let mut reference: Vec<Vec<u8>> = Vec::new();
-    if moving {
-        renderer.run(
-            gpu,
-            reference_spec,
-            &all,
-            &mut |_, f| reference.push(f.pixels),
-            None,
-        );
-    } else {
-        // A static camera without transition renders the same picture every frame.
-        let first = |f: usize| f == 0;
-        renderer.run(
-            gpu,
-            reference_spec,
-            &first,
-            &mut |_, f| reference.push(f.pixels),
-            None,
-        );
-    }
     let reference_at = |f: usize| reference.get(f).or(reference.last());
     let span = LEAD_FRAMES..=LEAD_FRAMES + renderer.transition_frames();
-    let strip = strip_frames(renderer);
-    let (mut change, mut triangles, mut fragments) = (Vec::new(), 0u64, 0u64);
+    let strip_at = strip_frames(renderer);
+    let mut run = TransitionRun {
+        change: Vec::new(),
+        triangles: 0,
+        fragments: 0,
+        strip: image::RgbaImage::new(size.0 * 7, size.1),
+        sources: None,
+    };
     let mut previous: Option<Vec<u8>> = None;
     let mut failed = None;
+    let mut sources = None;
+    let mut on_sources = |s| sources = Some(s);
+    let frame_sequential = matches!(technique, Technique::FrameSequential(_));
     renderer.run(
         gpu,
         spec,
-        &all,
+        &|_| true,
         &mut |f, frame: Frame| {
             if let (Some(prev), Some(r0), Some(r1)) = (
                 &previous,
                 reference_at(f.saturating_sub(1)),
                 reference_at(f),
             ) {
-                change.push(transition_change(prev, &frame.pixels, r0, r1));
+                run.change
+                    .push(transition_change(prev, &frame.pixels, r0, r1));
             }
             if span.contains(&f) {
-                triangles += frame.triangles;
-                fragments += frame.fragments;
+                run.triangles += frame.triangles;
+                run.fragments += frame.fragments;
             }
-            if let Some(slot) = strip.iter().position(|&s| s == f) {
+            if let Some(slot) = strip_at.iter().position(|&s| s == f) {
                 match to_image(size, frame.pixels.clone()) {
                     Ok(tile) => image::imageops::replace(
-                        &mut images.strip,
+                        &mut run.strip,
                         &tile,
                         i64::from(slot as u32 * size.0),
                         0,
@@ -165,11 +175,12 @@ fn change_run(
             }
             previous = Some(frame.pixels);
         },
-        None,
+        (frame_sequential && moving).then_some(&mut on_sources as &mut dyn FnMut(Vec<PixelSource>)),
     );
+    run.sources = sources;
     match failed {
         Some(e) => Err(e),
-        None => Ok((change, triangles, fragments)),
+        None => Ok(run),
     }
 }
 
@@ -248,46 +259,40 @@ pub fn measure_scene(
     let masks = renderer.lod_masks(gpu);
     let counts = renderer.counter().kind().is_count();
     let mut rows: Vec<TransitionMetrics> = Vec::new();
+    // Reference runs of the current technique family (single-frame or frame-sequential),
+    // static and moving camera.
+    let mut references: Option<(bool, [Vec<Vec<u8>>; 2])> = None;
     for technique in Technique::ALL {
         let name = technique.name();
+        let family = matches!(technique, Technique::FrameSequential(_));
+        if references.as_ref().is_none_or(|(f, _)| *f != family) {
+            drop(references.take()); // frees the other family's frames first
+            let runs = [false, true].map(|moving| reference_run(gpu, renderer, technique, moving));
+            references = Some((family, runs));
+        }
+        let Some((_, reference)) = &references else {
+            return Err(DemoError::Internal("no reference run".to_owned()));
+        };
         let mut changes = Vec::new();
         let mut cost = (0, 0);
-        for moving in [false, true] {
-            let mut images = Images {
-                strip: image::RgbaImage::new(size.0 * 7, size.1),
-            };
-            let (change, tris, frags) =
-                change_run(gpu, renderer, technique, moving, &mut images, size)?;
+        for (moving, reference) in [false, true].into_iter().zip(reference) {
+            let run = transition_run(gpu, renderer, technique, moving, reference, size)?;
             let camera = if moving { "moving" } else { "static" };
             super::save(
-                &images.strip,
+                &run.strip,
                 &out.join(format!("strips/{scene}-{name}-{camera}.png")),
             )?;
-            if !moving {
-                cost = (tris, frags);
+            if let Some(sources) = &run.sources {
+                let img = sources_image(size, sources);
+                super::save(&img, &out.join(format!("sources/{scene}-{name}.png")))?;
             }
-            changes.push(change);
+            if !moving {
+                cost = (run.triangles, run.fragments);
+            }
+            changes.push(run.change);
         }
         let (share, map) = see_through(gpu, renderer, technique, &masks, size)?;
         super::save(&map, &out.join(format!("see-through/{scene}-{name}.png")))?;
-        if let Technique::FrameSequential(_) = technique {
-            let spec = RunSpec {
-                technique,
-                moving: true,
-                transition: true,
-                background: Background::Scene,
-            };
-            let mut sources = Vec::new();
-            renderer.run(
-                gpu,
-                spec,
-                &|_| false,
-                &mut |_, _| {},
-                Some(&mut |s| sources = s),
-            );
-            let img = sources_image(size, &sources);
-            super::save(&img, &out.join(format!("sources/{scene}-{name}.png")))?;
-        }
         let moving_change = changes.pop().unwrap_or_default();
         let static_change = changes.pop().unwrap_or_default();
         rows.push(TransitionMetrics {

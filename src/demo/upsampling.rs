@@ -7,7 +7,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::DemoError;
-use super::timing::median;
+use super::timing::{median, wall_ms};
 use crate::framebuffer_lod::{
     FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
     RlsController, StepController, multiply_rgba8, psnr_rgba8, simulate, ssim_rgba8, step_response,
@@ -83,21 +83,21 @@ pub fn measure_upsampling(
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = texture_2d(gpu, size, format, usage, "upsampled");
     let view = target.create_view(&Default::default());
-    let upsample_with = |r: f32, sz: f32, sn: f32| {
+    let upsample_with = |r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        upsample.encode(gpu, &mut encoder, &low, r, full.geometry(), sz, sn, &view);
+        upsample.encode(gpu, &mut encoder, &low, r, geometry, sz, sn, &view);
         gpu.queue.submit([encoder.finish()]);
     };
     let mut rows = Vec::new();
     for r in RESIZE_FACTORS {
         scene.render(gpu, &low, r);
-        upsample_with(r, f32::INFINITY, f32::INFINITY);
+        upsample_with(r, full.geometry(), f32::INFINITY, f32::INFINITY);
         let bilinear = read_texture_rgba8(gpu, &target);
-        upsample_with(r, SIGMA_Z, SIGMA_N);
+        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N);
         let bilateral = read_texture_rgba8(gpu, &target);
         // Fine-grained: only the lighting goes through the low-res buffer; albedo at full res.
         scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
-        upsample_with(r, SIGMA_Z, SIGMA_N);
+        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N);
         let lighting = read_texture_rgba8(gpu, &target);
         scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
         let fine = multiply_rgba8(&lighting, &read_texture_rgba8(gpu, albedo.color()));
@@ -128,25 +128,11 @@ pub fn measure_upsampling(
     // prepass (with the cheap albedo) + low-res shading + upsample, and against the fine-grained
     // route (low-res lighting + full-res albedo, which writes the geometry too, + upsample).
     let prepass = LowResBuffer::new(gpu, w, h, format);
-    let upsample_from = |r: f32, geometry: &wgpu::Texture| {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        upsample.encode(
-            gpu,
-            &mut encoder,
-            &low,
-            r,
-            geometry,
-            SIGMA_Z,
-            SIGMA_N,
-            &view,
-        );
-        gpu.queue.submit([encoder.finish()]);
-    };
     let time = |f: &dyn Fn()| {
-        let t = std::time::Instant::now();
-        f();
-        gpu.wait_idle();
-        t.elapsed().as_secs_f64() * 1e3
+        wall_ms(&|| {
+            f();
+            gpu.wait_idle();
+        })
     };
     let mut base = Vec::new();
     let mut times = vec![[Vec::new(), Vec::new()]; RESIZE_FACTORS.len()];
@@ -157,12 +143,12 @@ pub fn measure_upsampling(
             let a = time(&|| {
                 scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo);
                 scene.render(gpu, &low, r);
-                upsample_from(r, prepass.geometry());
+                upsample_with(r, prepass.geometry(), SIGMA_Z, SIGMA_N);
             });
             let b = time(&|| {
                 scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
                 scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
-                upsample_from(r, albedo.geometry());
+                upsample_with(r, albedo.geometry(), SIGMA_Z, SIGMA_N);
             });
             ts.push([a, b]);
         }

@@ -189,8 +189,13 @@ impl CombinePass {
             buffers.id_depth(newer + 1),
         ];
         let layout = self.pipeline.get_bind_group_layout(0);
-        let bind_group =
-            textures_and_uniform(gpu, &layout, &textures, &self.params, "lodkit combine");
+        let bind_group = textures_and_uniform(
+            gpu,
+            &layout,
+            &textures,
+            Some(&self.params),
+            "lodkit combine",
+        );
         let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit combine");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);

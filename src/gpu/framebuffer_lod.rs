@@ -176,8 +176,13 @@ impl UpsamplePass {
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         let layout = self.pipeline.get_bind_group_layout(0);
         let textures = [low.color(), low.geometry(), full_geometry];
-        let bind_group =
-            textures_and_uniform(gpu, &layout, &textures, &self.params, "lodkit upsample");
+        let bind_group = textures_and_uniform(
+            gpu,
+            &layout,
+            &textures,
+            Some(&self.params),
+            "lodkit upsample",
+        );
         let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit upsample");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);

@@ -140,24 +140,10 @@ impl LodBufferRenderer {
     }
 
     /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers`, cleared to
-    /// `clear`. Returns the number of triangles drawn.
-    pub fn render(
-        &self,
-        gpu: &GpuContext,
-        buffers: &LodBuffers,
-        index: usize,
-        view_proj: Mat4,
-        items: &[LodDrawItem],
-        clear: wgpu::Color,
-    ) -> u64 {
-        self.render_counted(gpu, buffers, index, view_proj, items, clear, None)
-            .0
-    }
-
-    /// [`Self::render`], also counting the pass's fragments with `counter`: returns the
-    /// triangles drawn and the count (0 without a counter).
+    /// `clear`, counting the pass's fragments with `counter` if given. Returns the triangles
+    /// drawn and the count (0 without a counter).
     #[allow(clippy::too_many_arguments)]
-    pub fn render_counted(
+    pub fn render(
         &self,
         gpu: &GpuContext,
         buffers: &LodBuffers,

@@ -249,12 +249,13 @@ pub fn depth_write_state(
     }
 }
 
-/// A bind group of `textures` at bindings 0.. followed by `uniform` at the next binding.
+/// A bind group of `textures` at bindings 0.. followed, if given, by `uniform` at the next
+/// binding.
 pub fn textures_and_uniform(
     gpu: &GpuContext,
     layout: &wgpu::BindGroupLayout,
     textures: &[&wgpu::Texture],
-    uniform: &wgpu::Buffer,
+    uniform: Option<&wgpu::Buffer>,
     label: &str,
 ) -> wgpu::BindGroup {
     let views: Vec<wgpu::TextureView> = textures
@@ -269,10 +270,10 @@ pub fn textures_and_uniform(
             resource: wgpu::BindingResource::TextureView(v),
         })
         .collect();
-    entries.push(wgpu::BindGroupEntry {
+    entries.extend(uniform.map(|u| wgpu::BindGroupEntry {
         binding: views.len() as u32,
-        resource: uniform.as_entire_binding(),
-    });
+        resource: u.as_entire_binding(),
+    }));
     gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
         layout,

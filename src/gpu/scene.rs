@@ -271,12 +271,7 @@ impl MeshRenderer {
             let depth = lod_depth_stencil(&state, DEPTH_FORMAT, wgpu::CompareFunction::Less);
             mesh_pipeline(gpu, &module, &layout, &[Some(target)], depth, "lod_mesh")
         };
-        let opaque_state = LodRenderState {
-            alpha: 1.0,
-            depth_test: true,
-            depth_write: true,
-            blend: false,
-        };
+        let opaque_state = LodRenderState::OPAQUE;
         let blended_state = LodRenderState {
             alpha: 0.5,
             depth_test: true,
@@ -309,23 +304,10 @@ impl MeshRenderer {
     }
 
     /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]; the
-    /// rest are dropped), lit from `light_dir`.
-    pub fn render(
-        &self,
-        gpu: &GpuContext,
-        target: &RenderTarget,
-        clear: wgpu::Color,
-        view_proj: Mat4,
-        light_dir: Vec3,
-        items: &[DrawItem],
-    ) {
-        self.render_counted(gpu, target, clear, view_proj, light_dir, items, None);
-    }
-
-    /// [`Self::render`], also counting the pass's fragments with `counter`; returns the count
-    /// (0 without a counter).
+    /// rest are dropped), lit from `light_dir`, counting the pass's fragments with `counter` if
+    /// given. Returns the count (0 without a counter).
     #[allow(clippy::too_many_arguments)]
-    pub fn render_counted(
+    pub fn render(
         &self,
         gpu: &GpuContext,
         target: &RenderTarget,

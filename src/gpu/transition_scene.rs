@@ -62,13 +62,6 @@ pub const COARSE_COLOR: Vec4 = Vec4::new(0.0, 0.45, 1.0, 1.0);
 /// Color of the object behind (pure red).
 pub const BACKDROP_COLOR: Vec4 = Vec4::new(1.0, 0.0, 0.0, 1.0);
 
-const OPAQUE: LodRenderState = LodRenderState {
-    alpha: 1.0,
-    depth_test: true,
-    depth_write: true,
-    blend: false,
-};
-
 /// The scene, on the GPU, ready to render at any t.
 #[derive(Debug)]
 pub struct TransitionScene {
@@ -132,20 +125,6 @@ impl TransitionScene {
         parts: SceneParts,
     ) -> Vec<u8> {
         let model = Mat4::from_scale(Vec3::splat(1.1));
-        let lod = |role: LodRole| match role {
-            LodRole::Outgoing => (&self.fine, FINE_COLOR),
-            LodRole::Incoming => (&self.coarse, COARSE_COLOR),
-        };
-        let item = |role, state, dither_alpha| {
-            let (mesh, color) = lod(role);
-            DrawItem {
-                mesh,
-                model,
-                color,
-                state,
-                dither_alpha,
-            }
-        };
         let mut items = Vec::new();
         if parts == SceneParts::All {
             items.push(DrawItem {
@@ -153,21 +132,23 @@ impl TransitionScene {
                 model: Mat4::from_translation(Vec3::new(0.0, 0.0, -3.0))
                     * Mat4::from_scale(Vec3::new(2.5, 2.5, 0.2)),
                 color: BACKDROP_COLOR,
-                state: OPAQUE,
+                state: LodRenderState::OPAQUE,
                 dither_alpha: None,
             });
         }
-        match parts {
-            SceneParts::FineOnly => items.push(item(LodRole::Outgoing, OPAQUE, None)),
-            SceneParts::CoarseOnly => items.push(item(LodRole::Incoming, OPAQUE, None)),
-            SceneParts::All => items.extend(transition_items(
-                technique,
-                t,
-                model,
-                (&self.fine, FINE_COLOR),
-                (&self.coarse, COARSE_COLOR),
-            )),
-        }
+        // One LOD alone is a hard switch before (fine) or after (coarse) it happens.
+        let (technique, t) = match parts {
+            SceneParts::All => (technique, t),
+            SceneParts::FineOnly => (SingleFrameTechnique::HardSwitch, 0.0),
+            SceneParts::CoarseOnly => (SingleFrameTechnique::HardSwitch, 1.0),
+        };
+        items.extend(transition_items(
+            technique,
+            t,
+            model,
+            (&self.fine, FINE_COLOR),
+            (&self.coarse, COARSE_COLOR),
+        ));
         let pattern = technique
             .dither_pattern()
             .unwrap_or(DitherPattern::Bayer4x4);
@@ -185,6 +166,7 @@ impl TransitionScene {
             self.view_proj(),
             Vec3::new(0.4, 0.8, 0.6),
             &items,
+            None,
         );
         read_texture_rgba8(gpu, &self.target.color)
     }
@@ -221,7 +203,7 @@ pub fn transition_items<'a>(
             } else {
                 LodRole::Incoming
             };
-            vec![item(role, OPAQUE, None)]
+            vec![item(role, LodRenderState::OPAQUE, None)]
         }
         SingleFrameTechnique::Dither(_) => {
             let selection = LodSelection {
@@ -233,8 +215,8 @@ pub fn transition_items<'a>(
             };
             let (current, next) = selection.screen_door_alphas();
             vec![
-                item(LodRole::Outgoing, OPAQUE, Some(current)),
-                item(LodRole::Incoming, OPAQUE, next),
+                item(LodRole::Outgoing, LodRenderState::OPAQUE, Some(current)),
+                item(LodRole::Incoming, LodRenderState::OPAQUE, next),
             ]
         }
         SingleFrameTechnique::CrossFade | SingleFrameTechnique::Unpopping => {
