@@ -2,8 +2,7 @@
 //! passes the independent tools (spirv-val, glslangValidator); the GLSL twins match the WGSL
 //! modules name for name.
 
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::Path;
 
 use lodkit::shaders::{
     self, ComposeDescriptor, Composed, ExportOptions, ExportTarget, Exported, Language, ModuleInfo,
@@ -11,22 +10,12 @@ use lodkit::shaders::{
 };
 
 use crate::harness::{render, tool};
+use crate::support::scratch;
 
 pub(crate) fn wgsl_modules() -> impl Iterator<Item = &'static ModuleInfo> {
     shaders::modules()
         .iter()
         .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
-}
-
-pub(crate) fn scratch(name: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let dir = std::env::temp_dir().join(format!(
-        "lodkit-test-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
 }
 
 /// Splits a parameter list at top-level commas (generic arguments contain commas too).

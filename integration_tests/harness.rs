@@ -1,72 +1,13 @@
 //! The GPU test harness: one shared headless device, and a probe that runs a shader function over
 //! a table of inputs (one compute invocation per case) and reads the results back.
 //!
-//! GPU tests start with `lodkit_test_gpu!()`. Without an adapter they fail when
-//! `LODKIT_REQUIRE_GPU=1`, and otherwise return early after writing a SKIPPED line straight to
-//! stderr (past the test harness's capture), so a skip is never silent.
+//! The shared GPU and the skip rules live in `support.rs` (shared with the CLI's tests).
 
-use std::io::Write;
-use std::sync::OnceLock;
+pub use crate::support::{say, strict, test_name};
 
-use lodkit::gpu::{GpuContext, GpuOptions};
+use lodkit::gpu::GpuContext;
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary, SourceLanguage};
 use wgpu::util::DeviceExt;
-
-/// Whether missing GPU or reference tools are failures (`LODKIT_REQUIRE_GPU=1`, as CI sets it).
-pub fn strict() -> bool {
-    std::env::var("LODKIT_REQUIRE_GPU").is_ok_and(|v| v == "1")
-}
-
-/// Writes past libtest's output capture, so the line shows in a normal `cargo test` run.
-pub fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
-}
-
-fn test_name() -> String {
-    std::thread::current()
-        .name()
-        .unwrap_or("a GPU test")
-        .to_owned()
-}
-
-/// The shared GPU, or why there is none.
-pub fn gpu() -> Result<&'static GpuContext, String> {
-    static GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
-    let gpu = GPU.get_or_init(|| {
-        let gpu = GpuContext::new_headless(&GpuOptions::default()).map_err(|e| e.to_string());
-        if let Ok(g) = &gpu {
-            say(&format!("lodkit GPU tests run on: {}", g.adapter_summary()));
-        }
-        gpu
-    });
-    gpu.as_ref().map_err(Clone::clone)
-}
-
-/// The shared GPU; with none, panics under `LODKIT_REQUIRE_GPU=1`, else returns `None` after
-/// saying the calling test was skipped.
-pub fn gpu_or_skip() -> Option<&'static GpuContext> {
-    match gpu() {
-        Ok(g) => Some(g),
-        Err(e) if strict() => panic!("LODKIT_REQUIRE_GPU=1 but there is no GPU adapter: {e}"),
-        Err(e) => {
-            say(&format!(
-                "SKIPPED {}: {e}. Set LODKIT_REQUIRE_GPU=1 to make this a failure",
-                test_name()
-            ));
-            None
-        }
-    }
-}
-
-/// The shared GPU, or return from the test (see [`gpu_or_skip`]).
-macro_rules! lodkit_test_gpu {
-    () => {
-        match $crate::harness::gpu_or_skip() {
-            Some(gpu) => gpu,
-            None => return,
-        }
-    };
-}
 
 /// Runs `program` (which must not fail to spawn) or, if it is missing, fails under
 /// `LODKIT_REQUIRE_GPU=1` and skips loudly otherwise. Returns `None` when skipped.
@@ -356,44 +297,5 @@ pub fn assert_close(got: &[f32], want: &[f32], tol: f32, what: &str) {
             ok,
             "{what}: case {i}: GPU {g} vs Rust twin {w} (tolerance {tol})"
         );
-    }
-}
-
-/// `node .ci/browser/<script>` ready to take arguments, when node, the scripts' npm packages and
-/// Chromium are installed. Otherwise fails under `LODKIT_REQUIRE_BROWSER=1` (CI sets it) and
-/// skips loudly.
-pub fn browser_script(script: &str) -> Option<std::process::Command> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(".ci/browser");
-    let chromium = std::env::var_os("LODKIT_CHROMIUM")
-        .map_or_else(|| "/usr/bin/chromium".into(), std::path::PathBuf::from);
-    let node = std::process::Command::new("node")
-        .arg("--version")
-        .output()
-        .is_ok();
-    let missing = if !node {
-        Some("node is not installed")
-    } else if !dir.join("node_modules/playwright-core").exists() {
-        Some("the browser scripts' packages are not installed (npm ci --prefix .ci/browser)")
-    } else if !chromium.exists() {
-        Some("Chromium is not installed (apt-get install chromium)")
-    } else {
-        None
-    };
-    match missing {
-        None => {
-            let mut cmd = std::process::Command::new("node");
-            cmd.arg(dir.join(script));
-            Some(cmd)
-        }
-        Some(why) if std::env::var("LODKIT_REQUIRE_BROWSER").is_ok_and(|v| v == "1") => {
-            panic!("LODKIT_REQUIRE_BROWSER=1 but {why}")
-        }
-        Some(why) => {
-            say(&format!(
-                "SKIPPED {}: {why}. Set LODKIT_REQUIRE_BROWSER=1 to make this a failure",
-                test_name()
-            ));
-            None
-        }
     }
 }

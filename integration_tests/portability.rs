@@ -8,8 +8,10 @@ use lodkit::shaders::{
     ShaderLibrary,
 };
 
-use crate::composition::{scratch, wgsl_harness, wgsl_modules};
-use crate::harness::{browser_script, render};
+use crate::composition::{wgsl_harness, wgsl_modules};
+use crate::harness::render;
+use crate::support::browser_script;
+use crate::support::scratch;
 
 /// Composes `source` with no shader defs and with each of `defs` switched on, exports each
 /// variant to plain WGSL and returns the distinct texts.

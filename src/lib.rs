@@ -18,7 +18,18 @@
 //!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders.
 //! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
 //! - [`gpu`] (feature `wgpu`): headless devices and ready-made passes.
-//! - `demo` (feature `demo`): the quality/cost harness behind `lodkit demo`.
+//!
+//! ## Features
+//!
+//! | feature | default | gives | pulls in |
+//! |---|---|---|---|
+//! | `compose` | yes | [`shaders::ShaderLibrary`], validation, export, [`shaders::add_to_composer`] | naga 30, naga_oil 0.23 |
+//! | `wgpu` | no | [`gpu`]: headless devices, buffers, ready-made passes | wgpu 30 (and `compose`) |
+//!
+//! With `default-features = false` the crate is the embedded shader sources ([`shaders::modules`])
+//! and the host math: no naga, naga_oil or wgpu in the tree, so an engine on another naga (Bevy
+//! 0.19's naga 29) registers lodkit's sources with its own composer. The `lodkit` command and the
+//! demo are the separate `lodkit-cli` package.
 //!
 //! Every pure shader function has a Rust twin with the same name; tests hold the GPU result
 //! against it.
@@ -43,6 +54,3 @@ pub mod visibility;
 
 #[cfg(feature = "wgpu")]
 pub mod gpu;
-
-#[cfg(feature = "demo")]
-pub mod demo;

@@ -8,15 +8,15 @@ use serde::Serialize;
 
 use super::DemoError;
 use super::timing::{median, wall_ms};
-use crate::framebuffer_lod::{
+use lodkit::framebuffer_lod::{
     FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
     RlsController, StepController, multiply_rgba8, psnr_rgba8, simulate, ssim_rgba8, step_response,
 };
-use crate::gpu::GpuContext;
-use crate::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
-use crate::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
-use crate::gpu::readback::read_texture_rgba8;
-use crate::gpu::resources::texture_2d;
+use lodkit::gpu::GpuContext;
+use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
+use lodkit::gpu::readback::read_texture_rgba8;
+use lodkit::gpu::resources::texture_2d;
 
 /// Resize factors the demo measures.
 pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];

@@ -4,10 +4,10 @@
 //! browsable `index.html`; optionally regenerates `docs/benchmarks.md` and `docs/quality.md`.
 //!
 //! ```no_run
-//! let options = lodkit::demo::DemoOptions::default();
-//! let report = lodkit::demo::run(&options)?;
-//! println!("{}", lodkit::demo::report::summary(&report));
-//! # Ok::<(), lodkit::demo::DemoError>(())
+//! let options = lodkit_cli::demo::DemoOptions::default();
+//! let report = lodkit_cli::demo::run(&options)?;
+//! println!("{}", lodkit_cli::demo::report::summary(&report));
+//! # Ok::<(), lodkit_cli::demo::DemoError>(())
 //! ```
 
 pub mod cpu;
@@ -23,8 +23,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::gpu::{GpuContext, GpuError, GpuOptions};
-use crate::shaders::ShaderError;
+use lodkit::gpu::{GpuContext, GpuError, GpuOptions};
+use lodkit::shaders::ShaderError;
 use scene::{DemoScene, SceneError};
 
 /// What `lodkit demo` renders and where it writes.

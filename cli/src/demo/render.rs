@@ -4,21 +4,21 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::scene::DemoScene;
-use crate::combine::{DepthConvention, PixelSource, combine_images};
-use crate::frame_sequential::{Drive, TransitionScheduler};
-use crate::gpu::GpuContext;
-use crate::gpu::counters::FragmentCounter;
-use crate::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
-use crate::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
-use crate::gpu::readback::read_texture_rgba8;
-use crate::gpu::resources::texture_2d;
-use crate::gpu::scene::{DrawItem, GpuMesh, MeshRenderer, RenderTarget};
-use crate::gpu::transition_scene::{SingleFrameTechnique, transition_items};
-use crate::reproject::new_to_old_matrix;
-use crate::screen_door::DitherPattern;
-use crate::shaders::ShaderError;
-use crate::unpopping::LodRenderState;
-use crate::visibility::{VisibilityPattern, visibility_texture};
+use lodkit::combine::{DepthConvention, PixelSource, combine_images};
+use lodkit::frame_sequential::{Drive, TransitionScheduler};
+use lodkit::gpu::GpuContext;
+use lodkit::gpu::counters::FragmentCounter;
+use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::readback::read_texture_rgba8;
+use lodkit::gpu::resources::texture_2d;
+use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshRenderer, RenderTarget};
+use lodkit::gpu::transition_scene::{SingleFrameTechnique, transition_items};
+use lodkit::reproject::new_to_old_matrix;
+use lodkit::screen_door::DitherPattern;
+use lodkit::shaders::ShaderError;
+use lodkit::unpopping::LodRenderState;
+use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 /// A transition technique of the harness.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

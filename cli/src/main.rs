@@ -81,6 +81,9 @@ enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Show the GPU adapter the demo would run on (Vulkan, then GL; `LODKIT_BACKEND=vulkan|gl`
+    /// picks one). Exits 1 when there is none.
+    Adapter,
     /// Render the built-in scenes with every technique, measure them, write images, plots and
     /// an HTML report.
     Demo {
@@ -159,12 +162,12 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((side(w)?, side(h)?))
 }
 
-fn demo(options: lodkit::demo::DemoOptions) -> ExitCode {
-    use lodkit::demo::DemoError;
+fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
+    use lodkit_cli::demo::DemoError;
     println!("lodkit demo: writing into {}", options.out.display());
-    match lodkit::demo::run(&options) {
+    match lodkit_cli::demo::run(&options) {
         Ok(report) => {
-            println!("{}", lodkit::demo::report::summary(&report));
+            println!("{}", lodkit_cli::demo::report::summary(&report));
             println!("open {}", options.out.join("index.html").display());
             if !report.plot_text {
                 println!("note: no TrueType font found, plots have no text (set LODKIT_FONT)");
@@ -184,9 +187,23 @@ fn demo(options: lodkit::demo::DemoOptions) -> ExitCode {
     }
 }
 
+fn adapter() -> ExitCode {
+    match lodkit_cli::demo::open_gpu() {
+        Ok(gpu) => {
+            println!("{}", gpu.adapter_summary());
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Adapter => adapter(),
         Command::Demo {
             out,
             size,
@@ -194,7 +211,7 @@ fn main() -> ExitCode {
             scene,
             pairs,
             docs,
-        } => demo(lodkit::demo::DemoOptions {
+        } => demo(lodkit_cli::demo::DemoOptions {
             out,
             size,
             frames,

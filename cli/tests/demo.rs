@@ -3,13 +3,12 @@
 
 use std::process::Command;
 
-use lodkit::demo::scene::{DemoScene, SceneError};
-use lodkit::demo::transitions::{pop, transition_change};
-use lodkit::demo::{DemoOptions, run_on, utc_date};
 use lodkit::gpu::counters::{CounterKind, FragmentCounter};
+use lodkit_cli::demo::scene::{DemoScene, SceneError};
+use lodkit_cli::demo::transitions::{pop, transition_change};
+use lodkit_cli::demo::{DemoOptions, run_on, utc_date};
 
-use crate::composition::scratch;
-use crate::harness::{browser_script, say};
+use crate::support::{browser_script, say, scratch};
 
 fn lodkit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_lodkit"))
@@ -58,7 +57,7 @@ fn scene_files_name_the_line_and_the_field() {
         other => panic!("expected a parse error, got {other:?}"),
     }
     let mut bad = good.clone();
-    bad.objects[3].fine = lodkit::demo::scene::Shape::Sphere {
+    bad.objects[3].fine = lodkit_cli::demo::scene::Shape::Sphere {
         rings: 1,
         segments: 8,
     };
@@ -86,7 +85,7 @@ fn scene_files_name_the_line_and_the_field() {
         bad.check()
     );
     let mut bad = good.clone();
-    bad.objects[0].fine = lodkit::demo::scene::Shape::Sphere {
+    bad.objects[0].fine = lodkit_cli::demo::scene::Shape::Sphere {
         rings: 256,
         segments: 512,
     };
@@ -312,7 +311,7 @@ const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// Counts one fullscreen triangle over a `w` x `h` target.
 fn count_fullscreen(gpu: &lodkit::gpu::GpuContext, w: u32, h: u32) -> (CounterKind, u64) {
-    let pipeline = lodkit::demo::timing::plain_pass(gpu, FLAT, "flat.wgsl").unwrap();
+    let pipeline = lodkit_cli::demo::timing::plain_pass(gpu, FLAT, "flat.wgsl").unwrap();
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
     let target = lodkit::gpu::resources::texture_2d(gpu, (w, h), FORMAT, usage, "t");
     let view = target.create_view(&Default::default());
@@ -348,7 +347,7 @@ fn fragment_counter_counts_every_pixel_of_a_fullscreen_triangle() {
     let shared = lodkit_test_gpu!();
     // The shared device has no optional features (occlusion query); the demo's asks for
     // pipeline statistics where the adapter has them.
-    let demo_gpu = lodkit::demo::open_gpu().unwrap();
+    let demo_gpu = lodkit_cli::demo::open_gpu().unwrap();
     let (w, h) = (64, 48);
     for gpu in [shared, &demo_gpu] {
         let (kind, count) = count_fullscreen(gpu, w, h);

@@ -3,9 +3,9 @@
 //! so read the ratio, not the absolute figures, on a software GPU. `lodkit demo` measures the
 //! same ratio, and whole-frame speed-ups per resize factor, for its report.
 //!
-//! `cargo bench --bench upsample [-- WIDTH HEIGHT PAIRS]` (default 640 x 480, 60 pairs)
+//! `cargo bench -p lodkit-cli --bench upsample [-- WIDTH HEIGHT PAIRS]` (default 640 x 480, 60 pairs)
 
-use lodkit::demo::{open_gpu, timing::upsample_vs_bilinear};
+use lodkit_cli::demo::{open_gpu, timing::upsample_vs_bilinear};
 
 fn main() {
     let args: Vec<u32> = std::env::args().filter_map(|a| a.parse().ok()).collect();

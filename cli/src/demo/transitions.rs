@@ -8,8 +8,8 @@ use serde::Serialize;
 
 use super::DemoError;
 use super::render::{Background, Frame, LEAD_FRAMES, RunSpec, SceneRenderer, Technique};
-use crate::combine::PixelSource;
-use crate::gpu::GpuContext;
+use lodkit::combine::PixelSource;
+use lodkit::gpu::GpuContext;
 
 /// Metrics of one technique on one scene.
 #[derive(Clone, Debug, Serialize)]
@@ -59,7 +59,7 @@ pub fn transition_change(a0: &[u8], a1: &[u8], r0: &[u8], r1: &[u8]) -> f32 {
 /// The largest share of the total in one entry (0 when nothing changed).
 ///
 /// ```
-/// # use lodkit::demo::transitions::pop;
+/// # use lodkit_cli::demo::transitions::pop;
 /// assert_eq!(pop(&[0.0, 0.0, 3.0, 0.0]), 1.0);
 /// assert_eq!(pop(&[1.0, 1.0, 1.0, 1.0]), 0.25);
 /// ```

@@ -387,7 +387,7 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
         "Median wall time of a full-resolution frame over a framebuffer-LOD frame: the full-resolution geometry prepass the upsampling needs (depth and normals, with the cheap albedo), the low-res shading pass and the upsample pass (fine-grained: the low-res lighting pass, the full-resolution albedo pass that also writes the geometry, and the upsample). Edge scene with {SHADING_WORK} sky directions of shading work per fragment.\n"
     );
     b.push_str(&speed_table(report).markdown());
-    b.push_str("\n## Host side (CPU)\n\nMedians of repeated runs in the same process (the machine's CPU, not the GPU). The criterion benches measure the same workloads more thoroughly: `cargo bench --bench compose`, `cargo bench --bench select`; `cargo bench --bench combine` and `--bench upsample` print the pass ratios above on their own.\n\n");
+    b.push_str("\n## Host side (CPU)\n\nMedians of repeated runs in the same process (the machine's CPU, not the GPU). The criterion benches measure the same workloads more thoroughly: `cargo bench -p lodkit-cli --bench compose`, `cargo bench -p lodkit-cli --bench select`; `cargo bench -p lodkit-cli --bench combine` and `--bench upsample` print the pass ratios above on their own.\n\n");
     b.push_str(&cpu_table(report).markdown());
     write(&docs.join("benchmarks.md"), &b)
 }

@@ -3,9 +3,9 @@
 //! Wall time per pass including submit and wait, so read the ratio, not the absolute figures,
 //! on a software GPU. `lodkit demo` measures the same ratio for its report.
 //!
-//! `cargo bench --bench combine [-- SIZE PAIRS]` (default 512 x 512, 200 pairs)
+//! `cargo bench -p lodkit-cli --bench combine [-- SIZE PAIRS]` (default 512 x 512, 200 pairs)
 
-use lodkit::demo::{open_gpu, timing::combine_vs_copy};
+use lodkit_cli::demo::{open_gpu, timing::combine_vs_copy};
 
 fn main() {
     let args: Vec<u32> = std::env::args().filter_map(|a| a.parse().ok()).collect();

@@ -1,6 +1,6 @@
 //! Host-side figures for the generated benchmarks page: composing shaders against the library and
 //! batch LOD selection, as medians of repeated runs. The criterion benches
-//! (`cargo bench --bench compose`, `--bench select`) measure the same workloads more thoroughly.
+//! (`cargo bench -p lodkit-cli --bench compose`, `--bench select`) measure the same workloads more thoroughly.
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -10,11 +10,11 @@ use serde::Serialize;
 
 use super::DemoError;
 use super::timing::median;
-use crate::select::{
+use lodkit::select::{
     InstanceBatch, LodCamera, LodGroup, LodSelection, LodSettings, LodState, TransitionMode,
     select_batch,
 };
-use crate::shaders::{
+use lodkit::shaders::{
     self, ComposeDescriptor, Composed, ExportOptions, ExportTarget, ShaderLibrary,
 };
 
@@ -69,7 +69,7 @@ impl SelectionWorkload {
         .into_iter()
         .flatten()
         .collect();
-        let noise = crate::noise::white_noise(3 * n, 11);
+        let noise = lodkit::noise::white_noise(3 * n, 11);
         Self {
             camera,
             groups,

@@ -1,12 +1,12 @@
 //! Throughput of batch LOD selection: instances per second on one core, per transition mode.
 //!
-//! `cargo bench --bench select`
+//! `cargo bench -p lodkit-cli --bench select`
 
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use lodkit::demo::cpu::SelectionWorkload;
 use lodkit::select::*;
+use lodkit_cli::demo::cpu::SelectionWorkload;
 
 fn benches(c: &mut Criterion) {
     for n in [10_000, 100_000] {

@@ -2,13 +2,13 @@
 //! composing one user shader against a warm library, exporting it, and `lodkit check` of one small
 //! shader end to end (process start included).
 //!
-//! `cargo bench --bench compose`
+//! `cargo bench -p lodkit-cli --bench compose`
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use lodkit::demo::cpu::{USER_SHADER, compose_user_shader};
 use lodkit::shaders::{self, ExportOptions, ExportTarget, ShaderLibrary};
+use lodkit_cli::demo::cpu::{USER_SHADER, compose_user_shader};
 
 fn compose(library: &mut ShaderLibrary) -> shaders::Composed {
     compose_user_shader(library).expect("composes")

@@ -19,7 +19,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::gpu::scene::Mesh;
+use lodkit::gpu::scene::Mesh;
 
 /// The most objects a scene may have (each transition draws two items per object).
 pub const MAX_OBJECTS: usize = 100;

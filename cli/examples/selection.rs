@@ -8,9 +8,9 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use lodkit::demo::plots::{Chart, Series, line_chart};
 use lodkit::select::config::LodConfig;
 use lodkit::select::*;
+use lodkit_cli::demo::plots::{Chart, Series, line_chart};
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();

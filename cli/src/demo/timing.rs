@@ -10,18 +10,18 @@ use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
 
 use super::upsampling::{SIGMA_N, SIGMA_Z};
-use crate::gpu::GpuContext;
-use crate::gpu::frame_sequential::{CombinePass, LodBuffers};
-use crate::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
-use crate::gpu::gbuffer_scene::EdgeScene;
-use crate::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
-use crate::gpu::resources::{
+use lodkit::gpu::GpuContext;
+use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::gbuffer_scene::EdgeScene;
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::resources::{
     begin_color_pass, fullscreen_pipeline, texture_2d, textures_and_uniform, uniform_buffer,
 };
-use crate::gpu::scene::{GpuMesh, Mesh};
-use crate::reproject::new_to_old_matrix;
-use crate::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary};
-use crate::visibility::{VisibilityPattern, visibility_texture};
+use lodkit::gpu::scene::{GpuMesh, Mesh};
+use lodkit::reproject::new_to_old_matrix;
+use lodkit::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary};
+use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 /// A pass timed against its baseline.
 #[derive(Clone, Debug, Serialize)]

@@ -1,0 +1,8 @@
+//! Tests of the `lodkit` command and its demo: exit codes, diagnostics with file:line:col, JSON
+//! output, and the demo's report on a GPU (lavapipe / llvmpipe in CI) checked in headless Chromium.
+
+#[macro_use]
+#[path = "../../integration_tests/support.rs"]
+mod support;
+mod cli;
+mod demo;

@@ -1,0 +1,135 @@
+//! What every lodkit test crate shares (the library's integration tests and the CLI's): one
+//! headless device, the skip rules, scratch folders and the headless-browser scripts.
+//!
+//! GPU tests start with `lodkit_test_gpu!()`. Without an adapter they fail when
+//! `LODKIT_REQUIRE_GPU=1`, and otherwise return early after writing a SKIPPED line straight to
+//! stderr (past the test harness's capture), so a skip is never silent. Browser checks follow the
+//! same rule with `LODKIT_REQUIRE_BROWSER=1`.
+
+#![allow(dead_code)] // each test crate uses its own part
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use lodkit::gpu::{GpuContext, GpuOptions};
+
+/// The workspace root (where `shader_lib/` and `.ci/` are), from either package.
+pub fn workspace_root() -> PathBuf {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    if here.join("shader_lib").is_dir() {
+        here.to_path_buf()
+    } else {
+        here.parent()
+            .expect("a package folder has a parent")
+            .to_path_buf()
+    }
+}
+
+/// A fresh scratch path `name` inside a new temporary folder.
+pub fn scratch(name: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "lodkit-test-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Whether missing GPU or reference tools are failures (`LODKIT_REQUIRE_GPU=1`, as CI sets it).
+pub fn strict() -> bool {
+    std::env::var("LODKIT_REQUIRE_GPU").is_ok_and(|v| v == "1")
+}
+
+/// Writes past libtest's output capture, so the line shows in a normal `cargo test` run.
+pub fn say(line: &str) {
+    let _ = writeln!(std::io::stderr(), "{line}");
+}
+
+pub fn test_name() -> String {
+    std::thread::current()
+        .name()
+        .unwrap_or("a GPU test")
+        .to_owned()
+}
+
+/// The shared GPU, or why there is none.
+pub fn gpu() -> Result<&'static GpuContext, String> {
+    static GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
+    let gpu = GPU.get_or_init(|| {
+        let gpu = GpuContext::new_headless(&GpuOptions::default()).map_err(|e| e.to_string());
+        if let Ok(g) = &gpu {
+            say(&format!("lodkit GPU tests run on: {}", g.adapter_summary()));
+        }
+        gpu
+    });
+    gpu.as_ref().map_err(Clone::clone)
+}
+
+/// The shared GPU; with none, panics under `LODKIT_REQUIRE_GPU=1`, else returns `None` after
+/// saying the calling test was skipped.
+pub fn gpu_or_skip() -> Option<&'static GpuContext> {
+    match gpu() {
+        Ok(g) => Some(g),
+        Err(e) if strict() => panic!("LODKIT_REQUIRE_GPU=1 but there is no GPU adapter: {e}"),
+        Err(e) => {
+            say(&format!(
+                "SKIPPED {}: {e}. Set LODKIT_REQUIRE_GPU=1 to make this a failure",
+                test_name()
+            ));
+            None
+        }
+    }
+}
+
+/// The shared GPU, or return from the test (see [`gpu_or_skip`]).
+macro_rules! lodkit_test_gpu {
+    () => {
+        match $crate::support::gpu_or_skip() {
+            Some(gpu) => gpu,
+            None => return,
+        }
+    };
+}
+
+/// `node .ci/browser/<script>` ready to take arguments, when node, the scripts' npm packages and
+/// Chromium are installed. Otherwise fails under `LODKIT_REQUIRE_BROWSER=1` (CI sets it) and
+/// skips loudly.
+pub fn browser_script(script: &str) -> Option<std::process::Command> {
+    let dir = workspace_root().join(".ci/browser");
+    let chromium = std::env::var_os("LODKIT_CHROMIUM")
+        .map_or_else(|| "/usr/bin/chromium".into(), std::path::PathBuf::from);
+    let node = std::process::Command::new("node")
+        .arg("--version")
+        .output()
+        .is_ok();
+    let missing = if !node {
+        Some("node is not installed")
+    } else if !dir.join("node_modules/playwright-core").exists() {
+        Some("the browser scripts' packages are not installed (npm ci --prefix .ci/browser)")
+    } else if !chromium.exists() {
+        Some("Chromium is not installed (apt-get install chromium)")
+    } else {
+        None
+    };
+    match missing {
+        None => {
+            let mut cmd = std::process::Command::new("node");
+            cmd.arg(dir.join(script));
+            Some(cmd)
+        }
+        Some(why) if std::env::var("LODKIT_REQUIRE_BROWSER").is_ok_and(|v| v == "1") => {
+            panic!("LODKIT_REQUIRE_BROWSER=1 but {why}")
+        }
+        Some(why) => {
+            say(&format!(
+                "SKIPPED {}: {why}. Set LODKIT_REQUIRE_BROWSER=1 to make this a failure",
+                test_name()
+            ));
+            None
+        }
+    }
+}
