@@ -12,5 +12,6 @@ mod framebuffer_lod;
 mod gpu_twins;
 mod harness;
 mod portability;
+mod robustness;
 mod selection;
 mod single_frame;

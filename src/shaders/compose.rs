@@ -290,6 +290,15 @@ impl ShaderLibrary {
         stage: naga::ShaderStage,
     ) -> Result<Composed, ShaderError> {
         let expanded = glsl::expand_includes(desc.file_path, desc.source, &self.include_dirs)?;
+        // naga's GLSL front end recurses once per nesting level with no limit of its own.
+        if let Some(nesting) = super::limits::too_deep(&expanded.text) {
+            let message = nesting.message();
+            let d = expanded.diagnostic(DiagnosticKind::Limit, nesting.at, message);
+            return Err(ShaderError::Source(Box::new(
+                d.with_label("nested too deep")
+                    .with_hint("split the expression into `let`/local variables"),
+            )));
+        }
         let defines = desc
             .shader_defs
             .iter()

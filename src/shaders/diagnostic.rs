@@ -28,6 +28,9 @@ pub enum DiagnosticKind {
     Preprocessor,
     /// The module parses but naga's validator rejects it (types, uniformity, layout).
     Validation,
+    /// The source goes past a limit lodkit sets so that parsing cannot exhaust the stack
+    /// (brackets nested deeper than [`MAX_NESTING`](crate::shaders::MAX_NESTING)).
+    Limit,
 }
 
 impl DiagnosticKind {
@@ -41,6 +44,7 @@ impl DiagnosticKind {
             Self::InvalidUtf8 => "invalid-utf8",
             Self::Preprocessor => "preprocessor",
             Self::Validation => "validation",
+            Self::Limit => "limit",
         }
     }
 }
@@ -97,7 +101,11 @@ impl Diagnostic {
     /// Points the diagnostic at bytes `span` of `source` (clamped to the text) and computes its
     /// line and column.
     pub fn with_span(mut self, source: Arc<str>, span: Range<usize>) -> Self {
+        // Spans from the front ends may cut a multibyte character: widen them to whole ones.
         let end = span.end.min(source.len());
+        let end = (end..=source.len())
+            .find(|&i| source.is_char_boundary(i))
+            .unwrap_or(source.len());
         let start = span.start.min(end);
         let start = (0..=start)
             .rev()
@@ -251,7 +259,10 @@ fn path_token(source: &str, pos: usize) -> Range<usize> {
 /// `a::b::f` calls), the column is clamped to the original line.
 fn remap_offset(rewritten: &str, original: &str, at: usize) -> usize {
     const PRE: &str = "X_naga_oil_mod_X";
-    let at = at.min(rewritten.len());
+    let mut at = at.min(rewritten.len());
+    while !rewritten.is_char_boundary(at) {
+        at -= 1;
+    }
     let line_start = rewritten[..at].rfind('\n').map_or(0, |i| i + 1);
     let line_index = rewritten[..line_start].matches('\n').count();
     let mut column = at - line_start;
@@ -261,9 +272,11 @@ fn remap_offset(rewritten: &str, original: &str, at: usize) -> usize {
         let end = tail
             .find(|c: char| !(c.is_ascii_uppercase() || ('2'..='7').contains(&c)))
             .unwrap_or(tail.len());
-        let removed = PRE.len() + end + usize::from(tail[end..].starts_with('X'));
+        let closing = usize::from(tail[end..].starts_with('X'));
+        let removed = PRE.len() + end + closing;
         column -= removed.min(column);
-        prefix = &tail[(end + 1).min(tail.len())..];
+        // `end + closing` is a char boundary: the run and its closing `X` are ASCII.
+        prefix = &tail[end + closing..];
     }
     let original_line_start: usize = original
         .split_inclusive('\n')

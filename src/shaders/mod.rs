@@ -25,6 +25,8 @@ mod export;
 mod glsl;
 #[cfg(feature = "compose")]
 mod imports;
+#[cfg(feature = "compose")]
+mod limits;
 mod registry;
 
 #[cfg(feature = "compose")]
@@ -43,6 +45,8 @@ pub use compose::{
 pub use diagnostic::{Diagnostic, DiagnosticKind, Location};
 #[cfg(feature = "compose")]
 pub use export::{ExportOptions, ExportTarget, Exported, export};
+#[cfg(feature = "compose")]
+pub use limits::MAX_NESTING;
 #[cfg(feature = "compose")]
 pub use naga;
 #[cfg(feature = "compose")]
