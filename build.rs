@@ -1,4 +1,4 @@
-//! Embeds every file under `shader_lib/` into the crate: writes `$OUT_DIR/shader_lib.rs`, a table of
+//! Embeds every shader file under `shader_lib/` (.wgsl, .wesl, .glsl) into the crate: writes `$OUT_DIR/shader_lib.rs`, a table of
 //! `(path relative to shader_lib/, include_str!(...))` sorted by path.
 
 use std::fs;
@@ -14,7 +14,7 @@ fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
             collect(&path, out);
         } else if matches!(
             path.extension().and_then(|e| e.to_str()),
-            Some("wgsl" | "glsl")
+            Some("wgsl" | "wesl" | "glsl")
         ) {
             out.push(path);
         }

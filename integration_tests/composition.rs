@@ -45,10 +45,17 @@ fn params(signature: &str) -> Vec<(String, String)> {
         .collect()
 }
 
-/// A fragment shader that imports `module` and calls every function it exports with zero
-/// values (textures and samplers become bindings), so that every function reaches the back ends.
-pub(crate) fn wgsl_harness(module: &ModuleInfo) -> String {
+/// A fragment shader that imports `module` and calls every function it exports (textures as
+/// bindings, other arguments zero-valued), in naga_oil WGSL or in WESL.
+pub(crate) fn module_harness(module: &ModuleInfo, wesl: bool) -> String {
     let path = module.import_path.as_deref().unwrap();
+    // naga_oil: `#import lodkit::t` and qualified calls; WESL: an import list and plain names.
+    let prefix = if wesl {
+        String::new()
+    } else {
+        format!("{path}::")
+    };
+    let mut items: Vec<String> = Vec::new();
     let mut globals = String::new();
     let mut calls = String::new();
     for (i, f) in module.functions.iter().enumerate() {
@@ -61,21 +68,35 @@ pub(crate) fn wgsl_harness(module: &ModuleInfo) -> String {
                 ));
                 args.push(format!("g{binding}"));
             } else if module.source.contains(&format!("struct {ty} ")) {
-                args.push(format!("{path}::{ty}()"));
+                args.push(format!("{prefix}{ty}()"));
+                if !items.contains(&ty) {
+                    items.push(ty.clone());
+                }
             } else {
                 args.push(format!("{ty}()"));
             }
         }
-        let call = format!("{path}::{}({})", f.name, args.join(", "));
+        items.push(f.name.clone());
+        let call = format!("{prefix}{}({})", f.name, args.join(", "));
         if f.signature.contains("->") {
             calls.push_str(&format!("    _ = {call};\n"));
         } else {
             calls.push_str(&format!("    {call};\n"));
         }
     }
+    let import = if wesl {
+        format!("import {path}::{{{}}};", items.join(", "))
+    } else {
+        format!("#import {path}")
+    };
     format!(
-        "#import {path}\n{globals}\n@fragment\nfn lodkit_harness() -> @location(0) vec4<f32> {{\n{calls}    return vec4<f32>(0.0);\n}}\n"
+        "{import}\n{globals}\n@fragment\nfn lodkit_harness() -> @location(0) vec4<f32> {{\n{calls}    return vec4<f32>(0.0);\n}}\n"
     )
+}
+
+/// [`module_harness`] in naga_oil WGSL.
+pub(crate) fn wgsl_harness(module: &ModuleInfo) -> String {
+    module_harness(module, false)
 }
 
 fn compose(source: &str, file: &str, language: SourceLanguage) -> Composed {
@@ -156,6 +177,8 @@ fn every_file_under_shader_lib_is_embedded() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib");
     let mut on_disk = Vec::new();
     walk(&root, &root, &mut on_disk);
+    // The WESL package's manifest is not a shader; it is `shaders::WESL_TOML`.
+    on_disk.retain(|p| p != "wesl/wesl.toml");
     on_disk.sort();
     let mut embedded: Vec<String> = shaders::modules()
         .iter()

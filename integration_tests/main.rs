@@ -15,3 +15,4 @@ mod portability;
 mod robustness;
 mod selection;
 mod single_frame;
+mod wesl;

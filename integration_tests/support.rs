@@ -95,23 +95,21 @@ macro_rules! lodkit_test_gpu {
     };
 }
 
-/// `node .ci/browser/<script>` ready to take arguments, when node, the scripts' npm packages and
-/// Chromium are installed. Otherwise fails under `LODKIT_REQUIRE_BROWSER=1` (CI sets it) and
-/// skips loudly.
-pub fn browser_script(script: &str) -> Option<std::process::Command> {
+/// `node .ci/browser/<script>` ready to take arguments, when node and the npm `package` the
+/// script needs (`npm ci --prefix .ci/browser`) are installed. Otherwise fails under
+/// `LODKIT_REQUIRE_BROWSER=1` (CI sets it) and skips loudly.
+pub fn node_script(script: &str, package: &str) -> Option<std::process::Command> {
     let dir = workspace_root().join(".ci/browser");
-    let chromium = std::env::var_os("LODKIT_CHROMIUM")
-        .map_or_else(|| "/usr/bin/chromium".into(), std::path::PathBuf::from);
     let node = std::process::Command::new("node")
         .arg("--version")
         .output()
         .is_ok();
     let missing = if !node {
-        Some("node is not installed")
-    } else if !dir.join("node_modules/playwright-core").exists() {
-        Some("the browser scripts' packages are not installed (npm ci --prefix .ci/browser)")
-    } else if !chromium.exists() {
-        Some("Chromium is not installed (apt-get install chromium)")
+        Some("node is not installed".to_owned())
+    } else if !dir.join("node_modules").join(package).exists() {
+        Some(format!(
+            "npm package `{package}` is not installed (npm ci --prefix .ci/browser)"
+        ))
     } else {
         None
     };
@@ -121,15 +119,29 @@ pub fn browser_script(script: &str) -> Option<std::process::Command> {
             cmd.arg(dir.join(script));
             Some(cmd)
         }
-        Some(why) if std::env::var("LODKIT_REQUIRE_BROWSER").is_ok_and(|v| v == "1") => {
-            panic!("LODKIT_REQUIRE_BROWSER=1 but {why}")
-        }
-        Some(why) => {
-            say(&format!(
-                "SKIPPED {}: {why}. Set LODKIT_REQUIRE_BROWSER=1 to make this a failure",
-                test_name()
-            ));
-            None
-        }
+        Some(why) => skip_browser(&why),
     }
+}
+
+fn skip_browser(why: &str) -> Option<std::process::Command> {
+    if std::env::var("LODKIT_REQUIRE_BROWSER").is_ok_and(|v| v == "1") {
+        panic!("LODKIT_REQUIRE_BROWSER=1 but {why}")
+    }
+    say(&format!(
+        "SKIPPED {}: {why}. Set LODKIT_REQUIRE_BROWSER=1 to make this a failure",
+        test_name()
+    ));
+    None
+}
+
+/// `node .ci/browser/<script>` ready to take arguments, when node, the scripts' npm packages and
+/// Chromium are installed. Otherwise fails under `LODKIT_REQUIRE_BROWSER=1` (CI sets it) and
+/// skips loudly.
+pub fn browser_script(script: &str) -> Option<std::process::Command> {
+    let chromium = std::env::var_os("LODKIT_CHROMIUM")
+        .map_or_else(|| "/usr/bin/chromium".into(), std::path::PathBuf::from);
+    if !chromium.exists() {
+        return skip_browser("Chromium is not installed (apt-get install chromium)");
+    }
+    node_script(script, "playwright-core")
 }

@@ -81,6 +81,13 @@ enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Write lodkit's WESL package (wesl.toml and lodkit/<topic>.wesl, generated from the
+    /// naga_oil modules) into a folder, for wesl-js and wesl-rs projects.
+    Wesl {
+        /// Folder to write into (created; the package's files in it are overwritten).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
     /// Show the GPU adapter the demo would run on (Vulkan, then GL; `LODKIT_BACKEND=vulkan|gl`
     /// picks one). Exits 1 when there is none.
     Adapter,
@@ -187,6 +194,33 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
     }
 }
 
+fn write_wesl(out: &Path) -> ExitCode {
+    let files = match shaders::wesl_package() {
+        Ok(files) => files,
+        Err(e) => {
+            eprintln!("error: a lodkit module has no WESL form: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    for (rel, text) in &files {
+        let path = out.join(rel);
+        let written = path
+            .parent()
+            .map_or(Ok(()), std::fs::create_dir_all)
+            .and_then(|()| std::fs::write(&path, text));
+        if let Err(e) = written {
+            eprintln!("error: cannot write `{}`: {e}", path.display());
+            return ExitCode::from(2);
+        }
+    }
+    println!(
+        "wrote {} files of the WESL package `lodkit` into {}",
+        files.len(),
+        out.display()
+    );
+    ExitCode::SUCCESS
+}
+
 fn adapter() -> ExitCode {
     match lodkit_cli::demo::open_gpu() {
         Ok(gpu) => {
@@ -204,6 +238,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Adapter => adapter(),
+        Command::Wesl { out } => write_wesl(&out),
         Command::Demo {
             out,
             size,
@@ -251,8 +286,12 @@ fn modules(format: Format) -> ExitCode {
             (shaders::ModuleKind::Pass, _) => "pass",
             (_, shaders::Language::Wgsl) => "wgsl",
             (_, shaders::Language::Glsl) => "glsl twin",
+            (_, shaders::Language::Wesl) => "wesl",
         };
         println!("{name}  [{kind}: shader_lib/{}]", m.path);
+        if let Some(path) = &m.embedded_path {
+            println!("    Bevy 0.20: Shader::from_wesl(source, \"{path}\")");
+        }
         println!("    {}", m.summary);
         for f in &m.functions {
             println!("    {}", f.signature);

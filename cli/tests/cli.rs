@@ -327,3 +327,30 @@ fn an_include_line_may_end_with_a_comment() {
     let src = b"#version 450\n#include \"lodkit/normal_distance.glsl\" // the guard\nlayout(location = 0) out vec4 color;\nvoid main() { color = vec4(lodkit_foreshortened_normal_distance(vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0))); }\n";
     assert_eq!(check_one("commented.frag", src, &[]).0, 0);
 }
+
+#[test]
+fn wesl_writes_the_committed_package() {
+    let out = fixture(&[]).join("pkg");
+    let (code, stdout, stderr) = run(Path::new("."), &["wesl", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let committed = crate::support::workspace_root().join("shader_lib/wesl");
+    for rel in [
+        "wesl.toml",
+        "lodkit/visibility.wesl",
+        "lodkit/screen_door.wesl",
+    ] {
+        assert_eq!(
+            std::fs::read_to_string(out.join(rel)).unwrap(),
+            std::fs::read_to_string(committed.join(rel)).unwrap(),
+            "{rel}"
+        );
+    }
+    // A file where the folder should be: exit 2 naming the path.
+    let blocked = fixture(&[("pkg", b"not a folder")]).join("pkg");
+    let (code, _, stderr) = run(
+        Path::new("."),
+        &["wesl", "--out", blocked.to_str().unwrap()],
+    );
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("cannot write"), "{stderr}");
+}

@@ -2,24 +2,28 @@
 
 use std::sync::OnceLock;
 
-/// `(path relative to shader_lib/, source)` for every `.wgsl` and `.glsl` file, sorted by path.
+/// `(path relative to shader_lib/, source)` for every `.wgsl`, `.wesl` and `.glsl` file, sorted
+/// by path.
 static FILES: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/shader_lib.rs"));
 
 /// Shading language of a library file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Language {
     /// WGSL, composed with naga_oil (`#import lodkit::<topic>`).
     Wgsl,
     /// GLSL 450, included textually (`#include "lodkit/<topic>.glsl"`).
     Glsl,
+    /// WESL (`import lodkit::<topic>::item;`, `@if` conditions), generated from the WGSL module:
+    /// Bevy 0.20, wesl-js, wesl-rs.
+    Wesl,
 }
 
 /// What a library file is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ModuleKind {
-    /// An importable module (`shader_lib/wgsl/lodkit/*.wgsl` or its GLSL twin).
+    /// An importable module (`shader_lib/wgsl/lodkit/*.wgsl`, its WESL form or its GLSL twin).
     Module,
     /// A complete entry-point shader built from modules (`shader_lib/passes/`).
     Pass,
@@ -58,6 +62,10 @@ pub struct ModuleInfo {
     pub import_path: Option<String>,
     /// Path to `#include` for GLSL twins (`lodkit/<topic>.glsl`); `None` otherwise.
     pub include_path: Option<String>,
+    /// For WESL modules, the asset path Bevy 0.20 registers them under so that
+    /// `import lodkit::<topic>::...` resolves (`embedded://lodkit/<topic>.wesl`,
+    /// with `Shader::from_wesl(source, path)`); `None` otherwise.
+    pub embedded_path: Option<String>,
     /// First line of the header, after the module name.
     pub summary: String,
     /// Functions defined at file scope, in source order.
@@ -79,7 +87,7 @@ impl ModuleInfo {
 }
 
 /// Every file of the shader library, described: modules by import path (each WGSL module followed
-/// by its GLSL twin), then passes. Parsed once, on first use.
+/// by its GLSL twin and its WESL form), then passes. Parsed once, on first use.
 pub fn modules() -> &'static [ModuleInfo] {
     static MODULES: OnceLock<Vec<ModuleInfo>> = OnceLock::new();
     MODULES.get_or_init(|| {
@@ -91,7 +99,7 @@ pub fn modules() -> &'static [ModuleInfo] {
             (
                 m.kind == ModuleKind::Pass,
                 m.import_path.clone(),
-                m.language == Language::Glsl,
+                m.language,
                 m.path,
             )
         });
@@ -115,6 +123,22 @@ pub fn find_glsl_include(include_path: &str) -> Option<&'static ModuleInfo> {
         .find(|m| m.include_path.as_deref() == Some(include_path))
 }
 
+/// The WESL form of the module with import path `import_path` (e.g. `lodkit::visibility`).
+pub fn find_wesl_module(import_path: &str) -> Option<&'static ModuleInfo> {
+    modules().iter().find(|m| {
+        m.language == Language::Wesl
+            && m.kind == ModuleKind::Module
+            && m.import_path.as_deref() == Some(import_path)
+    })
+}
+
+/// The WESL modules, each with the `embedded://` path Bevy 0.20 registers it under.
+pub fn wesl_modules() -> impl Iterator<Item = &'static ModuleInfo> {
+    modules()
+        .iter()
+        .filter(|m| m.language == Language::Wesl && m.kind == ModuleKind::Module)
+}
+
 /// The GLSL twin of a WGSL module (same topic), if there is one.
 pub fn glsl_twin(wgsl: &ModuleInfo) -> Option<&'static ModuleInfo> {
     let topic = wgsl.import_path.as_deref()?.strip_prefix("lodkit::")?;
@@ -133,6 +157,8 @@ pub fn import_paths() -> Vec<&'static str> {
 fn describe(path: &'static str, source: &'static str) -> ModuleInfo {
     let language = if path.ends_with(".glsl") {
         Language::Glsl
+    } else if path.ends_with(".wesl") {
+        Language::Wesl
     } else {
         Language::Wgsl
     };
@@ -153,7 +179,10 @@ fn describe(path: &'static str, source: &'static str) -> ModuleInfo {
             Some(format!("lodkit::{stem}")),
             path.strip_prefix("glsl/").map(str::to_owned),
         ),
+        (ModuleKind::Module, Language::Wesl) => (Some(format!("lodkit::{stem}")), None),
     };
+    let embedded_path = (language == Language::Wesl && kind == ModuleKind::Module)
+        .then(|| format!("embedded://lodkit/{stem}.wesl"));
     let header = header_lines(source);
     let summary = header
         .first()
@@ -177,6 +206,7 @@ fn describe(path: &'static str, source: &'static str) -> ModuleInfo {
         kind,
         import_path,
         include_path,
+        embedded_path,
         summary,
         functions: functions(source, language),
         constants: constants(source, language),
@@ -236,6 +266,21 @@ pub(crate) fn used_shader_defs(source: &str) -> Vec<String> {
             }
         }
         let mut rest = line;
+        // WESL conditions: every name in `@if(...)` / `@elif(...)`.
+        let code = line.split("//").next().unwrap_or_default();
+        for attr in ["@if(", "@elif("] {
+            let mut rest = code;
+            while let Some(i) = rest.find(attr) {
+                let after = &rest[i + attr.len()..];
+                let end = after.find(')').unwrap_or(after.len());
+                for name in after[..end].split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')) {
+                    if name != "true" && name != "false" {
+                        push(name);
+                    }
+                }
+                rest = &after[end..];
+            }
+        }
         while let Some(i) = rest.find("#{") {
             let after = &rest[i + 2..];
             let end = after.find('}').unwrap_or(after.len());
@@ -271,7 +316,7 @@ fn functions(source: &str, language: Language) -> Vec<FunctionInfo> {
     let mut out = Vec::new();
     for (i, line) in lines.iter().enumerate() {
         let name = match language {
-            Language::Wgsl => line
+            Language::Wgsl | Language::Wesl => line
                 .strip_prefix("fn ")
                 .map(|rest| identifier(rest.trim_start())),
             Language::Glsl => glsl_function_name(line),
@@ -324,7 +369,7 @@ fn constants(source: &str, language: Language) -> Vec<String> {
         .filter_map(|l| {
             let rest = l.strip_prefix("const ")?;
             let name = match language {
-                Language::Wgsl => identifier(rest),
+                Language::Wgsl | Language::Wesl => identifier(rest),
                 Language::Glsl => identifier(rest.split_whitespace().nth(1)?),
             };
             Some(name.to_owned())
