@@ -137,7 +137,10 @@ pub fn run_glsl(gpu: &GpuContext, probe: &Probe, cases: &[u32]) -> Vec<u32> {
     run_with(gpu, probe, cases, glsl, &[])
 }
 
-/// Runs the probe in `language` with the boolean shader defs `defs` switched on.
+/// Runs the probe in `language` with the boolean shader defs `defs` switched on. A WGSL probe
+/// runs twice: composed from the naga_oil modules, and converted to WESL
+/// (`naga_oil_to_wesl`) and linked by wesl-rs against the WESL package; both must give the same
+/// words, so every table a test holds against a Rust twin also holds for the WESL form.
 pub fn run_with(
     gpu: &GpuContext,
     probe: &Probe,
@@ -146,14 +149,24 @@ pub fn run_with(
     defs: &[&str],
 ) -> Vec<u32> {
     let source = match language {
-        SourceLanguage::Wgsl => wgsl_probe(probe),
         SourceLanguage::Glsl(_) => glsl_probe(probe),
+        _ => wgsl_probe(probe),
     };
-    let shader_defs = defs
+    let shader_defs: lodkit::shaders::ShaderDefs = defs
         .iter()
         .map(|d| (d.to_string(), lodkit::shaders::ShaderDefValue::Bool(true)))
         .collect();
-    run(gpu, probe, cases, &source, language, shader_defs)
+    let words = run(gpu, probe, cases, &source, language, shader_defs.clone());
+    if language == SourceLanguage::Wgsl {
+        let wesl = lodkit::shaders::naga_oil_to_wesl(&source, "", "")
+            .unwrap_or_else(|e| panic!("the probe has no WESL form: {e}\n{source}"));
+        let wesl_words = run(gpu, probe, cases, &wesl, SourceLanguage::Wesl, shader_defs);
+        assert!(
+            wesl_words == words,
+            "the WESL modules compute other results than the naga_oil modules (defs {defs:?})\n{wesl}"
+        );
+    }
+    words
 }
 
 fn run(

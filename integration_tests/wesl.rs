@@ -26,20 +26,23 @@ fn files_under(dir: &Path, base: &Path, out: &mut Vec<String>) {
 
 #[test]
 fn committed_wesl_package_is_what_the_generator_writes() {
-    let dir = workspace_root().join("shader_lib/wesl");
+    let dir = workspace_root().join("shader_lib/wesl/lodkit");
     let generated = shaders::wesl_package().expect("every module converts to WESL");
     let mut on_disk = Vec::new();
     files_under(&dir, &dir, &mut on_disk);
     let names: Vec<String> = generated.iter().map(|(p, _)| p.clone()).collect();
     let mut sorted = names.clone();
     sorted.sort();
-    let fix = "regenerate with `cargo run -p lodkit-cli -- wesl --out shader_lib/wesl`";
-    assert_eq!(on_disk, sorted, "files of shader_lib/wesl differ; {fix}");
+    let fix = "regenerate with `cargo run -p lodkit-cli -- wesl --out shader_lib/wesl/lodkit`";
+    assert_eq!(
+        on_disk, sorted,
+        "files of shader_lib/wesl/lodkit differ; {fix}"
+    );
     for (rel, text) in &generated {
         let committed = std::fs::read_to_string(dir.join(rel)).unwrap();
         assert!(
             committed == *text,
-            "shader_lib/wesl/{rel} is stale or was edited by hand; {fix}"
+            "shader_lib/wesl/lodkit/{rel} is stale or was edited by hand; {fix}"
         );
     }
 }
@@ -92,13 +95,14 @@ fn validate(wgsl: &str, what: &str) {
         });
 }
 
-#[test]
-fn every_wesl_module_links_with_wesl_js_and_validates_in_naga_and_tint() {
+/// One link job per module and condition set: a harness importing every item of the module,
+/// with no condition set and with each one set. Returns the jobs and the file they are in.
+fn link_jobs(name: &str) -> (Vec<serde_json::Value>, std::path::PathBuf) {
     let defs: BTreeSet<String> = shaders::wesl_modules()
         .flat_map(|m| m.shader_defs.iter().map(|d| d.name.clone()))
         .collect();
     assert!(defs.len() >= 2, "the modules read shader defs: {defs:?}");
-    let dir = scratch("wesl-link");
+    let dir = scratch(name);
     std::fs::create_dir_all(&dir).unwrap();
     let mut jobs = Vec::new();
     for m in wgsl_modules() {
@@ -121,13 +125,17 @@ fn every_wesl_module_links_with_wesl_js_and_validates_in_naga_and_tint() {
             jobs.push(serde_json::json!({ "root": root, "conditions": conditions, "out": out }));
         }
     }
-    let jobs_file = dir.join("jobs.json");
+    let jobs_file = dir.with_extension("json");
     std::fs::write(&jobs_file, serde_json::to_string(&jobs).unwrap()).unwrap();
-    let Some(mut node) = node_script("wesl-link.mjs", "wesl") else {
-        return;
-    };
-    let out = node
-        .arg(workspace_root().join("shader_lib/wesl"))
+    (jobs, jobs_file)
+}
+
+/// Runs a linker over the jobs (`PACKAGE_DIR JOBS.json`), then holds every linked file to naga's
+/// validator and to Tint.
+fn link_and_check(mut linker: std::process::Command, name: &str) {
+    let (jobs, jobs_file) = link_jobs(name);
+    let out = linker
+        .arg(workspace_root().join("shader_lib/wesl/lodkit"))
         .arg(&jobs_file)
         .output()
         .unwrap();
@@ -138,24 +146,51 @@ fn every_wesl_module_links_with_wesl_js_and_validates_in_naga_and_tint() {
     );
     assert!(
         out.status.success(),
-        "wesl-js cannot link lodkit's WESL:\n{text}"
+        "{name} cannot link lodkit's WESL:\n{text}"
     );
-    crate::harness::say(&format!("wesl-js: {}", text.trim()));
-    std::fs::remove_file(&jobs_file).unwrap();
+    crate::harness::say(&format!("{name}: {}", text.trim()));
+    let mut dir = None;
     for job in &jobs {
-        let path = job["out"].as_str().unwrap();
+        let path = Path::new(job["out"].as_str().unwrap());
         let wgsl = std::fs::read_to_string(path).unwrap();
-        validate(&wgsl, path);
+        validate(&wgsl, &path.display().to_string());
+        dir = path.parent().map(Path::to_path_buf);
     }
     // Tint (Chromium's WebGPU) compiles the same linked files.
     let Some(mut tint) = browser_script("tint.mjs") else {
         return;
     };
-    let out = tint.arg(&dir).output().unwrap();
+    let out = tint.arg(dir.unwrap()).output().unwrap();
     assert!(
         out.status.success(),
-        "Tint rejects WESL linked by wesl-js:\n{}{}",
+        "Tint rejects WESL linked by {name}:\n{}{}",
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+#[test]
+fn every_wesl_module_links_with_wesl_js_and_validates_in_naga_and_tint() {
+    if let Some(node) = node_script("wesl-link.mjs", "wesl") {
+        link_and_check(node, "wesl-js");
+    }
+}
+
+/// wesl-py bundles wesl-rs 0.6, the linker Bevy 0.20 runs. It needs Python >= 3.12:
+/// `.ci/wesl-py/setup.sh` makes an environment where there is one and prints its python, which
+/// CI passes as `LODKIT_WESL_PY` (and then requires it with `LODKIT_REQUIRE_WESL_PY=1`).
+#[test]
+fn every_wesl_module_links_with_wesl_rs_through_wesl_py() {
+    let Some(python) = std::env::var_os("LODKIT_WESL_PY") else {
+        let why =
+            "LODKIT_WESL_PY is not set (bash .ci/wesl-py/setup.sh prints a python with wesl-py)";
+        if std::env::var("LODKIT_REQUIRE_WESL_PY").is_ok_and(|v| v == "1") {
+            panic!("LODKIT_REQUIRE_WESL_PY=1 but {why}");
+        }
+        crate::harness::say(&format!("SKIPPED {}: {why}", crate::harness::test_name()));
+        return;
+    };
+    let mut cmd = std::process::Command::new(python);
+    cmd.arg(workspace_root().join(".ci/wesl-py/link.py"));
+    link_and_check(cmd, "wesl-py");
 }

@@ -3,7 +3,7 @@
 //
 //   node .ci/browser/wesl-link.mjs PACKAGE_DIR JOBS.json
 //
-// PACKAGE_DIR holds wesl.toml and lodkit/*.wesl (shader_lib/wesl). JOBS.json is an array of
+// PACKAGE_DIR holds wesl.toml and the package's *.wesl files (shader_lib/wesl/lodkit). JOBS.json is an array of
 // { "root": "<WESL source of main.wesl>", "conditions": { "NAME": true }, "out": "<path>" };
 // each linked result (plain WGSL) is written to its "out".
 // Exit: 0 all linked, 1 some job failed to link (its error on stderr), 2 usage error.

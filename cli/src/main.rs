@@ -77,12 +77,12 @@ enum Command {
         compose: ComposeArgs,
         #[arg(long, value_enum, default_value_t)]
         format: Format,
-        /// Shaders to check (.wgsl; .glsl/.vert/.frag/.comp).
+        /// Shaders to check (.wgsl: naga_oil; .wesl: WESL linked by wesl-rs; .glsl/.vert/.frag/.comp).
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
-    /// Write lodkit's WESL package (wesl.toml and lodkit/<topic>.wesl, generated from the
-    /// naga_oil modules) into a folder, for wesl-js and wesl-rs projects.
+    /// Write lodkit's WESL package (wesl.toml and <topic>.wesl, generated from the naga_oil
+    /// modules) into a folder, for wesl-js and wesl-rs projects.
     Wesl {
         /// Folder to write into (created; the package's files in it are overwritten).
         #[arg(long, value_name = "DIR")]
@@ -331,6 +331,9 @@ fn language_of(path: &Path, stage: Option<Stage>) -> Result<SourceLanguage, Stri
     if name.ends_with(".wgsl") {
         return Ok(SourceLanguage::Wgsl);
     }
+    if name.ends_with(".wesl") {
+        return Ok(SourceLanguage::Wesl);
+    }
     let from_name = [
         (".vert", naga::ShaderStage::Vertex),
         (".frag", naga::ShaderStage::Fragment),
@@ -351,7 +354,7 @@ fn language_of(path: &Path, stage: Option<Stage>) -> Result<SourceLanguage, Stri
             path.display()
         )),
         None => Err(format!(
-            "{}: unknown shader language (expected .wgsl, .glsl, .vert, .frag or .comp)",
+            "{}: unknown shader language (expected .wgsl, .wesl, .glsl, .vert, .frag or .comp)",
             path.display()
         )),
     }

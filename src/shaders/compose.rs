@@ -25,6 +25,11 @@ pub enum SourceLanguage {
     Wgsl,
     /// GLSL 450 of one stage. Includes lodkit with `#include "lodkit/<topic>.glsl"`.
     Glsl(naga::ShaderStage),
+    /// WESL, linked by wesl-rs against lodkit's WESL package (`import lodkit::<topic>::item;`)
+    /// and the `.wesl` files of the include folders (`package::<path>`). Bool shader defs are
+    /// `@if` conditions; int and uint defs set the condition and are `constants::NAME`.
+    /// Needs the `wesl` feature.
+    Wesl,
 }
 
 /// A top-level shader to compose.
@@ -78,6 +83,8 @@ pub struct ShaderLibrary {
     capabilities: naga::valid::Capabilities,
     include_dirs: Vec<PathBuf>,
     user_modules: Vec<String>,
+    #[cfg(feature = "wesl")]
+    wesl_modules: Vec<super::wesl_link::WeslUserModule>,
 }
 
 impl std::fmt::Debug for ShaderLibrary {
@@ -122,6 +129,8 @@ impl ShaderLibrary {
             capabilities: desc.capabilities,
             include_dirs: Vec::new(),
             user_modules: Vec::new(),
+            #[cfg(feature = "wesl")]
+            wesl_modules: Vec::new(),
         })
     }
 
@@ -154,6 +163,8 @@ impl ShaderLibrary {
                 });
             }
             collect_wgsl(dir, &mut files)?;
+            #[cfg(feature = "wesl")]
+            super::wesl_link::collect_user_modules(dir, &mut self.wesl_modules)?;
             self.include_dirs.push(dir.clone());
         }
         files.sort();
@@ -203,9 +214,39 @@ impl ShaderLibrary {
         let module = match desc.language {
             SourceLanguage::Wgsl => self.compose_wgsl(desc)?,
             SourceLanguage::Glsl(stage) => return self.compose_glsl(desc, stage),
+            SourceLanguage::Wesl => self.compose_wesl(desc)?,
         };
         let info = validate_with(&module, self.capabilities, desc.file_path)?;
         Ok(Composed { module, info })
+    }
+
+    #[cfg(feature = "wesl")]
+    fn compose_wesl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
+        let mut defs: Vec<(String, ShaderDefValue)> = desc
+            .shader_defs
+            .iter()
+            .map(|(k, v)| (k.clone(), *v))
+            .collect();
+        defs.sort_by(|a, b| a.0.cmp(&b.0));
+        let linked =
+            super::wesl_link::link(desc.source, desc.file_path, &defs, &self.wesl_modules)?;
+        naga::front::wgsl::parse_str(&linked.wgsl).map_err(|e| {
+            ShaderError::Source(Box::new(super::wesl_link::front_end_diagnostic(
+                &e,
+                &linked,
+                desc.file_path,
+                desc.source,
+            )))
+        })
+    }
+
+    #[cfg(not(feature = "wesl"))]
+    fn compose_wesl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
+        Err(ShaderError::Source(Box::new(Diagnostic::new(
+            DiagnosticKind::Parse,
+            desc.file_path,
+            "linking WESL needs lodkit's `wesl` feature (the `lodkit` command has it)",
+        ))))
     }
 
     fn compose_wgsl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
