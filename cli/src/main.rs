@@ -62,6 +62,14 @@ struct ComposeArgs {
     /// Stage of a GLSL file (default: from the extension .vert, .frag, .comp).
     #[arg(long)]
     stage: Option<Stage>,
+    /// Validator capabilities beyond WebGPU's, for shaders of a native engine: `all`, or names
+    /// such as `immediates,float64,shader-int64` (aliases: push-constants, f64, int64, f16).
+    #[arg(long, value_name = "LIST", value_parser = shaders::parse_capabilities)]
+    capabilities: Option<naga::valid::Capabilities>,
+    /// Leave out every file under the -I folders whose path contains PATTERN (e.g. the stand-in
+    /// of a module an engine swaps by build feature); repeatable.
+    #[arg(long, value_name = "PATTERN")]
+    exclude: Vec<String>,
 }
 
 #[derive(Subcommand)]
@@ -318,8 +326,12 @@ enum Outcome {
 }
 
 fn library(args: &ComposeArgs) -> Result<ShaderLibrary, ShaderError> {
-    let mut library = ShaderLibrary::new()?;
-    library.add_import_dirs(&args.include)?;
+    let mut library = ShaderLibrary::with_descriptor(&shaders::LibraryDescriptor {
+        capabilities: args
+            .capabilities
+            .map_or_else(Default::default, |c| c | Default::default()),
+    })?;
+    library.add_import_dirs_excluding(&args.include, &args.exclude)?;
     Ok(library)
 }
 

@@ -8,7 +8,7 @@ fn lodkit() -> Command {
 }
 
 /// A fresh folder holding `files` (name, bytes).
-fn fixture(files: &[(&str, &[u8])]) -> PathBuf {
+pub(crate) fn fixture(files: &[(&str, &[u8])]) -> PathBuf {
     static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
         "lodkit-cli-{}-{}",
@@ -23,7 +23,7 @@ fn fixture(files: &[(&str, &[u8])]) -> PathBuf {
     dir
 }
 
-fn run(dir: &Path, args: &[&str]) -> (i32, String, String) {
+pub(crate) fn run(dir: &Path, args: &[&str]) -> (i32, String, String) {
     let Output {
         status,
         stdout,

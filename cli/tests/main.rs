@@ -6,4 +6,5 @@
 mod support;
 mod cli;
 mod demo;
+mod engine_tree;
 mod wesl_check;

@@ -1,16 +1,14 @@
 //! [`ShaderLibrary`]: a naga_oil `Composer` that knows every lodkit module and the user's own.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
-use naga_oil::compose::{
-    ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
-    ShaderType, get_preprocessor_data,
-};
+use naga_oil::compose::{Composer, NagaModuleDescriptor, ShaderDefValue, ShaderType};
 
 use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error, validation_diagnostic};
 use super::imports::{declared_imports, import_site, module_prefix};
+use super::loading::{Unavailable, add_modules, collect_wgsl, split_duplicates};
 use super::registry::{self, Language, ModuleKind};
 use super::{ShaderError, closest, glsl, read_source};
 
@@ -83,6 +81,7 @@ pub struct ShaderLibrary {
     capabilities: naga::valid::Capabilities,
     include_dirs: Vec<PathBuf>,
     user_modules: Vec<String>,
+    unavailable: Unavailable,
     #[cfg(feature = "wesl")]
     wesl_modules: Vec<super::wesl_link::WeslUserModule>,
 }
@@ -105,7 +104,7 @@ pub fn add_to_composer(composer: &mut Composer) -> Result<(), ShaderError> {
         .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
         .map(|m| (format!("shader_lib/{}", m.path), Arc::from(m.source)))
         .collect();
-    add_modules(composer, sources, true)
+    add_modules(composer, sources, true, None)
 }
 
 impl ShaderLibrary {
@@ -129,6 +128,7 @@ impl ShaderLibrary {
             capabilities: desc.capabilities,
             include_dirs: Vec::new(),
             user_modules: Vec::new(),
+            unavailable: Unavailable::new(),
             #[cfg(feature = "wesl")]
             wesl_modules: Vec::new(),
         })
@@ -150,10 +150,22 @@ impl ShaderLibrary {
     }
 
     /// Adds user folders: every `.wgsl` file under them that declares `#define_import_path`
-    /// becomes importable (imports among them are ordered; a cycle or a duplicate import path is
-    /// an error naming the file and line), and GLSL `#include`s are searched in them.
-    /// Returns the import paths added.
+    /// becomes importable (imports among them are ordered), GLSL `#include`s are searched in
+    /// them, and (feature `wesl`) their `.wesl` files are `package::<path>` modules. An import
+    /// cycle, or a module reusing a lodkit import path, is an error naming the file and line.
+    /// A module that does not compose, or an import path declared by several files, fails only
+    /// the shaders that import it, with that diagnostic. Returns the import paths added.
     pub fn add_import_dirs(&mut self, dirs: &[PathBuf]) -> Result<Vec<String>, ShaderError> {
+        self.add_import_dirs_excluding(dirs, &[])
+    }
+
+    /// [`Self::add_import_dirs`], leaving out every file whose path contains one of `exclude`
+    /// (e.g. the stand-in of a module an engine swaps by build feature).
+    pub fn add_import_dirs_excluding(
+        &mut self,
+        dirs: &[PathBuf],
+        exclude: &[String],
+    ) -> Result<Vec<String>, ShaderError> {
         let mut files = Vec::new();
         for dir in dirs {
             if !dir.is_dir() {
@@ -162,7 +174,7 @@ impl ShaderLibrary {
                     source: std::io::Error::new(std::io::ErrorKind::NotFound, "not a folder"),
                 });
             }
-            collect_wgsl(dir, &mut files)?;
+            collect_wgsl(dir, exclude, &mut files)?;
             #[cfg(feature = "wesl")]
             super::wesl_link::collect_user_modules(dir, &mut self.wesl_modules)?;
             self.include_dirs.push(dir.clone());
@@ -175,11 +187,22 @@ impl ShaderLibrary {
                 sources.push((file.display().to_string(), Arc::from(text)));
             }
         }
-        let names: Vec<String> = sources
-            .iter()
-            .filter_map(|(_, s)| registry::define_import_path(s))
+        split_duplicates(&mut sources, &mut self.unavailable);
+        add_modules(
+            &mut self.composer,
+            sources,
+            false,
+            Some(&mut self.unavailable),
+        )?;
+        let names: Vec<String> = self
+            .composer
+            .module_sets
+            .keys()
+            .filter(|n| registry::find_module(n).is_none() && !self.user_modules.contains(n))
+            .cloned()
             .collect();
-        add_modules(&mut self.composer, sources, false)?;
+        let mut names = names;
+        names.sort();
         self.user_modules.extend(names.iter().cloned());
         Ok(names)
     }
@@ -197,6 +220,7 @@ impl ShaderLibrary {
             &mut self.composer,
             vec![(file_path.to_owned(), Arc::from(source))],
             false,
+            None,
         )?;
         self.user_modules.push(name.clone());
         Ok(name)
@@ -269,6 +293,9 @@ impl ShaderLibrary {
     /// complains about imports that are used).
     fn check_imports(&self, desc: &ComposeDescriptor) -> Result<(), ShaderError> {
         for (import, line_at) in declared_imports(desc.source) {
+            if let Some(d) = self.unavailable_import(&import, desc, line_at) {
+                return Err(ShaderError::Source(Box::new(d)));
+            }
             let mut candidate = import.as_str();
             let found = loop {
                 if self.composer.contains_module(candidate) {
@@ -299,6 +326,36 @@ impl ShaderLibrary {
             }
         }
         Ok(())
+    }
+
+    /// The diagnostic for importing a user module that could not be added, at the import in
+    /// the user's file, with the module's own problem as notes.
+    fn unavailable_import(
+        &self,
+        import: &str,
+        desc: &ComposeDescriptor,
+        line_at: usize,
+    ) -> Option<Diagnostic> {
+        let mut candidate = import;
+        let problem = loop {
+            if let Some(d) = self.unavailable.get(candidate) {
+                break d;
+            }
+            candidate = candidate.rsplit_once("::")?.0;
+        };
+        let site = import_site(&desc.source[line_at..], candidate);
+        let span = site.start + line_at..site.end + line_at;
+        let mut d = Diagnostic::new(
+            problem.kind,
+            desc.file_path,
+            format!("cannot import `{candidate}`: {}", problem.message),
+        )
+        .with_span(Arc::from(desc.source), span)
+        .with_note(problem.render().trim_end().to_owned());
+        if let Some(hint) = &problem.hint {
+            d = d.with_hint(hint.clone());
+        }
+        Some(d)
     }
 
     fn with_import_hint(&self, mut d: Diagnostic) -> Diagnostic {
@@ -386,6 +443,38 @@ impl ShaderLibrary {
     }
 }
 
+/// Parses a list of naga validator capabilities, as `lodkit check --capabilities` takes it:
+/// `all`, or names separated by commas, case-insensitive, `-` or `_` between words
+/// (`immediates,float64,shader-int64`). `push-constants` is an alias of `IMMEDIATES`, `f64` of
+/// `FLOAT64`, `int64` of `SHADER_INT64`, `f16` of `SHADER_FLOAT16`. An unknown name is an error
+/// that lists the known ones.
+pub fn parse_capabilities(list: &str) -> Result<naga::valid::Capabilities, String> {
+    use naga::valid::Capabilities;
+    let mut caps = Capabilities::empty();
+    for raw in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let name = raw.to_ascii_uppercase().replace('-', "_");
+        let flag = match name.as_str() {
+            "ALL" => Capabilities::all(),
+            "PUSH_CONSTANT" | "PUSH_CONSTANTS" => Capabilities::IMMEDIATES,
+            "F64" => Capabilities::FLOAT64,
+            "INT64" | "I64" => Capabilities::SHADER_INT64,
+            "F16" => Capabilities::SHADER_FLOAT16,
+            other => Capabilities::from_name(other).ok_or_else(|| {
+                let known: Vec<String> = Capabilities::all()
+                    .iter_names()
+                    .map(|(n, _)| n.to_ascii_lowercase().replace('_', "-"))
+                    .collect();
+                format!(
+                    "unknown capability `{raw}`; known: all, {} (aliases: push-constants, f64, int64, f16)",
+                    known.join(", ")
+                )
+            })?,
+        };
+        caps |= flag;
+    }
+    Ok(caps)
+}
+
 /// Validates a naga module (one you built yourself) with `capabilities`.
 pub fn validate(
     module: &naga::Module,
@@ -409,165 +498,4 @@ fn validate_with(
                 |_| 0..0,
             )))
         })
-}
-
-fn collect_wgsl(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), ShaderError> {
-    let entries = std::fs::read_dir(dir).map_err(|source| ShaderError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    for entry in entries.flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            collect_wgsl(&path, out)?;
-        } else if path.extension().is_some_and(|e| e == "wgsl") {
-            out.push(path);
-        }
-    }
-    Ok(())
-}
-
-/// Adds `(file, source)` modules to `composer` so that every module comes after those it imports.
-/// A module whose import path the composer already has is skipped when `skip_existing` (adding
-/// the lodkit modules twice is harmless) and an error otherwise.
-fn add_modules(
-    composer: &mut Composer,
-    sources: Vec<(String, Arc<str>)>,
-    skip_existing: bool,
-) -> Result<(), ShaderError> {
-    let mut by_name: HashMap<String, usize> = HashMap::new();
-    let mut deps: Vec<Vec<String>> = Vec::new();
-    for (i, (file, source)) in sources.iter().enumerate() {
-        let (name, imports, _) = get_preprocessor_data(source);
-        let name = name.unwrap_or_default();
-        if let Some(&j) = by_name.get(&name) {
-            let d = Diagnostic::new(
-                DiagnosticKind::DuplicateModule,
-                file.clone(),
-                format!("`{name}` is also defined in {}", sources[j].0),
-            )
-            .with_span(source.clone(), import_site_define(source));
-            return Err(ShaderError::Source(Box::new(d)));
-        }
-        by_name.insert(name, i);
-        deps.push(imports.into_iter().map(|d| d.import).collect());
-    }
-    // Resolve each import to a module of this batch (the longest matching prefix).
-    let resolve = |import: &str| -> Option<usize> {
-        let mut candidate = import;
-        loop {
-            if let Some(&i) = by_name.get(candidate) {
-                return Some(i);
-            }
-            candidate = candidate.rsplit_once("::")?.0;
-        }
-    };
-    let n = sources.len();
-    let mut state = vec![0u8; n]; // 0 new, 1 on stack, 2 done
-    let mut order = Vec::with_capacity(n);
-    fn visit(
-        i: usize,
-        deps: &[Vec<String>],
-        resolve: &dyn Fn(&str) -> Option<usize>,
-        state: &mut [u8],
-        stack: &mut Vec<(usize, String)>,
-        order: &mut Vec<usize>,
-    ) -> Result<(), (usize, Vec<(usize, String)>)> {
-        state[i] = 1;
-        for import in &deps[i] {
-            let Some(j) = resolve(import) else { continue };
-            stack.push((i, import.clone()));
-            match state[j] {
-                1 => return Err((j, stack.clone())),
-                0 => visit(j, deps, resolve, state, stack, order)?,
-                _ => {}
-            }
-            stack.pop();
-        }
-        state[i] = 2;
-        order.push(i);
-        Ok(())
-    }
-    for i in 0..n {
-        if state[i] == 0 {
-            let mut stack = Vec::new();
-            if let Err((start, stack)) =
-                visit(i, &deps, &resolve, &mut state, &mut stack, &mut order)
-            {
-                let cycle: Vec<&(usize, String)> =
-                    stack.iter().skip_while(|(m, _)| *m != start).collect();
-                let (first, import) = cycle[0];
-                let names: Vec<String> = cycle
-                    .iter()
-                    .map(|(m, _)| registry::define_import_path(&sources[*m].1).unwrap_or_default())
-                    .chain(registry::define_import_path(&sources[start].1))
-                    .collect();
-                let (file, source) = &sources[*first];
-                let d = Diagnostic::new(
-                    DiagnosticKind::ImportCycle,
-                    file.clone(),
-                    format!("import cycle: {}", names.join(" -> ")),
-                )
-                .with_span(
-                    source.clone(),
-                    import_site(source, module_prefix_of(import, &by_name)),
-                )
-                .with_label("the cycle starts with this import")
-                .with_hint("move what both modules need into a third module that imports neither");
-                return Err(ShaderError::Source(Box::new(d)));
-            }
-        }
-    }
-    for i in order {
-        let (file, source) = &sources[i];
-        let name = registry::define_import_path(source).unwrap_or_default();
-        if composer.contains_module(&name) {
-            if skip_existing {
-                continue;
-            }
-            let owner = if registry::find_module(&name).is_some() {
-                "a lodkit module"
-            } else {
-                "a module added earlier"
-            };
-            let d = Diagnostic::new(
-                DiagnosticKind::DuplicateModule,
-                file.clone(),
-                format!("`{name}` is already {owner}"),
-            )
-            .with_span(source.clone(), import_site_define(source))
-            .with_hint("give the module another #define_import_path");
-            return Err(ShaderError::Source(Box::new(d)));
-        }
-        let added = composer.add_composable_module(ComposableModuleDescriptor {
-            source,
-            file_path: file,
-            language: ShaderLanguage::Wgsl,
-            ..Default::default()
-        });
-        if let Err(e) = added {
-            return Err(ShaderError::Source(Box::new(from_composer_error(
-                &e, composer, None,
-            ))));
-        }
-    }
-    Ok(())
-}
-
-fn module_prefix_of<'a>(import: &'a str, by_name: &HashMap<String, usize>) -> &'a str {
-    let mut candidate = import;
-    while !by_name.contains_key(candidate) {
-        match candidate.rsplit_once("::") {
-            Some((head, _)) => candidate = head,
-            None => return import,
-        }
-    }
-    candidate
-}
-
-fn import_site_define(source: &str) -> std::ops::Range<usize> {
-    source
-        .find("#define_import_path")
-        .map(|i| i..i + "#define_import_path".len())
-        .unwrap_or(0..0)
 }

@@ -27,6 +27,8 @@ mod glsl;
 mod imports;
 #[cfg(feature = "compose")]
 mod limits;
+#[cfg(feature = "compose")]
+mod loading;
 mod registry;
 mod wesl;
 #[cfg(feature = "wesl")]
@@ -42,7 +44,7 @@ pub use errors::{ShaderError, read_source};
 #[cfg(feature = "compose")]
 pub use compose::{
     ComposeDescriptor, Composed, LibraryDescriptor, ShaderDefs, ShaderLibrary, SourceLanguage,
-    add_to_composer, validate,
+    add_to_composer, parse_capabilities, validate,
 };
 #[cfg(feature = "compose")]
 pub use diagnostic::{Diagnostic, DiagnosticKind, Location};
