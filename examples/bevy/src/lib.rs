@@ -25,14 +25,26 @@ pub struct Frame {
 impl Frame {
     /// A frame from packed RGBA bytes; panics if the length does not match the size.
     pub fn new(width: u32, height: u32, rgba: Vec<u8>) -> Self {
-        assert_eq!(rgba.len(), width as usize * height as usize * 4, "RGBA size mismatch");
-        Self { width, height, rgba }
+        assert_eq!(
+            rgba.len(),
+            width as usize * height as usize * 4,
+            "RGBA size mismatch"
+        );
+        Self {
+            width,
+            height,
+            rgba,
+        }
     }
 
     /// A frame filled with one opaque color.
     pub fn filled(width: u32, height: u32, rgb: [u8; 3]) -> Self {
         let pixel = [rgb[0], rgb[1], rgb[2], 255];
-        Self::new(width, height, pixel.repeat(width as usize * height as usize))
+        Self::new(
+            width,
+            height,
+            pixel.repeat(width as usize * height as usize),
+        )
     }
 
     /// The color at `(x, y)`, alpha dropped.
@@ -59,25 +71,37 @@ impl Frame {
 
     /// Per pixel, row-major: is something other than `background` there?
     pub fn coverage(&self, background: [u8; 3]) -> Vec<bool> {
-        self.pixels().map(|p| !is_background(p, background)).collect()
+        self.pixels()
+            .map(|p| !is_background(p, background))
+            .collect()
     }
 
     /// Number of pixels that are not `background`.
     pub fn object_pixels(&self, background: [u8; 3]) -> usize {
-        self.pixels().filter(|&p| !is_background(p, background)).count()
+        self.pixels()
+            .filter(|&p| !is_background(p, background))
+            .count()
     }
 }
 
 /// Whether `color` is `background` within [`BACKGROUND_TOLERANCE`] on every channel.
 pub fn is_background(color: [u8; 3], background: [u8; 3]) -> bool {
-    color.iter().zip(background).all(|(&c, b)| c.abs_diff(b) <= BACKGROUND_TOLERANCE)
+    color
+        .iter()
+        .zip(background)
+        .all(|(&c, b)| c.abs_diff(b) <= BACKGROUND_TOLERANCE)
 }
 
 /// Sum of absolute RGB differences over all pixels of two frames of the same size.
 pub fn difference(a: &Frame, b: &Frame) -> u64 {
     a.pixels()
         .zip(b.pixels())
-        .map(|(p, q)| p.iter().zip(q).map(|(&x, y)| u64::from(x.abs_diff(y))).sum::<u64>())
+        .map(|(p, q)| {
+            p.iter()
+                .zip(q)
+                .map(|(&x, y)| u64::from(x.abs_diff(y)))
+                .sum::<u64>()
+        })
         .sum()
 }
 
@@ -115,14 +139,22 @@ impl TransitionReport {
         assert!(frames.len() >= 2, "a transition needs at least two frames");
         let (first, last) = (&frames[0], &frames[frames.len() - 1]);
         assert!(
-            frames.iter().all(|f| (f.width, f.height) == (first.width, first.height)),
+            frames
+                .iter()
+                .all(|f| (f.width, f.height) == (first.width, first.height)),
             "frames differ in size"
         );
-        let step_changes: Vec<u64> = frames.windows(2).map(|w| difference(&w[0], &w[1])).collect();
+        let step_changes: Vec<u64> = frames
+            .windows(2)
+            .map(|w| difference(&w[0], &w[1]))
+            .collect();
         let total_change = difference(first, last);
         let largest = step_changes.iter().copied().max().unwrap_or(0);
-        let largest_step_share =
-            if total_change == 0 { 0.0 } else { largest as f64 / total_change as f64 };
+        let largest_step_share = if total_change == 0 {
+            0.0
+        } else {
+            largest as f64 / total_change as f64
+        };
         // The silhouette: inside both the outgoing and the incoming LOD.
         let inside: Vec<bool> = first
             .coverage(background)

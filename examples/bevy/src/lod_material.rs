@@ -2,9 +2,7 @@
 //! `Shader` assets, a material that draws one LOD level through lodkit's complementary
 //! screen-door pattern, and applying a `lodkit::select::LodSelection` to a group's entities.
 
-use std::marker::PhantomData;
-
-use bevy::asset::{uuid::Uuid, uuid_handle};
+use bevy::asset::uuid_handle;
 use bevy::prelude::*;
 use bevy::reflect::TypePath;
 use bevy::render::render_resource::{AsBindGroup, ShaderType};
@@ -14,8 +12,6 @@ use lodkit::shaders::{Language, ModuleKind};
 
 /// The material's fragment shader, under a fixed handle (embedded, so no asset folder is needed).
 const LOD_DITHER_SHADER: Handle<Shader> = uuid_handle!("6f0c1c52-93a4-4d7e-9a51-2b7e0d3c5a10");
-/// High 64 bits of the fixed handles of lodkit's modules (low bits: hash of the import path).
-const LODKIT_HANDLE_NAMESPACE: u64 = 0x10d4_17b5_ce11_0000;
 
 /// Registers every lodkit WGSL module, and this example's material shader, as `Shader` assets.
 ///
@@ -23,35 +19,35 @@ const LODKIT_HANDLE_NAMESPACE: u64 = 0x10d4_17b5_ce11_0000;
 /// a missing module only as a pipeline that never becomes ready.
 pub struct LodkitShadersPlugin;
 
+/// Strong handles that keep lodkit's modules loaded for the app's lifetime.
+#[derive(Resource)]
+pub struct LodkitShaders(
+    #[expect(
+        dead_code,
+        reason = "held, never read: dropping the handles unloads the modules"
+    )]
+    Vec<Handle<Shader>>,
+);
+
 impl Plugin for LodkitShadersPlugin {
     fn build(&self, app: &mut App) {
         let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
-        for module in lodkit::shaders::modules() {
-            if module.language != Language::Wgsl || module.kind != ModuleKind::Module {
-                continue;
-            }
-            let import_path = module.import_path.as_deref().unwrap_or(module.path);
-            let handle = lodkit_module_handle(import_path);
-            // `from_wgsl` reads `#define_import_path lodkit::<topic>` from the source: that is
-            // the name `#import` resolves, whatever the asset path.
-            shaders
-                .insert(&handle, Shader::from_wgsl(module.source, module.path))
-                .expect("UUID handles never fail to insert");
-        }
+        // `from_wgsl` reads `#define_import_path lodkit::<topic>` from the source: that is the
+        // name `#import` resolves, whatever the asset path.
+        let modules: Vec<Handle<Shader>> = lodkit::shaders::modules()
+            .iter()
+            .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
+            .map(|m| shaders.add(Shader::from_wgsl(m.source, m.path)))
+            .collect();
         let source = include_str!("../assets/shaders/lod_dither.wgsl");
         shaders
-            .insert(&LOD_DITHER_SHADER, Shader::from_wgsl(source, "shaders/lod_dither.wgsl"))
+            .insert(
+                &LOD_DITHER_SHADER,
+                Shader::from_wgsl(source, "shaders/lod_dither.wgsl"),
+            )
             .expect("UUID handles never fail to insert");
+        app.insert_resource(LodkitShaders(modules));
     }
-}
-
-/// A fixed (UUID) handle per lodkit module, stable across runs: FNV-1a of its import path.
-fn lodkit_module_handle(import_path: &str) -> Handle<Shader> {
-    let hash = import_path
-        .bytes()
-        .fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3));
-    let uuid = Uuid::from_u128((u128::from(LODKIT_HANDLE_NAMESPACE) << 64) | u128::from(hash));
-    Handle::Uuid(uuid, PhantomData)
 }
 
 /// One level of a LOD group, drawn through lodkit's screen-door pattern.
@@ -100,7 +96,11 @@ pub fn show_levels(
     for (i, level) in levels.iter().enumerate() {
         let alpha = alpha_of(i);
         if let Some(mut visibility) = world.get_mut::<Visibility>(level.entity) {
-            *visibility = if alpha.is_some() { Visibility::Visible } else { Visibility::Hidden };
+            *visibility = if alpha.is_some() {
+                Visibility::Visible
+            } else {
+                Visibility::Hidden
+            };
         }
         if let Some(alpha) = alpha {
             let mut materials = world.resource_mut::<Assets<LodDitherMaterial>>();

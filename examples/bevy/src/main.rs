@@ -79,7 +79,9 @@ impl LodDriver {
             group: LodGroup::from_distances(&[0.0, LOD1_DISTANCE]).expect("valid LOD distances"),
             settings: LodSettings {
                 hysteresis: 1.0,
-                transition: TransitionMode::Time { seconds: TRANSITION_SECONDS },
+                transition: TransitionMode::Time {
+                    seconds: TRANSITION_SECONDS,
+                },
                 ..default()
             },
             state: LodState::NEW,
@@ -90,7 +92,8 @@ impl LodDriver {
     /// Selects for the object at the origin (scale 1) under `global_bias`, `dt` seconds later.
     fn select(&mut self, global_bias: f32, dt: f32) -> LodSelection {
         let distance = self.camera.lod_distance(glam::Vec3::ZERO, 1.0, global_bias);
-        self.group.select(distance, &self.settings, dt, &mut self.state)
+        self.group
+            .select(distance, &self.settings, dt, &mut self.state)
     }
 }
 
@@ -108,9 +111,15 @@ fn build_app() -> App {
                 exit_condition: ExitCondition::DontExit,
                 ..default()
             })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() }),
+            .set(RenderPlugin {
+                synchronous_pipeline_compilation: true,
+                ..default()
+            }),
     )
-    .add_plugins((LodkitShadersPlugin, MaterialPlugin::<LodDitherMaterial>::default()))
+    .add_plugins((
+        LodkitShadersPlugin,
+        MaterialPlugin::<LodDitherMaterial>::default(),
+    ))
     .init_resource::<ScreenshotInbox>();
     // What `App::run` would do before its first update; we never call it.
     app.finish();
@@ -120,7 +129,11 @@ fn build_app() -> App {
 
 /// The scene: the render target, a camera and a light, and the two levels at the origin.
 fn spawn_scene(world: &mut World) -> (Handle<Image>, Vec<LevelEntity>) {
-    let size = Extent3d { width: SIZE, height: SIZE, depth_or_array_layers: 1 };
+    let size = Extent3d {
+        width: SIZE,
+        height: SIZE,
+        depth_or_array_layers: 1,
+    };
     let mut target = Image::new_uninit(
         size,
         TextureDimension::D2,
@@ -133,7 +146,10 @@ fn spawn_scene(world: &mut World) -> (Handle<Image>, Vec<LevelEntity>) {
     // Exact colors for the checks: no MSAA (edge pixels would mix), no tonemapping, no debanding noise.
     world.spawn((
         Camera3d::default(),
-        Camera { clear_color: ClearColorConfig::Custom(BACKGROUND), ..default() },
+        Camera {
+            clear_color: ClearColorConfig::Custom(BACKGROUND),
+            ..default()
+        },
         RenderTarget::from(target.clone()),
         Projection::Perspective(PerspectiveProjection::default()),
         Msaa::Off,
@@ -142,22 +158,35 @@ fn spawn_scene(world: &mut World) -> (Handle<Image>, Vec<LevelEntity>) {
         Transform::from_translation(CAMERA_POSITION).looking_at(Vec3::ZERO, Vec3::Y),
     ));
     world.spawn((
-        DirectionalLight { shadow_maps_enabled: false, ..default() },
+        DirectionalLight {
+            shadow_maps_enabled: false,
+            ..default()
+        },
         Transform::from_xyz(-2.0, 3.0, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
     ));
 
     // LOD0: a smooth warm sphere; LOD1: a coarse cool one. Different colors make the handover visible.
     let lods = [
-        (Sphere::new(1.0).mesh().uv(48, 24), Color::srgb(0.95, 0.55, 0.20)),
-        (Sphere::new(1.0).mesh().uv(8, 5), Color::srgb(0.20, 0.70, 0.85)),
+        (
+            Sphere::new(1.0).mesh().uv(48, 24),
+            Color::srgb(0.95, 0.55, 0.20),
+        ),
+        (
+            Sphere::new(1.0).mesh().uv(8, 5),
+            Color::srgb(0.20, 0.70, 0.85),
+        ),
     ];
     let levels = lods
         .into_iter()
         .map(|(mesh, color)| {
             let mesh = world.resource_mut::<Assets<Mesh>>().add(mesh);
-            let params = LodDitherParams { color: color.to_linear().to_vec4(), alpha: 1.0 };
-            let material =
-                world.resource_mut::<Assets<LodDitherMaterial>>().add(LodDitherMaterial { params });
+            let params = LodDitherParams {
+                color: color.to_linear().to_vec4(),
+                alpha: 1.0,
+            };
+            let material = world
+                .resource_mut::<Assets<LodDitherMaterial>>()
+                .add(LodDitherMaterial { params });
             let entity = world
                 .spawn((
                     Mesh3d(mesh),
@@ -178,26 +207,35 @@ fn step(app: &mut App) {
     app.world()
         .resource::<RenderDevice>()
         .wgpu_device()
-        .poll(PollType::Wait { submission_index: None, timeout: None })
+        .poll(PollType::Wait {
+            submission_index: None,
+            timeout: None,
+        })
         .expect("the GPU device was lost");
 }
 
 /// Renders a frame with a screenshot of `target` and pumps updates until its pixels are back.
 fn capture(app: &mut App, target: &Handle<Image>) -> Result<Frame, String> {
-    app.world_mut().spawn(Screenshot::image(target.clone())).observe(
-        |shot: On<ScreenshotCaptured>, mut inbox: ResMut<ScreenshotInbox>| {
-            inbox.0 = Some(shot.image.clone());
-        },
-    );
+    app.world_mut()
+        .spawn(Screenshot::image(target.clone()))
+        .observe(
+            |shot: On<ScreenshotCaptured>, mut inbox: ResMut<ScreenshotInbox>| {
+                inbox.0 = Some(shot.image.clone());
+            },
+        );
     for _ in 0..READBACK_UPDATES {
         step(app);
         if let Some(image) = app.world_mut().resource_mut::<ScreenshotInbox>().0.take() {
             let (width, height) = (image.width(), image.height());
-            let pixels = image.try_into_dynamic().map_err(|e| format!("screenshot: {e}"))?;
+            let pixels = image
+                .try_into_dynamic()
+                .map_err(|e| format!("screenshot: {e}"))?;
             return Ok(Frame::new(width, height, pixels.to_rgba8().into_raw()));
         }
     }
-    Err(format!("no screenshot came back within {READBACK_UPDATES} updates"))
+    Err(format!(
+        "no screenshot came back within {READBACK_UPDATES} updates"
+    ))
 }
 
 /// Whether anything but the background shows up within `frames` frames.
@@ -248,7 +286,9 @@ fn run(out: &Path, check: bool) -> Result<(), Failure> {
             "frame {:2}: LOD{} {}  t = {:.3}  alphas {current:+.3} / {}",
             frames.len() - 1,
             selection.current,
-            selection.next.map_or("settled ".into(), |n| format!("-> LOD{n}")),
+            selection
+                .next
+                .map_or("settled ".into(), |n| format!("-> LOD{n}")),
             selection.transition,
             next.map_or("-".into(), |a| format!("{a:+.3}")),
         );
@@ -262,7 +302,11 @@ fn run(out: &Path, check: bool) -> Result<(), Failure> {
     }
 
     save_png(&strip(&frames), out).map_err(io)?;
-    println!("wrote {} ({} frames of {SIZE}x{SIZE})", out.display(), frames.len());
+    println!(
+        "wrote {} ({} frames of {SIZE}x{SIZE})",
+        out.display(),
+        frames.len()
+    );
 
     let report = TransitionReport::measure(&frames, frames[0].corner());
     println!(
@@ -286,7 +330,11 @@ fn run(out: &Path, check: bool) -> Result<(), Failure> {
 
 /// Writes `frame` as a PNG through Bevy's own image conversion (`png` feature).
 fn save_png(frame: &Frame, path: &Path) -> Result<(), String> {
-    let size = Extent3d { width: frame.width, height: frame.height, depth_or_array_layers: 1 };
+    let size = Extent3d {
+        width: frame.width,
+        height: frame.height,
+        depth_or_array_layers: 1,
+    };
     let image = Image::new(
         size,
         TextureDimension::D2,
@@ -295,7 +343,9 @@ fn save_png(frame: &Frame, path: &Path) -> Result<(), String> {
         RenderAssetUsages::MAIN_WORLD,
     );
     let dynamic = image.try_into_dynamic().map_err(|e| e.to_string())?;
-    dynamic.save(path).map_err(|e| format!("{}: {e}", path.display()))
+    dynamic
+        .save(path)
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn main() -> ExitCode {

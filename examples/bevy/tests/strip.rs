@@ -64,7 +64,10 @@ fn hard_pop_fails() {
     let frames = transition(|_, t| Some(if t < 0.5 { OUTGOING } else { INCOMING }));
     let report = TransitionReport::measure(&frames, BACKGROUND);
     assert_eq!(report.largest_step_share, 1.0);
-    assert!(report.failures().iter().any(|f| f.starts_with("popping")), "{report:?}");
+    assert!(
+        report.failures().iter().any(|f| f.starts_with("popping")),
+        "{report:?}"
+    );
 }
 
 #[test]
@@ -82,7 +85,12 @@ fn same_pattern_for_both_levels_shows_see_through() {
     });
     let report = TransitionReport::measure(&frames, BACKGROUND);
     assert!(report.see_through[STEPS / 2] > 0, "{report:?}");
-    assert!(report.failures().iter().any(|f| f.starts_with("see-through")));
+    assert!(
+        report
+            .failures()
+            .iter()
+            .any(|f| f.starts_with("see-through"))
+    );
 }
 
 #[test]
@@ -111,6 +119,9 @@ fn bevy_renders_a_complementary_crossfade() {
         eprintln!("SKIPPED: no GPU adapter (install mesa-vulkan-drivers for lavapipe)");
         return;
     }
-    assert!(output.status.success(), "example failed:\n{stdout}\n{stderr}");
+    assert!(
+        output.status.success(),
+        "example failed:\n{stdout}\n{stderr}"
+    );
     assert!(out.exists(), "no strip at {}", out.display());
 }
