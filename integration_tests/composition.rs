@@ -10,7 +10,7 @@ use lodkit::shaders::{
 };
 
 use crate::harness::{render, tool};
-use crate::support::scratch;
+use crate::support::{files_under, scratch, workspace_root};
 
 pub(crate) fn wgsl_modules() -> impl Iterator<Item = &'static ModuleInfo> {
     shaders::modules()
@@ -159,24 +159,7 @@ fn spirv_val(words: &[u32], what: &str) {
 
 #[test]
 fn every_file_under_shader_lib_is_embedded() {
-    fn walk(dir: &Path, root: &Path, out: &mut Vec<String>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(&p, root, out);
-            } else {
-                out.push(
-                    p.strip_prefix(root)
-                        .unwrap()
-                        .to_string_lossy()
-                        .replace('\\', "/"),
-                );
-            }
-        }
-    }
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shader_lib");
-    let mut on_disk = Vec::new();
-    walk(&root, &root, &mut on_disk);
+    let mut on_disk = files_under(&workspace_root().join("shader_lib"));
     // The WESL package's manifest is not a shader; it is `shaders::WESL_TOML`.
     on_disk.retain(|p| p != "wesl/lodkit/wesl.toml");
     on_disk.sort();

@@ -24,7 +24,7 @@ fn sample(c: f32, id: u32, depth: f32) -> LodSample {
 }
 
 /// (newer, older) pairs: the paper's three cases, ties, big ids, sky.
-fn combine_cases() -> Vec<(LodSample, LodSample)> {
+pub(crate) fn combine_cases() -> Vec<(LodSample, LodSample)> {
     vec![
         (sample(0.9, 0, 0.5), sample(0.1, 0, 0.2)), // 1. both n-instances: newer, even if older is closer
         (sample(0.9, 5, 0.5), sample(0.1, 0, 0.2)), // 2. t vs n: older closer -> older
@@ -40,7 +40,7 @@ fn combine_cases() -> Vec<(LodSample, LodSample)> {
     ]
 }
 
-fn combine_inputs(cases: &[(LodSample, LodSample)]) -> Vec<u32> {
+pub(crate) fn combine_inputs(cases: &[(LodSample, LodSample)]) -> Vec<u32> {
     cases
         .iter()
         .flat_map(|(n, o)| {
@@ -52,6 +52,16 @@ fn combine_inputs(cases: &[(LodSample, LodSample)]) -> Vec<u32> {
         })
         .collect()
 }
+
+/// The WGSL probe of `combine_samples` over [`combine_inputs`] (12 words in, a color out).
+pub(crate) const COMBINE_PROBE: Probe<'static> = Probe {
+    header: "#import lodkit::combine::{LodSample, combine_samples}",
+    body: COMBINE_WGSL,
+    inputs: 12,
+    outputs: 4,
+    texture: None,
+    rgba: &[],
+};
 
 const COMBINE_WGSL: &str = "let newer = LodSample(vec4<f32>(inp_f(0u), inp_f(1u), inp_f(2u), inp_f(3u)), inp_u(4u), inp_f(5u));
     let older = LodSample(vec4<f32>(inp_f(6u), inp_f(7u), inp_f(8u), inp_f(9u)), inp_u(10u), inp_f(11u));

@@ -51,7 +51,8 @@ pub struct Probe<'a> {
     pub rgba: &'a [(u32, u32, &'a [glam::Vec4])],
 }
 
-fn wgsl_probe(p: &Probe) -> String {
+/// The WGSL probe shader (naga_oil: the header `#import`s lodkit).
+pub fn wgsl_probe(p: &Probe) -> String {
     let mut texture = if p.texture.is_some() {
         "@group(0) @binding(2) var probe_tex: texture_2d<f32>;".to_owned()
     } else {

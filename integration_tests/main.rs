@@ -15,4 +15,5 @@ mod portability;
 mod robustness;
 mod selection;
 mod single_frame;
+mod webgpu_page;
 mod wesl;

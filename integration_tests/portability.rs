@@ -11,7 +11,7 @@ use lodkit::shaders::{
 use crate::composition::{wgsl_harness, wgsl_modules};
 use crate::harness::render;
 use crate::support::browser_script;
-use crate::support::scratch;
+use crate::support::{run_ok, scratch};
 
 /// Composes `source` with no shader defs and with each of `defs` switched on, exports each
 /// variant to plain WGSL and returns the distinct texts.
@@ -80,16 +80,9 @@ fn every_module_and_pass_compiles_in_tint() {
     let Some(mut node) = browser_script("tint.mjs") else {
         return;
     };
-    let out = node.arg(&dir).output().unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        out.status.success(),
-        "Tint rejects composed lodkit WGSL ({}):\n{text}",
-        dir.display()
+    let text = run_ok(
+        node.arg(&dir),
+        &format!("Tint rejects composed lodkit WGSL ({})", dir.display()),
     );
     crate::harness::say(&format!(
         "tint: {}",

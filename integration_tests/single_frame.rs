@@ -15,7 +15,7 @@ use crate::harness::{Probe, floats, run_with, say, words};
 
 const TILE: u32 = 64;
 
-fn screen_door_cases() -> (Vec<f32>, Vec<u32>) {
+pub(crate) fn screen_door_cases() -> (Vec<f32>, Vec<u32>) {
     let ts: Vec<f32> = (0..=16).map(|k| k as f32 / 16.0).collect();
     let mut cases = Vec::new();
     for &t in &ts {
@@ -27,7 +27,7 @@ fn screen_door_cases() -> (Vec<f32>, Vec<u32>) {
 }
 
 /// Keep-bits of the current (-(1 - t)) and next (+t) LOD for every pixel of a 64x64 tile.
-fn rust_bits(pattern: DitherPattern, ts: &[f32]) -> Vec<u32> {
+pub(crate) fn rust_bits(pattern: DitherPattern, ts: &[f32]) -> Vec<u32> {
     let mut out = Vec::new();
     for &t in ts {
         for y in 0..TILE {
@@ -79,25 +79,31 @@ fn check_coverage(bits: &[u32], what: &str) {
     }
 }
 
-#[test]
-fn screen_door_twins_are_complementary_on_the_gpu() {
-    let gpu = lodkit_test_gpu!();
-    let (ts, cases) = screen_door_cases();
-    let wgsl = Probe {
-        header: "#import lodkit::screen_door::screen_door_keep",
-        body: "let t = inp_f(0u); let y = f32(inp_u(1u)) + 0.5;
+/// The WGSL probe of `screen_door_keep`: keep-bits of both LODs (-(1 - t) and +t) along one
+/// row of the 64x64 tile, per case (t, row) of [`screen_door_cases`].
+pub(crate) const SCREEN_DOOR_PROBE: Probe<'static> = Probe {
+    header: "#import lodkit::screen_door::screen_door_keep",
+    body: SCREEN_DOOR_WGSL,
+    inputs: 2,
+    outputs: 4,
+    texture: None,
+    rgba: &[],
+};
+
+const SCREEN_DOOR_WGSL: &str = "let t = inp_f(0u); let y = f32(inp_u(1u)) + 0.5;
                var w = array<u32, 4>(0u, 0u, 0u, 0u);
                for (var x = 0u; x < 64u; x++) {
                    let p = vec2<f32>(f32(x) + 0.5, y);
                    if (screen_door_keep(p, -(1.0 - t))) { w[x / 32u] |= 1u << (x % 32u); }
                    if (screen_door_keep(p, t)) { w[2u + x / 32u] |= 1u << (x % 32u); }
                }
-               out_u(0u, w[0]); out_u(1u, w[1]); out_u(2u, w[2]); out_u(3u, w[3]);",
-        inputs: 2,
-        outputs: 4,
-        texture: None,
-        rgba: &[],
-    };
+               out_u(0u, w[0]); out_u(1u, w[1]); out_u(2u, w[2]); out_u(3u, w[3]);";
+
+#[test]
+fn screen_door_twins_are_complementary_on_the_gpu() {
+    let gpu = lodkit_test_gpu!();
+    let (ts, cases) = screen_door_cases();
+    let wgsl = SCREEN_DOOR_PROBE;
     let glsl = Probe {
         header: "#include \"lodkit/screen_door.glsl\"",
         body: "float t = inp_f(0u); float y = float(inp_u(1u)) + 0.5;

@@ -8,28 +8,13 @@ use std::path::Path;
 use lodkit::shaders::{self, Language, ModuleKind, naga};
 
 use crate::composition::{module_harness, wgsl_modules};
-use crate::support::{browser_script, node_script, scratch, workspace_root};
-
-/// Every file under `dir`, relative to it, sorted.
-fn files_under(dir: &Path, base: &Path, out: &mut Vec<String>) {
-    for entry in std::fs::read_dir(dir).unwrap().flatten() {
-        let path = entry.path();
-        if path.is_dir() {
-            files_under(&path, base, out);
-        } else {
-            let rel = path.strip_prefix(base).unwrap().to_string_lossy();
-            out.push(rel.replace('\\', "/"));
-        }
-    }
-    out.sort();
-}
+use crate::support::{browser_script, files_under, node_script, run_ok, scratch, workspace_root};
 
 #[test]
 fn committed_wesl_package_is_what_the_generator_writes() {
     let dir = workspace_root().join("shader_lib/wesl/lodkit");
     let generated = shaders::wesl_package().expect("every module converts to WESL");
-    let mut on_disk = Vec::new();
-    files_under(&dir, &dir, &mut on_disk);
+    let on_disk = files_under(&dir);
     let names: Vec<String> = generated.iter().map(|(p, _)| p.clone()).collect();
     let mut sorted = names.clone();
     sorted.sort();
@@ -134,19 +119,11 @@ fn link_jobs(name: &str) -> (Vec<serde_json::Value>, std::path::PathBuf) {
 /// validator and to Tint.
 fn link_and_check(mut linker: std::process::Command, name: &str) {
     let (jobs, jobs_file) = link_jobs(name);
-    let out = linker
-        .arg(workspace_root().join("shader_lib/wesl/lodkit"))
-        .arg(&jobs_file)
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        out.status.success(),
-        "{name} cannot link lodkit's WESL:\n{text}"
+    let text = run_ok(
+        linker
+            .arg(workspace_root().join("shader_lib/wesl/lodkit"))
+            .arg(&jobs_file),
+        &format!("{name} cannot link lodkit's WESL"),
     );
     crate::harness::say(&format!("{name}: {}", text.trim()));
     let mut dir = None;
@@ -160,12 +137,9 @@ fn link_and_check(mut linker: std::process::Command, name: &str) {
     let Some(mut tint) = browser_script("tint.mjs") else {
         return;
     };
-    let out = tint.arg(dir.unwrap()).output().unwrap();
-    assert!(
-        out.status.success(),
-        "Tint rejects WESL linked by {name}:\n{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+    run_ok(
+        tint.arg(dir.unwrap()),
+        &format!("Tint rejects WESL linked by {name}"),
     );
 }
 

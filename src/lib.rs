@@ -54,3 +54,9 @@ pub mod visibility;
 
 #[cfg(feature = "wgpu")]
 pub mod gpu;
+
+/// The Rust snippets of `docs/engines.md`, compiled and run as doctests so the guide cannot
+/// drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/engines.md")]
+pub struct EnginesGuide;

@@ -8,7 +8,7 @@ use naga_oil::compose::{Composer, NagaModuleDescriptor, ShaderDefValue, ShaderTy
 
 use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error, validation_diagnostic};
 use super::imports::{declared_imports, import_site, module_prefix};
-use super::loading::{Unavailable, add_modules, collect_wgsl, split_duplicates};
+use super::loading::{Unavailable, add_modules, collect_files, split_duplicates};
 use super::registry::{self, Language, ModuleKind};
 use super::{ShaderError, closest, glsl, read_source};
 
@@ -174,7 +174,7 @@ impl ShaderLibrary {
                     source: std::io::Error::new(std::io::ErrorKind::NotFound, "not a folder"),
                 });
             }
-            collect_wgsl(dir, exclude, &mut files)?;
+            collect_files(dir, "wgsl", exclude, &mut files)?;
             #[cfg(feature = "wesl")]
             super::wesl_link::collect_user_modules(dir, &mut self.wesl_modules)?;
             self.include_dirs.push(dir.clone());

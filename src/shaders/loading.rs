@@ -14,9 +14,10 @@ use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error};
 use super::imports::import_site;
 use super::registry;
 
-/// Every `.wgsl` file under `dir` whose path contains none of `exclude`.
-pub(super) fn collect_wgsl(
+/// Every `.<extension>` file under `dir` whose path contains none of `exclude`.
+pub(super) fn collect_files(
     dir: &Path,
+    extension: &str,
     exclude: &[String],
     out: &mut Vec<PathBuf>,
 ) -> Result<(), ShaderError> {
@@ -27,8 +28,8 @@ pub(super) fn collect_wgsl(
     for entry in entries.flatten() {
         let path = entry.path();
         if path.is_dir() {
-            collect_wgsl(&path, exclude, out)?;
-        } else if path.extension().is_some_and(|e| e == "wgsl") && !excluded(&path, exclude) {
+            collect_files(&path, extension, exclude, out)?;
+        } else if path.extension().is_some_and(|e| e == extension) && !excluded(&path, exclude) {
             out.push(path);
         }
     }

@@ -8,7 +8,7 @@
 //! `package::<path>` relative to their folder.
 
 use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use naga_oil::compose::ShaderDefValue;
@@ -33,23 +33,8 @@ pub(crate) fn collect_user_modules(
     dir: &Path,
     out: &mut Vec<WeslUserModule>,
 ) -> Result<(), ShaderError> {
-    fn walk(dir: &Path, files: &mut Vec<PathBuf>) -> Result<(), ShaderError> {
-        let entries = std::fs::read_dir(dir).map_err(|source| ShaderError::Io {
-            path: dir.to_path_buf(),
-            source,
-        })?;
-        for entry in entries.flatten() {
-            let path = entry.path();
-            if path.is_dir() {
-                walk(&path, files)?;
-            } else if path.extension().is_some_and(|e| e == "wesl") {
-                files.push(path);
-            }
-        }
-        Ok(())
-    }
     let mut files = Vec::new();
-    walk(dir, &mut files)?;
+    super::loading::collect_files(dir, "wesl", &[], &mut files)?;
     files.sort();
     for file in files {
         let rel = file.strip_prefix(dir).unwrap_or(&file).with_extension("");
