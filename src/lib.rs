@@ -24,6 +24,7 @@
 //! | feature | default | gives | pulls in |
 //! |---|---|---|---|
 //! | `compose` | yes | [`shaders::ShaderLibrary`], validation, export, [`shaders::add_to_composer`] | naga 30, naga_oil 0.23 |
+//! | `wesl` | no | `SourceLanguage::Wesl`: link WESL that imports lodkit (wesl-rs), then validate | wesl 0.4.0 (no naga of its own; and `compose`) |
 //! | `wgpu` | no | [`gpu`]: headless devices, buffers, ready-made passes | wgpu 30 (and `compose`) |
 //!
 //! With `default-features = false` the crate is the embedded shader sources ([`shaders::modules`])
