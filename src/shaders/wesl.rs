@@ -35,22 +35,35 @@ impl fmt::Display for WeslError {
 
 impl std::error::Error for WeslError {}
 
-/// One open `#ifdef` group: whether it sits inside a function body, and the conditions of its
-/// branches so far (at module scope each declaration gets the whole condition of its branch,
-/// so no `@elif`/`@else` chain has to follow one declaration only).
+/// One open `#ifdef` group: the brace depth it was opened at (0: module scope), the
+/// conditions of its earlier branches and of the current one (`None` after `#else`). At module
+/// scope each declaration gets the whole condition of its branch and of every enclosing group,
+/// so no `@elif`/`@else` chain has to follow one declaration only.
 struct Group {
-    in_body: bool,
-    branches: Vec<String>,
+    depth: i64,
+    previous: Vec<String>,
+    current: Option<String>,
+    opened_as: String,
 }
 
 impl Group {
-    /// The condition under which the current (last) branch is taken; `cond` is `None` for
-    /// `#else`.
-    fn full_condition(&self, cond: Option<&str>) -> String {
-        let mut parts: Vec<String> = self.branches.iter().map(|c| negate(c)).collect();
-        parts.extend(cond.map(str::to_owned));
+    /// The condition under which the current branch is taken.
+    fn condition(&self) -> String {
+        let mut parts: Vec<String> = self.previous.iter().map(|c| negate(c)).collect();
+        parts.extend(self.current.clone());
         parts.join(" && ")
     }
+}
+
+/// The `@if` a module-scope declaration gets under the open groups, if any.
+fn module_scope_attribute(groups: &[Group]) -> Option<String> {
+    let parts: Vec<String> = groups
+        .iter()
+        .filter(|g| g.depth == 0)
+        .map(Group::condition)
+        .filter(|c| !c.is_empty())
+        .collect();
+    (!parts.is_empty()).then(|| format!("@if({})", parts.join(" && ")))
 }
 
 /// `X` -> `!X`, `!X` -> `X` (conditions here are single names, maybe negated).
@@ -69,8 +82,6 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
     let mut groups: Vec<Group> = Vec::new();
     let mut depth: i64 = 0;
     let mut in_header = true;
-    // At module scope under a condition: the attribute the next declaration gets.
-    let mut pending: Option<String> = None;
     for (index, line) in source.lines().enumerate() {
         let n = index + 1;
         let err = |message: String| WeslError { line: n, message };
@@ -85,7 +96,12 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
                 }
             }
         }
-        if trimmed.contains("#{") {
+        if trimmed
+            .split("//")
+            .next()
+            .unwrap_or_default()
+            .contains("#{")
+        {
             return Err(err(
                 "`#{...}` substitution has no WESL form (use `constants::NAME`)".into(),
             ));
@@ -120,15 +136,14 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
                 } else {
                     format!("!{name}")
                 };
-                let in_body = depth > 0;
-                if in_body {
+                if depth > 0 {
                     out.push_str(&format!("{}@if({cond}) {{\n", indent(line)));
-                } else {
-                    pending = Some(format!("@if({cond})"));
                 }
                 groups.push(Group {
-                    in_body,
-                    branches: vec![cond],
+                    depth,
+                    previous: Vec::new(),
+                    current: Some(cond),
+                    opened_as: trimmed.to_owned(),
                 });
                 continue;
             }
@@ -137,6 +152,12 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
                 let Some(group) = groups.last_mut() else {
                     return Err(err("`#else` without `#ifdef`".into()));
                 };
+                if group.depth != depth {
+                    return Err(err(format!(
+                        "`{trimmed}` is not at the brace depth of its `{}`: no WESL form",
+                        group.opened_as
+                    )));
+                }
                 let cond = if rest.is_empty() {
                     None
                 } else if let Some(r) = rest.strip_prefix("ifdef") {
@@ -148,26 +169,33 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
                         "`{trimmed}`: only `#else`, `#else ifdef NAME` and `#else ifndef NAME` convert"
                     )));
                 };
-                if group.in_body {
+                if group.depth > 0 {
                     let attr = match &cond {
                         Some(c) => format!("@elif({c})"),
                         None => "@else".to_owned(),
                     };
                     out.push_str(&format!("{}}} {attr} {{\n", indent(line)));
-                } else {
-                    pending = Some(format!("@if({})", group.full_condition(cond.as_deref())));
                 }
-                group.branches.extend(cond);
+                let Some(done) = group.current.take() else {
+                    return Err(err(format!("`{trimmed}` after `#else`")));
+                };
+                group.previous.push(done);
+                group.current = cond;
                 continue;
             }
             "#endif" => {
                 let Some(group) = groups.pop() else {
                     return Err(err("`#endif` without `#ifdef`".into()));
                 };
-                if group.in_body {
+                if group.depth != depth {
+                    return Err(err(format!(
+                        "`#endif` is not at the brace depth of its `{}`: no WESL form",
+                        group.opened_as
+                    )));
+                }
+                if group.depth > 0 {
                     out.push_str(&format!("{}}}\n", indent(line)));
                 }
-                pending = None;
                 continue;
             }
             d if d.starts_with("#if") || d.starts_with("#define") || d == "#undef" => {
@@ -179,9 +207,8 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
         }
         // An ordinary line. At module scope under a condition, the first line of each
         // declaration gets the branch's attribute.
-        if let Some(attr) = pending
-            .as_ref()
-            .filter(|_| depth == 0 && starts_declaration(trimmed))
+        if let Some(attr) =
+            module_scope_attribute(&groups).filter(|_| depth == 0 && starts_declaration(trimmed))
         {
             out.push_str(&format!("{}{attr} {}\n", indent(line), line.trim_start()));
             depth += brace_delta(line);
@@ -194,10 +221,7 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
     if let Some(group) = groups.last() {
         return Err(WeslError {
             line: source.lines().count(),
-            message: format!(
-                "`#ifdef {}` is never closed with `#endif`",
-                group.branches[0].trim_start_matches('!')
-            ),
+            message: format!("`{}` is never closed with `#endif`", group.opened_as),
         });
     }
     Ok(out)
@@ -277,6 +301,23 @@ mod tests {
     }
 
     #[test]
+    fn nested_groups_keep_every_enclosing_condition() {
+        let src = "#ifdef A\n#ifdef B\nfn f() {}\n#endif\nfn g() {}\n#else\nfn h() {}\n#endif\n";
+        let wesl = naga_oil_to_wesl(src, "lodkit", "").unwrap();
+        assert_eq!(
+            wesl,
+            "@if(A && B) fn f() {}\n@if(A) fn g() {}\n@if(!A) fn h() {}\n"
+        );
+    }
+
+    #[test]
+    fn groups_that_straddle_braces_are_errors() {
+        let e =
+            naga_oil_to_wesl("#ifdef A\nfn f() {\n#else\n}\n#endif\n", "lodkit", "").unwrap_err();
+        assert_eq!(e.line, 3, "{e}");
+    }
+
+    #[test]
     fn value_conditions_are_errors_with_their_line() {
         let e = naga_oil_to_wesl("fn f() {\n#if N == 3\n#endif\n}\n", "lodkit", "").unwrap_err();
         assert_eq!(e.line, 2);
@@ -284,6 +325,8 @@ mod tests {
         assert_eq!(e.line, 1);
         let e = naga_oil_to_wesl("#ifdef A\nfn f() {}\n", "lodkit", "").unwrap_err();
         assert!(e.message.contains("never closed"), "{e}");
+        // In a comment it is text, not a substitution.
+        assert!(naga_oil_to_wesl("// uses #{N} elsewhere\nfn f() {}\n", "lodkit", "").is_ok());
     }
 
     #[test]
