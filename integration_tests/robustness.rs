@@ -19,6 +19,17 @@ fn main(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
 }
 ";
 
+const WESL: &str = "import lodkit::normal_distance::foreshortened_normal_distance;
+import lodkit::screen_door::screen_door_keep;
+
+@fragment
+fn main(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+    let d = foreshortened_normal_distance(vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 1.0));
+    if (!screen_door_keep(p.xy, 0.5)) { discard; }
+    return vec4(d);
+}
+";
+
 const GLSL: &str = "#version 450
 #extension GL_GOOGLE_include_directive : require
 #include \"lodkit/normal_distance.glsl\"
@@ -118,6 +129,36 @@ fn glsl_nested_twenty_thousand_deep_is_an_error_not_a_stack_overflow() {
 }
 
 #[test]
+fn glsl_nesting_built_by_macros_is_an_error_not_a_stack_overflow() {
+    let n = 20_000;
+    let source = format!(
+        "#version 450\n#define O (\n#define C )\nlayout(location = 0) out vec4 o;\nvoid main() {{ float x = {}1.0{}; o = vec4(x); }}\n",
+        "O ".repeat(n),
+        " C".repeat(n)
+    );
+    // The brackets only appear after macro expansion: naga's parser meets them on its own
+    // deep-stack thread and must come back with a result, not abort the process.
+    let stage = SourceLanguage::Glsl(naga::ShaderStage::Fragment);
+    if let Err(e) = compose(&source, "macros.frag", stage) {
+        assert_reportable(&e, &source);
+    }
+}
+
+#[test]
+fn wesl_nested_twenty_thousand_deep_is_an_error() {
+    let n = 20_000;
+    let source = format!(
+        "import lodkit::unpopping::unpopping_alpha;\nfn f() -> f32 {{ return unpopping_alpha({}0.5{}, true); }}\n",
+        "(".repeat(n),
+        ")".repeat(n)
+    );
+    let e = compose(&source, "deep.wesl", SourceLanguage::Wesl).expect_err("too deep");
+    let d = e.diagnostic().expect("a source diagnostic");
+    assert_eq!(d.kind, DiagnosticKind::Limit);
+    assert_eq!(d.location.map(|l| l.line), Some(2));
+}
+
+#[test]
 fn wgsl_nested_twenty_thousand_deep_is_an_error() {
     let n = 20_000;
     let source = format!(
@@ -165,6 +206,14 @@ proptest! {
     fn mutated_wgsl_never_panics(anchor in 0usize..6, at in any::<usize>(), text in noise(), delete in 0usize..3) {
         let source = mutate(WGSL, anchor, at, &text, delete);
         if let Err(e) = compose(&source, "user.wgsl", SourceLanguage::Wgsl) {
+            assert_reportable(&e, &source);
+        }
+    }
+
+    #[test]
+    fn mutated_wesl_never_panics(anchor in 0usize..6, at in any::<usize>(), text in noise(), delete in 0usize..3) {
+        let source = mutate(WESL, anchor, at, &text, delete);
+        if let Err(e) = compose(&source, "user.wesl", SourceLanguage::Wesl) {
             assert_reportable(&e, &source);
         }
     }

@@ -40,7 +40,13 @@ if ! command -v apt-get >/dev/null; then
   exit 1
 fi
 sudo=""
-[ "$(id -u)" -eq 0 ] || sudo="sudo"
+if [ "$(id -u)" -ne 0 ]; then
+  if ! command -v sudo >/dev/null; then
+    echo "error: missing ${need[*]}; run this as root or install sudo" >&2
+    exit 1
+  fi
+  sudo="sudo"
+fi
 echo "installing ${need[*]}"
 $sudo apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${need[@]}"

@@ -176,7 +176,7 @@ impl ShaderLibrary {
             }
             collect_files(dir, "wgsl", exclude, &mut files)?;
             #[cfg(feature = "wesl")]
-            super::wesl_link::collect_user_modules(dir, &mut self.wesl_modules)?;
+            super::wesl_link::collect_user_modules(dir, exclude, &mut self.wesl_modules)?;
             self.include_dirs.push(dir.clone());
         }
         files.sort();
@@ -410,18 +410,37 @@ impl ShaderLibrary {
             })
             .collect();
         let options = naga::front::glsl::Options { stage, defines };
-        let module = naga::front::glsl::Frontend::default()
-            .parse(&options, &expanded.text)
-            .map_err(|e| {
-                let first = e.errors.first();
-                let span = first.and_then(|e| e.meta.to_range()).unwrap_or(0..0);
-                let message = first.map(|e| e.kind.to_string()).unwrap_or_default();
-                let mut d = expanded.diagnostic(DiagnosticKind::Parse, span, message);
-                for more in e.errors.iter().skip(1) {
-                    d = d.with_note(more.kind.to_string());
-                }
-                ShaderError::Source(Box::new(d))
-            })?;
+        // naga's GLSL parser recurses once per nesting level and macros can nest past the
+        // bracket count checked above, so it runs on a thread with a deep stack.
+        let text = expanded.text.as_str();
+        let parse = || naga::front::glsl::Frontend::default().parse(&options, text);
+        let parsed = std::thread::scope(|scope| {
+            match std::thread::Builder::new()
+                .name("lodkit-glsl-parser".into())
+                .stack_size(super::limits::GLSL_PARSER_STACK)
+                .spawn_scoped(scope, parse)
+            {
+                Ok(handle) => handle.join().map_err(|_| ()),
+                Err(_) => Ok(parse()),
+            }
+        })
+        .map_err(|()| {
+            ShaderError::Source(Box::new(expanded.diagnostic(
+                DiagnosticKind::Parse,
+                0..0,
+                "naga's GLSL front end failed on this file (it panicked)".into(),
+            )))
+        })?;
+        let module = parsed.map_err(|e| {
+            let first = e.errors.first();
+            let span = first.and_then(|e| e.meta.to_range()).unwrap_or(0..0);
+            let message = first.map(|e| e.kind.to_string()).unwrap_or_default();
+            let mut d = expanded.diagnostic(DiagnosticKind::Parse, span, message);
+            for more in e.errors.iter().skip(1) {
+                d = d.with_note(more.kind.to_string());
+            }
+            ShaderError::Source(Box::new(d))
+        })?;
         let info =
             naga::valid::Validator::new(naga::valid::ValidationFlags::all(), self.capabilities)
                 .validate(&module)

@@ -9,6 +9,11 @@ use std::ops::Range;
 /// GLSL parser stays within a 2 MiB thread stack in a debug build.
 pub const MAX_NESTING: usize = 256;
 
+/// Stack of the thread naga's GLSL parser runs on: room for about 50,000 nesting levels (a
+/// debug build spends about 4 KiB per level), which macros that expand to brackets can reach
+/// past [`MAX_NESTING`]. Reserved, not committed: pages are touched only as deep as it goes.
+pub(crate) const GLSL_PARSER_STACK: usize = 256 << 20;
+
 /// Where the nesting went past [`MAX_NESTING`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct TooDeep {

@@ -98,8 +98,10 @@ pub(super) fn add_modules(
     let mut by_name: HashMap<String, usize> = HashMap::new();
     let mut deps: Vec<Vec<String>> = Vec::new();
     for (i, (file, source)) in sources.iter().enumerate() {
-        let (name, imports, _) = get_preprocessor_data(source);
-        let name = name.unwrap_or_default();
+        // The declared path as written: naga_oil gives none for a module whose preprocessor
+        // directives are malformed, and two such modules must not look like duplicates.
+        let (_, imports, _) = get_preprocessor_data(source);
+        let name = registry::define_import_path(source).unwrap_or_else(|| file.clone());
         if let Some(&j) = by_name.get(&name) {
             let d = Diagnostic::new(
                 DiagnosticKind::DuplicateModule,

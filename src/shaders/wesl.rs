@@ -80,44 +80,61 @@ fn negate(c: &str) -> String {
 pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<String, WeslError> {
     let mut out = String::with_capacity(source.len() + 256);
     let mut groups: Vec<Group> = Vec::new();
-    let mut depth: i64 = 0;
+    let mut code = CodeState::default();
     let mut in_header = true;
+    // A `#import a::{` continued on the next lines, and the line it started on.
+    let mut import: Option<(String, usize)> = None;
+    // Whether the last module-scope line was attributes only (`@vertex` above `fn vs`).
+    let mut attributes_above = false;
     for (index, line) in source.lines().enumerate() {
         let n = index + 1;
         let err = |message: String| WeslError { line: n, message };
         let trimmed = line.trim();
         if in_header && !trimmed.starts_with("//") {
             in_header = false;
-            if !note.is_empty() {
-                for l in note.lines() {
-                    out.push_str("// ");
-                    out.push_str(l);
-                    out.push('\n');
-                }
+            for l in note.lines() {
+                out.push_str("// ");
+                out.push_str(l);
+                out.push('\n');
             }
         }
-        if trimmed
-            .split("//")
-            .next()
-            .unwrap_or_default()
-            .contains("#{")
-        {
+        if let Some((spec, start)) = import.as_mut() {
+            spec.push(' ');
+            spec.push_str(strip_comment(trimmed));
+            if balanced(spec) {
+                let statement = convert_import(spec, package).map_err(|message| WeslError {
+                    line: *start,
+                    message,
+                })?;
+                out.push_str(&statement);
+                out.push('\n');
+                import = None;
+            }
+            continue;
+        }
+        if !code.in_comment && strip_comment(trimmed).contains("#{") {
             return Err(err(
                 "`#{...}` substitution has no WESL form (use `constants::NAME`)".into(),
             ));
         }
-        if let Some(rest) = trimmed.strip_prefix("#define_import_path") {
+        let directive = directive(trimmed);
+        if let Some(rest) = directive.strip_prefix("#define_import_path") {
             if !rest.starts_with(char::is_whitespace) {
                 return Err(err(format!("unknown directive `{trimmed}`")));
             }
             continue;
         }
-        if let Some(rest) = trimmed.strip_prefix("#import") {
-            out.push_str(&convert_import(rest.trim(), package).map_err(err)?);
-            out.push('\n');
+        if let Some(rest) = directive.strip_prefix("#import") {
+            let spec = strip_comment(rest).trim().to_owned();
+            if balanced(&spec) {
+                out.push_str(&convert_import(&spec, package).map_err(err)?);
+                out.push('\n');
+            } else {
+                import = Some((spec, n));
+            }
             continue;
         }
-        let directive = trimmed.split_whitespace().next().unwrap_or("");
+        let word = directive.split_whitespace().next().unwrap_or("");
         let condition = |rest: &str| -> Result<String, WeslError> {
             let name = rest.trim();
             if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
@@ -128,19 +145,24 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
             }
             Ok(name.to_owned())
         };
-        match directive {
+        if word.starts_with('#') && code.parens > 0 {
+            return Err(err(format!(
+                "`{trimmed}` inside parentheses (a conditional parameter or argument) has no WESL form here"
+            )));
+        }
+        match word {
             "#ifdef" | "#ifndef" => {
-                let name = condition(&trimmed[directive.len()..])?;
-                let cond = if directive == "#ifdef" {
+                let name = condition(&directive[word.len()..])?;
+                let cond = if word == "#ifdef" {
                     name
                 } else {
                     format!("!{name}")
                 };
-                if depth > 0 {
+                if code.depth > 0 && !code.in_struct() {
                     out.push_str(&format!("{}@if({cond}) {{\n", indent(line)));
                 }
                 groups.push(Group {
-                    depth,
+                    depth: code.depth,
                     previous: Vec::new(),
                     current: Some(cond),
                     opened_as: trimmed.to_owned(),
@@ -148,11 +170,11 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
                 continue;
             }
             "#else" => {
-                let rest = trimmed["#else".len()..].trim();
+                let rest = directive["#else".len()..].trim();
                 let Some(group) = groups.last_mut() else {
                     return Err(err("`#else` without `#ifdef`".into()));
                 };
-                if group.depth != depth {
+                if group.depth != code.depth {
                     return Err(err(format!(
                         "`{trimmed}` is not at the brace depth of its `{}`: no WESL form",
                         group.opened_as
@@ -169,7 +191,7 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
                         "`{trimmed}`: only `#else`, `#else ifdef NAME` and `#else ifndef NAME` convert"
                     )));
                 };
-                if group.depth > 0 {
+                if group.depth > 0 && !code.in_struct() {
                     let attr = match &cond {
                         Some(c) => format!("@elif({c})"),
                         None => "@else".to_owned(),
@@ -187,36 +209,52 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
                 let Some(group) = groups.pop() else {
                     return Err(err("`#endif` without `#ifdef`".into()));
                 };
-                if group.depth != depth {
+                if group.depth != code.depth {
                     return Err(err(format!(
                         "`#endif` is not at the brace depth of its `{}`: no WESL form",
                         group.opened_as
                     )));
                 }
-                if group.depth > 0 {
+                if group.depth > 0 && !code.in_struct() {
                     out.push_str(&format!("{}}}\n", indent(line)));
                 }
                 continue;
             }
-            d if d.starts_with("#if") || d.starts_with("#define") || d == "#undef" => {
+            w if w.starts_with("#if") || w.starts_with("#define") || w == "#undef" => {
                 return Err(err(format!(
                     "`{trimmed}` has no WESL form: only `#ifdef`/`#ifndef`/`#else`/`#endif` convert"
                 )));
             }
             _ => {}
         }
-        // An ordinary line. At module scope under a condition, the first line of each
-        // declaration gets the branch's attribute.
-        if let Some(attr) =
-            module_scope_attribute(&groups).filter(|_| depth == 0 && starts_declaration(trimmed))
+        // An ordinary line. Under a condition, the first line of each module-scope declaration
+        // (above its attributes) and each struct member gets the whole condition.
+        let is_code = !trimmed.is_empty() && !trimmed.starts_with("//") && !code.in_comment;
+        let attr = if code.depth == 0 && is_code && !attributes_above && starts_declaration(trimmed)
         {
-            out.push_str(&format!("{}{attr} {}\n", indent(line), line.trim_start()));
-            depth += brace_delta(line);
-            continue;
+            module_scope_attribute(&groups)
+        } else if code.in_struct() && is_code && !trimmed.starts_with('}') {
+            struct_member_attribute(&groups, code.depth)
+        } else {
+            None
+        };
+        if code.depth == 0 && is_code {
+            attributes_above = trimmed.starts_with('@') && !starts_with_keyword(trimmed);
         }
-        out.push_str(line);
-        out.push('\n');
-        depth += brace_delta(line);
+        match attr {
+            Some(attr) => out.push_str(&format!("{}{attr} {}\n", indent(line), line.trim_start())),
+            None => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+        code.scan(line);
+    }
+    if let Some((_, start)) = import {
+        return Err(WeslError {
+            line: start,
+            message: "`#import` list is never closed with `}`".into(),
+        });
     }
     if let Some(group) = groups.last() {
         return Err(WeslError {
@@ -225,6 +263,100 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
         });
     }
     Ok(out)
+}
+
+/// Where the scan is in the code: brace and parenthesis depth, open block comment, and the
+/// brace depth at which the struct being declared opened.
+#[derive(Default)]
+struct CodeState {
+    depth: i64,
+    parens: i64,
+    in_comment: bool,
+    struct_depth: Option<i64>,
+}
+
+impl CodeState {
+    fn in_struct(&self) -> bool {
+        self.struct_depth.is_some_and(|d| self.depth == d)
+    }
+
+    /// Counts the brackets of `line` outside comments.
+    fn scan(&mut self, line: &str) {
+        let declares_struct = self.depth == 0 && line.trim_start().starts_with("struct ");
+        let bytes = line.as_bytes();
+        let mut i = 0;
+        while i < bytes.len() {
+            if self.in_comment {
+                if bytes[i..].starts_with(b"*/") {
+                    self.in_comment = false;
+                    i += 1;
+                }
+            } else if bytes[i..].starts_with(b"//") {
+                break;
+            } else if bytes[i..].starts_with(b"/*") {
+                self.in_comment = true;
+                i += 1;
+            } else {
+                match bytes[i] {
+                    b'{' => {
+                        self.depth += 1;
+                        if declares_struct && self.depth == 1 {
+                            self.struct_depth = Some(1);
+                        }
+                    }
+                    b'}' => {
+                        self.depth -= 1;
+                        if self.depth == 0 {
+                            self.struct_depth = None;
+                        }
+                    }
+                    b'(' => self.parens += 1,
+                    b')' => self.parens -= 1,
+                    _ => {}
+                }
+            }
+            i += 1;
+        }
+    }
+}
+
+/// The `@if` a struct member at `depth` gets under the groups opened inside the struct.
+fn struct_member_attribute(groups: &[Group], depth: i64) -> Option<String> {
+    let parts: Vec<String> = groups
+        .iter()
+        .filter(|g| g.depth == depth)
+        .map(Group::condition)
+        .filter(|c| !c.is_empty())
+        .collect();
+    (!parts.is_empty()).then(|| format!("@if({})", parts.join(" && ")))
+}
+
+/// A preprocessor line with the spaces naga_oil allows after `#` taken out (`# ifdef X`).
+fn directive(trimmed: &str) -> String {
+    match trimmed.strip_prefix('#') {
+        Some(rest) => format!("#{}", rest.trim_start()),
+        None => trimmed.to_owned(),
+    }
+}
+
+/// `text` up to a `//` comment.
+fn strip_comment(text: &str) -> &str {
+    text.split("//").next().unwrap_or_default()
+}
+
+/// Whether every `{` of an import list is closed.
+fn balanced(spec: &str) -> bool {
+    spec.matches('{').count() <= spec.matches('}').count()
+}
+
+/// Whether a line begins with a declaration keyword (after no attributes).
+fn starts_with_keyword(trimmed: &str) -> bool {
+    trimmed
+        .split(|c: char| {
+            !(c.is_ascii_alphanumeric() || c == '_' || c == '@' || c == '(' || c == ')')
+        })
+        .any(|w| matches!(w, "fn" | "struct" | "const" | "var" | "override" | "alias"))
+        || trimmed.contains("var<")
 }
 
 /// `a::b::{x, y}` or `a::b::x` (naga_oil) as a WESL import statement.
@@ -238,7 +370,8 @@ fn convert_import(spec: &str, package: &str) -> Result<String, String> {
              import items by path (`#import a::b::{{x, y}}`)"
         ));
     }
-    let spec = spec.trim_end_matches(';');
+    let spec = spec.split_whitespace().collect::<Vec<_>>().join(" ");
+    let spec = spec.trim_end_matches(';').trim_end();
     let own = format!("{package}::");
     let path = match spec.strip_prefix(&own) {
         Some(rest) => format!("package::{rest}"),
@@ -262,18 +395,6 @@ fn starts_declaration(trimmed: &str) -> bool {
 /// The leading whitespace of `line`.
 fn indent(line: &str) -> &str {
     &line[..line.len() - line.trim_start().len()]
-}
-
-/// Net `{` minus `}` on a line, outside `//` comments.
-fn brace_delta(line: &str) -> i64 {
-    let code = line.split("//").next().unwrap_or("");
-    code.chars()
-        .map(|c| match c {
-            '{' => 1,
-            '}' => -1,
-            _ => 0,
-        })
-        .sum()
 }
 
 #[cfg(test)]
@@ -308,6 +429,32 @@ mod tests {
             wesl,
             "@if(A && B) fn f() {}\n@if(A) fn g() {}\n@if(!A) fn h() {}\n"
         );
+    }
+
+    #[test]
+    fn struct_members_and_attribute_lines_take_the_condition_once() {
+        let src = "struct V {\n    a: f32,\n#ifdef UV\n    uv: vec2<f32>,\n#endif\n}\n#ifdef A\n@fragment\nfn f() {}\n@group(0) @binding(0)\nvar<uniform> u: f32;\n#endif\n";
+        let wesl = naga_oil_to_wesl(src, "lodkit", "").unwrap();
+        assert_eq!(
+            wesl,
+            "struct V {\n    a: f32,\n    @if(UV) uv: vec2<f32>,\n}\n@if(A) @fragment\nfn f() {}\n@if(A) @group(0) @binding(0)\nvar<uniform> u: f32;\n"
+        );
+    }
+
+    #[test]
+    fn imports_across_lines_with_comments_and_spaced_directives() {
+        let src = "#import lodkit::a::{\n    x, // first\n    y\n}\n#import lodkit::b::z // why\n# ifdef Q\nconst K = 1;\n# endif\n/* { */\nconst J = 2;\n";
+        let wesl = naga_oil_to_wesl(src, "lodkit", "").unwrap();
+        assert_eq!(
+            wesl,
+            "import package::a::{ x, y };\nimport package::b::z;\n@if(Q) const K = 1;\n/* { */\nconst J = 2;\n"
+        );
+    }
+
+    #[test]
+    fn conditional_parameters_are_errors() {
+        let src = "fn f(\n#ifdef A\n    a: f32,\n#endif\n) {}\n";
+        assert_eq!(naga_oil_to_wesl(src, "lodkit", "").unwrap_err().line, 2);
     }
 
     #[test]

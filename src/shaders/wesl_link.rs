@@ -28,13 +28,15 @@ pub(crate) struct WeslUserModule {
     pub source: Arc<str>,
 }
 
-/// Every `.wesl` file under `dir`, as user modules relative to it.
+/// Every `.wesl` file under `dir` whose path contains none of `exclude`, as user modules
+/// relative to it.
 pub(crate) fn collect_user_modules(
     dir: &Path,
+    exclude: &[String],
     out: &mut Vec<WeslUserModule>,
 ) -> Result<(), ShaderError> {
     let mut files = Vec::new();
-    super::loading::collect_files(dir, "wesl", &[], &mut files)?;
+    super::loading::collect_files(dir, "wesl", exclude, &mut files)?;
     files.sort();
     for file in files {
         let rel = file.strip_prefix(dir).unwrap_or(&file).with_extension("");
@@ -102,7 +104,22 @@ pub(crate) fn link(
             resolver.add_module(path(import), m.source.into());
         }
     }
-    for m in user_modules {
+    // Brackets nested past the limit would recurse the WESL parser off the stack.
+    for (text, name) in std::iter::once((source, file))
+        .chain(user_modules.iter().map(|m| (&*m.source, m.file.as_str())))
+    {
+        if let Some(nesting) = super::limits::too_deep(text) {
+            let message = nesting.message();
+            return Err(source_error(
+                Diagnostic::new(DiagnosticKind::Limit, name, message)
+                    .with_span(Arc::from(text), nesting.at)
+                    .with_label("nested too deep"),
+            ));
+        }
+    }
+    // A user module at the root's own path (a `main.wesl` in an include folder) would replace
+    // the file being linked: the file being linked wins.
+    for m in user_modules.iter().filter(|m| m.module_path != ROOT) {
         let Ok(p) = m.module_path.parse::<ModulePath>() else {
             return Err(source_error(Diagnostic::new(
                 DiagnosticKind::Parse,

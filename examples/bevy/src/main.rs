@@ -55,7 +55,8 @@ const TRANSITION_SECONDS: f32 = 0.5;
 const READBACK_UPDATES: usize = 8;
 /// Frames to wait for a level to appear before declaring the pipeline never ready.
 const WARMUP_FRAMES: usize = 30;
-/// LOD1 is used from this view-normalized distance on (the distance at a 90° field of view).
+/// LOD1 is used from this view-normalized distance on (distance / |P[1][1]|, DigitalRune's
+/// measure; Bevy's default 45° field of view).
 const LOD1_DISTANCE: f32 = 4.0;
 /// Global LOD bias after the quality drop that triggers the switch (1 before).
 const LOW_QUALITY_BIAS: f32 = 3.0;
