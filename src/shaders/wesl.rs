@@ -55,11 +55,12 @@ impl Group {
     }
 }
 
-/// The `@if` a module-scope declaration gets under the open groups, if any.
-fn module_scope_attribute(groups: &[Group]) -> Option<String> {
+/// The `@if` a declaration or struct member at brace `depth` gets from the groups opened at
+/// that depth, if any.
+fn attribute_at(groups: &[Group], depth: i64) -> Option<String> {
     let parts: Vec<String> = groups
         .iter()
-        .filter(|g| g.depth == 0)
+        .filter(|g| g.depth == depth)
         .map(Group::condition)
         .filter(|c| !c.is_empty())
         .collect();
@@ -232,9 +233,9 @@ pub fn naga_oil_to_wesl(source: &str, package: &str, note: &str) -> Result<Strin
         let is_code = !trimmed.is_empty() && !trimmed.starts_with("//") && !code.in_comment;
         let attr = if code.depth == 0 && is_code && !attributes_above && starts_declaration(trimmed)
         {
-            module_scope_attribute(&groups)
+            attribute_at(&groups, 0)
         } else if code.in_struct() && is_code && !trimmed.starts_with('}') {
-            struct_member_attribute(&groups, code.depth)
+            attribute_at(&groups, code.depth)
         } else {
             None
         };
@@ -318,17 +319,6 @@ impl CodeState {
             i += 1;
         }
     }
-}
-
-/// The `@if` a struct member at `depth` gets under the groups opened inside the struct.
-fn struct_member_attribute(groups: &[Group], depth: i64) -> Option<String> {
-    let parts: Vec<String> = groups
-        .iter()
-        .filter(|g| g.depth == depth)
-        .map(Group::condition)
-        .filter(|c| !c.is_empty())
-        .collect();
-    (!parts.is_empty()).then(|| format!("@if({})", parts.join(" && ")))
 }
 
 /// A preprocessor line with the spaces naga_oil allows after `#` taken out (`# ifdef X`).
