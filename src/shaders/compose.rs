@@ -7,7 +7,7 @@ use std::sync::Arc;
 use naga_oil::compose::{Composer, NagaModuleDescriptor, ShaderDefValue, ShaderType};
 
 use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error, validation_diagnostic};
-use super::imports::{declared_imports, import_site, module_prefix};
+use super::imports::{declared_imports, import_site, longest_prefix, module_prefix};
 use super::loading::{Unavailable, add_modules, collect_files, split_duplicates};
 use super::registry::{self, Language, ModuleKind};
 use super::{ShaderError, closest, glsl, read_source};
@@ -194,14 +194,14 @@ impl ShaderLibrary {
             false,
             Some(&mut self.unavailable),
         )?;
-        let names: Vec<String> = self
+        // What the composer gained: the modules that were added (others are unavailable).
+        let mut names: Vec<String> = self
             .composer
             .module_sets
             .keys()
             .filter(|n| registry::find_module(n).is_none() && !self.user_modules.contains(n))
             .cloned()
             .collect();
-        let mut names = names;
         names.sort();
         self.user_modules.extend(names.iter().cloned());
         Ok(names)
@@ -296,17 +296,8 @@ impl ShaderLibrary {
             if let Some(d) = self.unavailable_import(&import, desc, line_at) {
                 return Err(ShaderError::Source(Box::new(d)));
             }
-            let mut candidate = import.as_str();
-            let found = loop {
-                if self.composer.contains_module(candidate) {
-                    break true;
-                }
-                match candidate.rsplit_once("::") {
-                    Some((head, _)) => candidate = head,
-                    None => break false,
-                }
-            };
-            if !found {
+            let found = longest_prefix(&import, |p| self.composer.contains_module(p).then_some(()));
+            if found.is_none() {
                 let name = module_prefix(&import);
                 // Search from this statement on: an earlier import may contain the name too.
                 let site = import_site(&desc.source[line_at..], name);
@@ -336,13 +327,7 @@ impl ShaderLibrary {
         desc: &ComposeDescriptor,
         line_at: usize,
     ) -> Option<Diagnostic> {
-        let mut candidate = import;
-        let problem = loop {
-            if let Some(d) = self.unavailable.get(candidate) {
-                break d;
-            }
-            candidate = candidate.rsplit_once("::")?.0;
-        };
+        let (candidate, problem) = longest_prefix(import, |p| self.unavailable.get(p))?;
         let site = import_site(&desc.source[line_at..], candidate);
         let span = site.start + line_at..site.end + line_at;
         let mut d = Diagnostic::new(

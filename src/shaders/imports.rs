@@ -15,6 +15,21 @@ pub(crate) fn module_prefix(import: &str) -> &str {
     }
 }
 
+/// The longest prefix of `import` (itself, then without its last `::` segment, and so on) for
+/// which `find` gives something, with what it gave.
+pub(crate) fn longest_prefix<T>(
+    import: &str,
+    mut find: impl FnMut(&str) -> Option<T>,
+) -> Option<(&str, T)> {
+    let mut candidate = import;
+    loop {
+        if let Some(found) = find(candidate) {
+            return Some((candidate, found));
+        }
+        candidate = candidate.rsplit_once("::")?.0;
+    }
+}
+
 /// Every path an `#import` statement names, fully expanded (`#import a::{b, c::d}` names `a::b`
 /// and `a::c::d`), with the byte offset of its `#import`. Unlike naga_oil's own scan, imports that
 /// are never used count too.

@@ -11,7 +11,7 @@ use naga_oil::compose::{
 
 use super::ShaderError;
 use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error};
-use super::imports::import_site;
+use super::imports::{import_site, longest_prefix};
 use super::registry;
 
 /// Every `.<extension>` file under `dir` whose path contains none of `exclude`.
@@ -116,13 +116,7 @@ pub(super) fn add_modules(
     }
     // Resolve each import to a module of this batch (the longest matching prefix).
     let resolve = |import: &str| -> Option<usize> {
-        let mut candidate = import;
-        loop {
-            if let Some(&i) = by_name.get(candidate) {
-                return Some(i);
-            }
-            candidate = candidate.rsplit_once("::")?.0;
-        }
+        longest_prefix(import, |p| by_name.get(p).copied()).map(|(_, i)| i)
     };
     let n = sources.len();
     let mut state = vec![0u8; n]; // 0 new, 1 on stack, 2 done
@@ -221,14 +215,7 @@ pub(super) fn add_modules(
 }
 
 fn module_prefix_of<'a>(import: &'a str, by_name: &HashMap<String, usize>) -> &'a str {
-    let mut candidate = import;
-    while !by_name.contains_key(candidate) {
-        match candidate.rsplit_once("::") {
-            Some((head, _)) => candidate = head,
-            None => return import,
-        }
-    }
-    candidate
+    longest_prefix(import, |p| by_name.get(p)).map_or(import, |(prefix, _)| prefix)
 }
 
 pub(super) fn import_site_define(source: &str) -> std::ops::Range<usize> {

@@ -125,11 +125,7 @@ pub fn find_glsl_include(include_path: &str) -> Option<&'static ModuleInfo> {
 
 /// The WESL form of the module with import path `import_path` (e.g. `lodkit::visibility`).
 pub fn find_wesl_module(import_path: &str) -> Option<&'static ModuleInfo> {
-    modules().iter().find(|m| {
-        m.language == Language::Wesl
-            && m.kind == ModuleKind::Module
-            && m.import_path.as_deref() == Some(import_path)
-    })
+    wesl_modules().find(|m| m.import_path.as_deref() == Some(import_path))
 }
 
 /// The WESL modules, each with the `embedded://` path Bevy 0.20 registers it under.

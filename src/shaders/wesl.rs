@@ -345,9 +345,20 @@ fn starts_with_keyword(trimmed: &str) -> bool {
         .split(|c: char| {
             !(c.is_ascii_alphanumeric() || c == '_' || c == '@' || c == '(' || c == ')')
         })
-        .any(|w| matches!(w, "fn" | "struct" | "const" | "var" | "override" | "alias"))
+        .any(|w| DECLARATION_KEYWORDS.contains(&w))
         || trimmed.contains("var<")
 }
+
+/// The words that begin a module-scope declaration.
+pub(crate) const DECLARATION_KEYWORDS: [&str; 7] = [
+    "fn",
+    "struct",
+    "const",
+    "var",
+    "override",
+    "alias",
+    "const_assert",
+];
 
 /// `a::b::{x, y}` or `a::b::x` (naga_oil) as a WESL import statement.
 fn convert_import(spec: &str, package: &str) -> Result<String, String> {
@@ -376,10 +387,7 @@ fn starts_declaration(trimmed: &str) -> bool {
         .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '@'))
         .next()
         .unwrap_or("");
-    matches!(
-        word,
-        "fn" | "struct" | "const" | "var" | "override" | "alias" | "const_assert"
-    ) || trimmed.starts_with('@')
+    DECLARATION_KEYWORDS.contains(&word) || trimmed.starts_with('@')
 }
 
 /// The leading whitespace of `line`.

@@ -342,7 +342,8 @@ fn declared_name(line: &str) -> Option<&str> {
         .filter(|w| !w.is_empty() && !w.starts_with('@'));
     loop {
         let w = words.next()?;
-        if matches!(w, "fn" | "struct" | "const" | "override" | "alias") {
+        // A named declaration (`const_assert` names nothing; `var` is below).
+        if super::wesl::DECLARATION_KEYWORDS.contains(&w) && !matches!(w, "var" | "const_assert") {
             return words.next();
         }
         if w == "var" {
