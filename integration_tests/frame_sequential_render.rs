@@ -22,10 +22,10 @@ fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
     let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.25).unwrap();
-    let buffers = LodBuffers::new(gpu, W, H, format);
+    let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
     let combine = CombinePass::new(gpu, format, false).unwrap();
-    let sphere = GpuMesh::new(gpu, &Mesh::sphere(16, 24));
-    let cube = GpuMesh::new(gpu, &Mesh::cube());
+    let sphere = GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap();
+    let cube = GpuMesh::new(gpu, &Mesh::cube()).unwrap();
 
     let mut scheduler = TransitionScheduler::new();
     let t_instance = scheduler.insert(0);
@@ -73,39 +73,44 @@ fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
                 tau: n.tau,
             },
         ];
-        renderer.render(
-            gpu,
-            &buffers,
-            scheduler.buffer_index(),
-            proj * *view,
-            &items,
-            wgpu::Color {
-                r: 0.05,
-                g: 0.05,
-                b: 0.1,
-                a: 1.0,
-            },
-            None,
-        );
+        renderer
+            .render(
+                gpu,
+                &buffers,
+                scheduler.buffer_index(),
+                proj * *view,
+                &items,
+                wgpu::Color {
+                    r: 0.05,
+                    g: 0.05,
+                    b: 0.1,
+                    a: 1.0,
+                },
+                None,
+            )
+            .unwrap();
     }
     let newer = scheduler.buffer_index();
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let target = lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, "combined");
+    let target =
+        lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, "combined").unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    combine.encode(
-        gpu,
-        &mut encoder,
-        &buffers,
-        newer,
-        m,
-        &target.create_view(&Default::default()),
-    );
+    combine
+        .encode(
+            gpu,
+            &mut encoder,
+            &buffers,
+            newer,
+            m,
+            &target.create_view(&Default::default()),
+        )
+        .unwrap();
     gpu.queue.submit([encoder.finish()]);
 
-    let got = read_texture_rgba8(gpu, &target);
-    let newer_image = read_lod_image(gpu, &buffers, newer);
-    let older_image = read_lod_image(gpu, &buffers, 1 - newer);
+    let got = read_texture_rgba8(gpu, &target).unwrap();
+    let newer_image = read_lod_image(gpu, &buffers, newer).unwrap();
+    let older_image = read_lod_image(gpu, &buffers, 1 - newer).unwrap();
     let want = combine_images(&newer_image, &older_image, &m, DepthConvention::Standard);
     let (mut compared, mut ambiguous) = (0, 0);
     let count = |s: PixelSource| want.iter().filter(|p| p.source == s).count();
@@ -154,13 +159,13 @@ fn resizing_lod_buffers_does_not_leak_textures() {
             .generate_report()
             .map(|r| r.hub_report().textures.num_kept_from_user)
     };
-    let mut buffers = LodBuffers::new(gpu, 32, 32, wgpu::TextureFormat::Rgba8Unorm);
-    gpu.wait_idle();
+    let mut buffers = LodBuffers::new(gpu, 32, 32, wgpu::TextureFormat::Rgba8Unorm).unwrap();
+    gpu.wait_idle().unwrap();
     let before = count();
     for i in 0..40 {
-        buffers.resize(gpu, 32 + i, 24 + 2 * i);
+        buffers.resize(gpu, 32 + i, 24 + 2 * i).unwrap();
     }
-    gpu.wait_idle();
+    gpu.wait_idle().unwrap();
     assert_eq!(buffers.size(), (71, 102));
     match (before, count()) {
         (Some(b), Some(a)) => assert_eq!(a, b, "textures alive before and after 40 resizes"),

@@ -371,46 +371,54 @@ mod rendered {
         let gpu = lodkit_test_gpu!();
         let format = wgpu::TextureFormat::Rgba8Unorm;
         let scene = EdgeScene::new(gpu, format, W as f32 / H as f32).unwrap();
-        let full = LowResBuffer::new(gpu, W, H, format);
-        scene.render(gpu, &full, 1.0);
-        let reference = read_texture_rgba8(gpu, full.color());
-        let low = LowResBuffer::new(gpu, W, H, format);
-        let albedo = LowResBuffer::new(gpu, W, H, format);
+        let full = LowResBuffer::new(gpu, W, H, format).unwrap();
+        scene.render(gpu, &full, 1.0).unwrap();
+        let reference = read_texture_rgba8(gpu, full.color()).unwrap();
+        let low = LowResBuffer::new(gpu, W, H, format).unwrap();
+        let albedo = LowResBuffer::new(gpu, W, H, format).unwrap();
         let upsample = UpsamplePass::new(gpu, format).unwrap();
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-        let target = texture_2d(gpu, (W, H), format, usage, "upsampled");
+        let target = texture_2d(gpu, (W, H), format, usage, "upsampled").unwrap();
         let view = target.create_view(&Default::default());
         let mut rows = Vec::new();
         let mut gain_at_2 = 0.0;
         for r in [2.0f32, 4.0] {
-            scene.render(gpu, &low, r);
+            scene.render(gpu, &low, r).unwrap();
             let mut psnr = [0.0f32; 2];
             for (i, (sz, sn)) in [(f32::INFINITY, f32::INFINITY), (0.25, 0.4)]
                 .into_iter()
                 .enumerate()
             {
                 let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                upsample.encode(gpu, &mut encoder, &low, r, full.geometry(), sz, sn, &view);
+                upsample
+                    .encode(gpu, &mut encoder, &low, r, full.geometry(), sz, sn, &view)
+                    .unwrap();
                 gpu.queue.submit([encoder.finish()]);
-                psnr[i] = psnr_rgba8(&read_texture_rgba8(gpu, &target), &reference);
+                psnr[i] = psnr_rgba8(&read_texture_rgba8(gpu, &target).unwrap(), &reference);
             }
             // Fine-grained: only the lighting goes through L; the albedo is drawn at full res.
-            scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
+            scene
+                .render_term(gpu, &low, r, ShadingTerm::Lighting)
+                .unwrap();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            upsample.encode(
-                gpu,
-                &mut encoder,
-                &low,
-                r,
-                full.geometry(),
-                0.25,
-                0.4,
-                &view,
-            );
+            upsample
+                .encode(
+                    gpu,
+                    &mut encoder,
+                    &low,
+                    r,
+                    full.geometry(),
+                    0.25,
+                    0.4,
+                    &view,
+                )
+                .unwrap();
             gpu.queue.submit([encoder.finish()]);
-            let lighting = read_texture_rgba8(gpu, &target);
-            scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
-            let albedo_pixels = read_texture_rgba8(gpu, albedo.color());
+            let lighting = read_texture_rgba8(gpu, &target).unwrap();
+            scene
+                .render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)
+                .unwrap();
+            let albedo_pixels = read_texture_rgba8(gpu, albedo.color()).unwrap();
             let fine = psnr_rgba8(&multiply_rgba8(&lighting, &albedo_pixels), &reference);
             rows.push(format!(
                 "r = {r}: bilinear {:.2} dB, bilateral {:.2} dB, gain {:+.2} dB; fine-grained {fine:.2} dB",
@@ -449,13 +457,13 @@ mod rendered {
         };
         let format = wgpu::TextureFormat::Rgba8Unorm;
         let scene = EdgeScene::new(gpu, format, 4.0 / 3.0).unwrap();
-        let low = LowResBuffer::new(gpu, 64, 48, format);
-        scene.render(gpu, &low, 1.0);
-        gpu.wait_idle();
+        let low = LowResBuffer::new(gpu, 64, 48, format).unwrap();
+        scene.render(gpu, &low, 1.0).unwrap();
+        gpu.wait_idle().unwrap();
         let before = textures();
         for r in [1.0f32, 1.2, 1.4, 2.0, 3.7, 4.0] {
-            scene.render(gpu, &low, r);
-            gpu.wait_idle();
+            scene.render(gpu, &low, r).unwrap();
+            gpu.wait_idle().unwrap();
             assert_eq!(
                 textures(),
                 before,

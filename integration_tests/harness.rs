@@ -194,7 +194,7 @@ fn run(
         })
         .unwrap_or_else(|e| panic!("probe does not compose:\n{}\n{source}", render(&e)));
     let device = &gpu.device;
-    let module = gpu.shader_module("probe", &composed);
+    let module = gpu.shader_module("probe", &composed).expect("probe module");
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some("probe"),
         layout: None,
@@ -226,7 +226,8 @@ fn run(
         },
     ];
     let view = probe.texture.map(|(size, texels)| {
-        let texture = lodkit::gpu::resources::r32float_texture(gpu, size, texels, "probe texture");
+        let texture = lodkit::gpu::resources::r32float_texture(gpu, size, texels, "probe texture")
+            .expect("probe texture");
         texture.create_view(&Default::default())
     });
     let rgba_views: Vec<wgpu::TextureView> = probe
@@ -282,7 +283,8 @@ fn run(
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(n as u32, 1, 1);
     }
-    let bytes = lodkit::gpu::readback::read_buffer(gpu, encoder, &output, size);
+    let bytes =
+        lodkit::gpu::readback::read_buffer(gpu, encoder, &output, size).expect("probe readback");
     bytemuck::cast_slice(&bytes).to_vec()
 }
 

@@ -11,6 +11,7 @@ mod frame_sequential_render;
 mod framebuffer_lod;
 mod gpu_twins;
 mod harness;
+mod host_errors;
 mod portability;
 mod robustness;
 mod selection;

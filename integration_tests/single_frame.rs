@@ -286,22 +286,26 @@ fn blue_noise_has_less_low_frequency_power_than_white_noise() {
 fn unpopping_shows_no_background_through_the_object_cross_fade_does() {
     let gpu = lodkit_test_gpu!();
     let scene = TransitionScene::new(gpu, 96, 96).unwrap();
-    let fine = scene.render(
-        gpu,
-        SingleFrameTechnique::Unpopping,
-        0.0,
-        SceneParts::FineOnly,
-    );
-    let coarse = scene.render(
-        gpu,
-        SingleFrameTechnique::Unpopping,
-        0.0,
-        SceneParts::CoarseOnly,
-    );
+    let fine = scene
+        .render(
+            gpu,
+            SingleFrameTechnique::Unpopping,
+            0.0,
+            SceneParts::FineOnly,
+        )
+        .unwrap();
+    let coarse = scene
+        .render(
+            gpu,
+            SingleFrameTechnique::Unpopping,
+            0.0,
+            SceneParts::CoarseOnly,
+        )
+        .unwrap();
     let mut rows = Vec::new();
     for technique in SingleFrameTechnique::ALL {
         for t in [0.25f32, 0.5, 0.75] {
-            let image = scene.render(gpu, technique, t, SceneParts::All);
+            let image = scene.render(gpu, technique, t, SceneParts::All).unwrap();
             let (share, red) = see_through(&image, &fine, &coarse);
             rows.push(format!(
                 "{:<18} t={t:<4} see-through {:>6.1}% of interior, mean red {red:.3}",

@@ -61,3 +61,9 @@ pub mod gpu;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/engines.md")]
 pub struct EnginesGuide;
+
+/// The Rust snippets of `docs/errors.md` (errors and recovery in the wgpu glue), compiled as
+/// doctests.
+#[cfg(all(doctest, feature = "wgpu"))]
+#[doc = include_str!("../docs/errors.md")]
+pub struct ErrorsGuide;

@@ -313,9 +313,9 @@ const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 fn count_fullscreen(gpu: &lodkit::gpu::GpuContext, w: u32, h: u32) -> (CounterKind, u64) {
     let pipeline = lodkit_cli::demo::timing::plain_pass(gpu, FLAT, "flat.wgsl").unwrap();
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let target = lodkit::gpu::resources::texture_2d(gpu, (w, h), FORMAT, usage, "t");
+    let target = lodkit::gpu::resources::texture_2d(gpu, (w, h), FORMAT, usage, "t").unwrap();
     let view = target.create_view(&Default::default());
-    let counter = FragmentCounter::new(gpu);
+    let counter = FragmentCounter::new(gpu).unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -339,7 +339,7 @@ fn count_fullscreen(gpu: &lodkit::gpu::GpuContext, w: u32, h: u32) -> (CounterKi
         pass.draw(0..3, 0..1);
         counter.end(&mut pass);
     }
-    (counter.kind(), counter.read(gpu, encoder))
+    (counter.kind(), counter.read(gpu, encoder).unwrap())
 }
 
 #[test]

@@ -1,37 +1,19 @@
-//! A headless wgpu device: Vulkan first (a real GPU or lavapipe), OpenGL (llvmpipe) as fallback.
+//! A headless wgpu device: Vulkan first (a real GPU or lavapipe), OpenGL (llvmpipe) as fallback,
+//! with the error handling every lodkit call goes through: error scopes around the call, a handler
+//! that records errors raised outside them, and device-loss tracking.
 
 use std::borrow::Cow;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::{Arc, Mutex, PoisonError};
 
+use super::GpuError;
 use crate::shaders::{
     ComposeDescriptor, Composed, Diagnostic, DiagnosticKind, ShaderDefValue, ShaderError,
     ShaderLibrary,
 };
 
-/// Why no GPU context could be made.
-#[derive(Debug, thiserror::Error)]
-pub enum GpuError {
-    /// No adapter on any backend that was tried.
-    #[error(
-        "no GPU adapter found (tried: {tried}). On Debian/Ubuntu, `apt-get install \
-         mesa-vulkan-drivers libvulkan1` gives a software Vulkan device (lavapipe)"
-    )]
-    NoAdapter {
-        /// The backends that were tried, in order.
-        tried: String,
-    },
-    /// `LODKIT_BACKEND` names no backend wgpu knows.
-    #[error("LODKIT_BACKEND=`{0}` is not a backend (expected vulkan, gl, metal, dx12)")]
-    UnknownBackend(String),
-    /// The adapter refused to create a device.
-    #[error("the adapter `{adapter}` could not create a device: {source}")]
-    RequestDevice {
-        /// Adapter name.
-        adapter: String,
-        /// wgpu's reason.
-        #[source]
-        source: wgpu::RequestDeviceError,
-    },
-}
+/// Most errors the uncaptured-error handler keeps (it still counts the rest).
+const RECORDED_ERRORS: usize = 16;
 
 /// Options for [`GpuContext::new_headless`].
 #[derive(Clone, Debug, Default)]
@@ -42,7 +24,8 @@ pub struct GpuOptions {
     pub optional_features: wgpu::Features,
 }
 
-/// A headless device and queue with the adapter they came from.
+/// A device and queue with the adapter they came from, and what lodkit learned about the device:
+/// errors wgpu raised outside lodkit's calls, and whether the device is lost.
 #[derive(Debug)]
 pub struct GpuContext {
     /// The wgpu instance.
@@ -53,6 +36,50 @@ pub struct GpuContext {
     pub device: wgpu::Device,
     /// Its queue.
     pub queue: wgpu::Queue,
+    state: Arc<DeviceState>,
+}
+
+/// What the device callbacks recorded.
+#[derive(Debug, Default)]
+struct DeviceState {
+    /// (reason, message) once the device is lost.
+    lost: Mutex<Option<(String, String)>>,
+    /// Errors no scope caught: how many, and the first [`RECORDED_ERRORS`] descriptions.
+    uncaptured: Mutex<(usize, Vec<String>)>,
+}
+
+impl DeviceState {
+    fn lost(&self) -> Option<(String, String)> {
+        self.lost
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
+    fn record_lost(&self, reason: String, message: String) {
+        let mut lost = self.lost.lock().unwrap_or_else(PoisonError::into_inner);
+        lost.get_or_insert((reason, message));
+    }
+
+    fn record_error(&self, description: String) {
+        let mut recorded = self
+            .uncaptured
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner);
+        recorded.0 += 1;
+        if recorded.1.len() < RECORDED_ERRORS {
+            recorded.1.push(description);
+        }
+    }
+
+    fn take_errors(&self) -> (usize, Vec<String>) {
+        std::mem::take(
+            &mut *self
+                .uncaptured
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner),
+        )
+    }
 }
 
 impl GpuContext {
@@ -89,12 +116,7 @@ impl GpuContext {
                     adapter: adapter.get_info().name,
                     source,
                 })?;
-            return Ok(Self {
-                instance,
-                adapter,
-                device,
-                queue,
-            });
+            return Ok(Self::from_parts(instance, adapter, device, queue));
         }
         let tried = backends
             .iter()
@@ -102,6 +124,108 @@ impl GpuContext {
             .collect::<Vec<_>>()
             .join(", ");
         Err(GpuError::NoAdapter { tried })
+    }
+
+    /// A context over a device the engine already has. It installs lodkit's uncaptured-error
+    /// handler (it records errors instead of panicking; [`check`](Self::check) and every lodkit
+    /// call report them) and a device-lost callback, replacing any the engine had set: an engine
+    /// that keeps its own handler can set it again afterwards, and lodkit's calls still catch
+    /// their own errors with error scopes.
+    pub fn from_parts(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Self {
+        let state = Arc::new(DeviceState::default());
+        let recorder = Arc::clone(&state);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            recorder.record_error(error.to_string());
+        }));
+        let recorder = Arc::clone(&state);
+        device.set_device_lost_callback(move |reason, message| {
+            let message = if message.is_empty() {
+                "no message".into()
+            } else {
+                message
+            };
+            recorder.record_lost(format!("{reason:?}"), message);
+        });
+        Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            state,
+        }
+    }
+
+    /// `Ok` while the device is alive and no error was recorded outside lodkit's calls;
+    /// otherwise [`GpuError::DeviceLost`], or [`GpuError::Uncaptured`] with the recorded errors
+    /// (which it clears). `call` names the caller in the error. Every lodkit call runs it first.
+    pub fn check(&self, call: &'static str) -> Result<(), GpuError> {
+        // wgpu notices a destroyed device, and calls the lost callback, when it is polled. A
+        // device the driver lost makes wgpu 30's poll panic instead of returning an error; that
+        // panic is caught here and reported as a lost device.
+        let polled = catch_unwind(AssertUnwindSafe(|| self.device.poll(wgpu::PollType::Poll)));
+        if polled.is_err() {
+            self.state.record_lost(
+                "Unknown".into(),
+                "wgpu panicked while polling the device".into(),
+            );
+        }
+        if let Some((reason, message)) = self.state.lost() {
+            return Err(GpuError::DeviceLost {
+                call,
+                reason,
+                message,
+            });
+        }
+        let (count, errors) = self.state.take_errors();
+        match errors.into_iter().next() {
+            Some(first) => Err(GpuError::Uncaptured { call, count, first }),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs `f` (device work of lodkit call `call`) inside out-of-memory, validation and internal
+    /// error scopes, after and before [`check`](Self::check): the first error wgpu raised during
+    /// `f` comes back as this call's error instead of reaching the uncaptured-error handler.
+    ///
+    /// Inside another guarded call on the same thread it only runs `f`: the outermost call, the
+    /// one the engine made, checks the device and names the error.
+    pub(crate) fn guarded<T>(
+        &self,
+        call: &'static str,
+        f: impl FnOnce() -> Result<T, GpuError>,
+    ) -> Result<T, GpuError> {
+        let Some(_outermost) = Outermost::enter() else {
+            return f();
+        };
+        self.check(call)?;
+        let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
+        let value = f();
+        let popped = [internal.pop(), validation.pop(), out_of_memory.pop()];
+        let caught = popped.into_iter().find_map(pollster::block_on);
+        let value = value?;
+        self.check(call)?;
+        match caught {
+            Some(error) => Err(GpuError::from_wgpu(call, error)),
+            None => Ok(value),
+        }
+    }
+
+    /// What the device can do with `format`: the adapter's own answer when the device has
+    /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`, the guaranteed WebGPU set otherwise.
+    pub fn format_features(&self, format: wgpu::TextureFormat) -> wgpu::TextureFormatFeatures {
+        let features = self.device.features();
+        if features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES) {
+            self.adapter.get_texture_format_features(format)
+        } else {
+            format.guaranteed_format_features(features)
+        }
     }
 
     /// One line about the adapter: name, backend, device type, driver.
@@ -114,21 +238,24 @@ impl GpuContext {
     }
 
     /// A shader module from a composed lodkit module (no re-parsing: naga IR goes straight in).
-    pub fn shader_module(&self, label: &str, composed: &Composed) -> wgpu::ShaderModule {
-        self.device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(label),
-                source: wgpu::ShaderSource::Naga(Cow::Owned(composed.module.clone())),
-            })
+    pub fn shader_module(
+        &self,
+        label: &str,
+        composed: &Composed,
+    ) -> Result<wgpu::ShaderModule, GpuError> {
+        self.guarded("GpuContext::shader_module", || {
+            Ok(self
+                .device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(label),
+                    source: wgpu::ShaderSource::Naga(Cow::Owned(composed.module.clone())),
+                }))
+        })
     }
 
     /// The shader module of lodkit's pass `shader_lib/passes/<name>.wgsl`, composed with the
     /// boolean shader defs `defs` switched on.
-    pub fn pass_module(
-        &self,
-        name: &str,
-        defs: &[&str],
-    ) -> Result<wgpu::ShaderModule, ShaderError> {
+    pub fn pass_module(&self, name: &str, defs: &[&str]) -> Result<wgpu::ShaderModule, GpuError> {
         let file_path = format!("shader_lib/passes/{name}.wgsl");
         let Some(source) = crate::shaders::find_pass_source(name) else {
             let d = Diagnostic::new(
@@ -136,7 +263,7 @@ impl GpuContext {
                 file_path,
                 format!("lodkit has no pass `{name}`"),
             );
-            return Err(ShaderError::Source(Box::new(d)));
+            return Err(ShaderError::Source(Box::new(d)).into());
         };
         let shader_defs = defs
             .iter()
@@ -148,12 +275,47 @@ impl GpuContext {
             shader_defs,
             ..Default::default()
         })?;
-        Ok(self.shader_module(name, &composed))
+        self.guarded("GpuContext::pass_module", || {
+            self.shader_module(name, &composed)
+        })
     }
 
-    /// Blocks until the GPU has finished all submitted work.
-    pub fn wait_idle(&self) {
-        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    /// Blocks until the GPU has finished all submitted work. A lost device is an error, not a
+    /// hang or a panic.
+    pub fn wait_idle(&self) -> Result<(), GpuError> {
+        const CALL: &str = "GpuContext::wait_idle";
+        self.check(CALL)?;
+        let waited = catch_unwind(AssertUnwindSafe(|| {
+            self.device.poll(wgpu::PollType::wait_indefinitely())
+        }));
+        if waited.is_err() {
+            self.state.record_lost(
+                "Unknown".into(),
+                "wgpu panicked while waiting for the device".into(),
+            );
+        }
+        self.check(CALL)
+    }
+}
+
+thread_local! {
+    /// Whether this thread is inside a guarded lodkit call.
+    static GUARDED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Marks this thread as inside a guarded call until dropped (also when unwinding).
+struct Outermost;
+
+impl Outermost {
+    /// `None` when the thread already is inside a guarded call.
+    fn enter() -> Option<Self> {
+        (!GUARDED.with(|g| g.replace(true))).then_some(Self)
+    }
+}
+
+impl Drop for Outermost {
+    fn drop(&mut self) {
+        GUARDED.with(|g| g.set(false));
     }
 }
 

@@ -2,8 +2,8 @@
 //! statistics where the device has them, samples that passed the depth test through an
 //! occlusion query otherwise.
 
-use super::GpuContext;
 use super::readback::read_buffer;
+use super::{GpuContext, GpuError};
 
 /// What a [`FragmentCounter`] counts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,7 +48,7 @@ pub struct FragmentCounter {
 impl FragmentCounter {
     /// Counts fragment invocations when the device was created with
     /// `Features::PIPELINE_STATISTICS_QUERY`, samples passed otherwise.
-    pub fn new(gpu: &GpuContext) -> Self {
+    pub fn new(gpu: &GpuContext) -> Result<Self, GpuError> {
         let statistics = gpu
             .device
             .features()
@@ -65,18 +65,20 @@ impl FragmentCounter {
         } else {
             (CounterKind::SamplesPassed, wgpu::QueryType::Occlusion)
         };
-        let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
-            label: Some("lodkit fragment counter"),
-            ty,
-            count: 1,
-        });
-        let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("lodkit fragment counter resolve"),
-            size: 8,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        Self { kind, set, resolve }
+        gpu.guarded("FragmentCounter::new", || {
+            let set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("lodkit fragment counter"),
+                ty,
+                count: 1,
+            });
+            let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lodkit fragment counter resolve"),
+                size: 8,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            Ok(Self { kind, set, resolve })
+        })
     }
 
     /// What this counter counts.
@@ -108,12 +110,18 @@ impl FragmentCounter {
 
     /// Resolves the query into `encoder` (after the pass ends), submits it and returns the
     /// count.
-    pub fn read(&self, gpu: &GpuContext, mut encoder: wgpu::CommandEncoder) -> u64 {
+    pub fn read(
+        &self,
+        gpu: &GpuContext,
+        mut encoder: wgpu::CommandEncoder,
+    ) -> Result<u64, GpuError> {
+        const CALL: &str = "FragmentCounter::read";
         encoder.resolve_query_set(&self.set, 0..1, &self.resolve, 0);
-        let bytes = read_buffer(gpu, encoder, &self.resolve, 8);
-        bytes
-            .get(..8)
-            .and_then(|b| b.try_into().ok())
-            .map_or(0, u64::from_le_bytes)
+        let bytes = gpu.guarded(CALL, || read_buffer(gpu, encoder, &self.resolve, 8))?;
+        let word = bytes.get(..8).and_then(|b| b.try_into().ok());
+        word.map(u64::from_le_bytes).ok_or(GpuError::Readback {
+            call: CALL,
+            reason: format!("8 bytes expected, {} read", bytes.len()),
+        })
     }
 }

@@ -7,13 +7,13 @@
 
 use glam::Mat4;
 
-use super::GpuContext;
+use super::error::{check_color_format, texture_matches};
 use super::resources::{
-    begin_color_pass, begin_targets_pass, fullscreen_pipeline, texture_2d, textures_and_uniform,
-    uniform_buffer,
+    TextureSet, begin_color_pass, begin_targets_pass, fullscreen_pipeline, new_set, resize_set,
+    texture_2d, textures_and_uniform, uniform_buffer,
 };
+use super::{GpuContext, GpuError};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
-use crate::shaders::ShaderError;
 
 /// Depth format of the pair's shared depth buffer.
 pub const LOD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -28,53 +28,80 @@ pub struct LodBuffers {
     depth: wgpu::Texture,
 }
 
-impl LodBuffers {
-    /// Allocates both buffers at `width` x `height` with color format `color_format`.
-    pub fn new(
+impl TextureSet for LodBuffers {
+    const USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+        .union(wgpu::TextureUsages::TEXTURE_BINDING)
+        .union(wgpu::TextureUsages::COPY_SRC);
+
+    fn allocate(
         gpu: &GpuContext,
-        width: u32,
-        height: u32,
+        size: (u32, u32),
         color_format: wgpu::TextureFormat,
-    ) -> Self {
-        let size = (width.max(1), height.max(1));
+    ) -> Result<Self, GpuError> {
         let texture = |format, usage, label| texture_2d(gpu, size, format, usage, label);
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC;
-        Self {
+        let usage = Self::USAGE;
+        Ok(Self {
             color_format,
-            size: (width.max(1), height.max(1)),
+            size,
             colors: [
-                texture(color_format, usage, "lod buffer color 0"),
-                texture(color_format, usage, "lod buffer color 1"),
+                texture(color_format, usage, "lod buffer color 0")?,
+                texture(color_format, usage, "lod buffer color 1")?,
             ],
             id_depths: [
-                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 0"),
-                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 1"),
+                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 0")?,
+                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 1")?,
             ],
             depth: texture(
                 LOD_DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
                 "lod buffer depth",
-            ),
-        }
+            )?,
+        })
     }
 
-    /// Reallocates at a new size (a no-op at the same size). The old textures are destroyed at
-    /// once rather than left to the allocator.
-    pub fn resize(&mut self, gpu: &GpuContext, width: u32, height: u32) {
-        if (width.max(1), height.max(1)) == self.size {
-            return;
-        }
-        let old = std::mem::replace(self, Self::new(gpu, width, height, self.color_format));
-        for t in old.colors.iter().chain(&old.id_depths).chain([&old.depth]) {
-            t.destroy();
-        }
+    fn extent(&self) -> (u32, u32) {
+        self.size
+    }
+
+    fn format(&self) -> wgpu::TextureFormat {
+        self.color_format
+    }
+
+    fn textures(&self) -> Vec<&wgpu::Texture> {
+        self.colors
+            .iter()
+            .chain(&self.id_depths)
+            .chain([&self.depth])
+            .collect()
+    }
+}
+
+impl LodBuffers {
+    /// Allocates both buffers at `width` x `height` (a zero side is taken as 1) with color format
+    /// `color_format`, a floating-point color format the device can render to, sample and copy.
+    pub fn new(
+        gpu: &GpuContext,
+        width: u32,
+        height: u32,
+        color_format: wgpu::TextureFormat,
+    ) -> Result<Self, GpuError> {
+        new_set(gpu, "LodBuffers::new", (width, height), color_format)
+    }
+
+    /// Reallocates at a new size (a no-op at the same size; a zero side is taken as 1). The old
+    /// textures are destroyed once the new ones exist; on an error the buffers are unchanged.
+    pub fn resize(&mut self, gpu: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
+        resize_set(gpu, "LodBuffers::resize", self, (width, height))
     }
 
     /// Width and height.
     pub fn size(&self) -> (u32, u32) {
         self.size
+    }
+
+    /// Format of the color textures.
+    pub fn color_format(&self) -> wgpu::TextureFormat {
+        self.color_format
     }
 
     /// Color texture of buffer `index` (0 or 1).
@@ -138,6 +165,7 @@ pub struct CombineParams {
 pub struct CombinePass {
     pipeline: wgpu::RenderPipeline,
     params: wgpu::Buffer,
+    target_format: wgpu::TextureFormat,
 }
 
 impl CombinePass {
@@ -146,28 +174,38 @@ impl CombinePass {
     /// buffer is shown as it is.
     pub const NO_HISTORY: Mat4 = Mat4::ZERO;
 
-    /// Builds the pipeline for targets of `target_format`; `reverse_z` selects the depth
-    /// convention of the LOD buffers (`LODKIT_REVERSE_Z`).
+    /// Builds the pipeline for targets of `target_format` (a floating-point color format the
+    /// device can render to); `reverse_z` selects the depth convention of the LOD buffers
+    /// (`LODKIT_REVERSE_Z`).
     pub fn new(
         gpu: &GpuContext,
         target_format: wgpu::TextureFormat,
         reverse_z: bool,
-    ) -> Result<Self, ShaderError> {
+    ) -> Result<Self, GpuError> {
+        const CALL: &str = "CombinePass::new";
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        check_color_format(gpu, CALL, "target_format", target_format, usage)?;
         let defs: &[&str] = if reverse_z {
             &["LODKIT_REVERSE_Z"]
         } else {
             &[]
         };
-        let module = gpu.pass_module("combine", defs)?;
-        let pipeline = fullscreen_pipeline(gpu, &module, target_format, "lodkit combine");
-        let params = uniform_buffer(gpu, std::mem::size_of::<CombineParams>(), "combine params");
-        Ok(Self { pipeline, params })
+        gpu.guarded(CALL, || {
+            let module = gpu.pass_module("combine", defs)?;
+            let size = std::mem::size_of::<CombineParams>();
+            Ok(Self {
+                pipeline: fullscreen_pipeline(gpu, &module, target_format, "lodkit combine")?,
+                params: uniform_buffer(gpu, size, "combine params")?,
+                target_format,
+            })
+        })
     }
 
     /// Records the combination of buffer `newer` with the other one (reprojected through
-    /// `new_to_old`) into `target`, which must be as large as the buffers. The parameters go
-    /// through one uniform buffer written with `queue.write_buffer`: record one `encode` per
-    /// submit (two in one encoder would both see the last matrix).
+    /// `new_to_old`) into `target`, which must have the format the pass was built for and the
+    /// size of the buffers ([`GpuError::Mismatch`] otherwise). The parameters go through one
+    /// uniform buffer written with `queue.write_buffer`: record one `encode` per submit (two in
+    /// one encoder would both see the last matrix).
     pub fn encode(
         &self,
         gpu: &GpuContext,
@@ -176,47 +214,74 @@ impl CombinePass {
         newer: usize,
         new_to_old: Mat4,
         target: &wgpu::TextureView,
-    ) {
-        let params = CombineParams {
-            new_to_old: new_to_old.to_cols_array_2d(),
-        };
-        gpu.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let textures = [
-            buffers.color(newer),
-            buffers.id_depth(newer),
-            buffers.color(newer + 1),
-            buffers.id_depth(newer + 1),
-        ];
-        let layout = self.pipeline.get_bind_group_layout(0);
-        let bind_group = textures_and_uniform(
-            gpu,
-            &layout,
-            &textures,
-            Some(&self.params),
-            "lodkit combine",
-        );
-        let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit combine");
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..3, 0..1);
+    ) -> Result<(), GpuError> {
+        const CALL: &str = "CombinePass::encode";
+        texture_matches(
+            CALL,
+            "target",
+            target.texture(),
+            buffers.size(),
+            self.target_format,
+            "the pass (built for its format, drawing the LOD buffers' size)",
+        )?;
+        gpu.guarded(CALL, || {
+            let params = CombineParams {
+                new_to_old: new_to_old.to_cols_array_2d(),
+            };
+            gpu.queue
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            let textures = [
+                buffers.color(newer),
+                buffers.id_depth(newer),
+                buffers.color(newer + 1),
+                buffers.id_depth(newer + 1),
+            ];
+            let layout = self.pipeline.get_bind_group_layout(0);
+            let bind_group = textures_and_uniform(
+                gpu,
+                &layout,
+                &textures,
+                Some(&self.params),
+                "lodkit combine",
+            )?;
+            let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit combine");
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.draw(0..3, 0..1);
+            Ok(())
+        })
     }
 }
 
-/// Reads buffer `index` of `buffers` back to the CPU (an RGBA8 color format is expected).
+/// Reads buffer `index` of `buffers` back to the CPU (its color format must be RGBA8, unorm or
+/// sRGB: [`GpuError::UnsupportedFormat`] otherwise).
 pub fn read_lod_image(
     gpu: &GpuContext,
     buffers: &LodBuffers,
     index: usize,
-) -> crate::combine::LodImage {
-    let colors = super::readback::read_texture_rgba8(gpu, buffers.color(index));
-    let id_depth = super::readback::read_texture(gpu, buffers.id_depth(index), 8);
+) -> Result<crate::combine::LodImage, GpuError> {
+    use wgpu::TextureFormat::{Rgba8Unorm, Rgba8UnormSrgb};
+    if !matches!(buffers.color_format(), Rgba8Unorm | Rgba8UnormSrgb) {
+        return Err(GpuError::UnsupportedFormat {
+            call: "read_lod_image",
+            parameter: "buffers",
+            format: buffers.color_format(),
+            reason: "LodImage holds RGBA8 colors; read other formats with readback::read_texture"
+                .into(),
+        });
+    }
+    let (colors, id_depth) = gpu.guarded("read_lod_image", || {
+        Ok((
+            super::readback::read_texture_rgba8(gpu, buffers.color(index))?,
+            super::readback::read_texture(gpu, buffers.id_depth(index), 8)?,
+        ))
+    })?;
     let words: Vec<u32> = id_depth
         .chunks(4)
         .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect();
     let (width, height) = buffers.size();
-    crate::combine::LodImage {
+    Ok(crate::combine::LodImage {
         width,
         height,
         colors: colors
@@ -230,5 +295,5 @@ pub fn read_lod_image(
             .step_by(2)
             .map(|w| f32::from_bits(*w))
             .collect(),
-    }
+    })
 }

@@ -2,13 +2,13 @@
 //! full size and rendered through a viewport that shrinks with r (changing r never reallocates),
 //! and the upsample pass as a ready object.
 
-use super::GpuContext;
+use super::error::{check_color_format, texture_matches};
 use super::resources::{
-    begin_color_pass, begin_targets_pass, fullscreen_pipeline, texture_2d, textures_and_uniform,
-    uniform_buffer,
+    TextureSet, begin_color_pass, begin_targets_pass, fullscreen_pipeline, new_set, resize_set,
+    texture_2d, textures_and_uniform, uniform_buffer,
 };
+use super::{GpuContext, GpuError};
 use crate::gbuffer::GEOMETRY_FORMAT;
-use crate::shaders::ShaderError;
 
 /// Depth format of the low-resolution pass.
 pub const LOW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -18,40 +18,72 @@ pub const LOW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Fl
 #[derive(Debug)]
 pub struct LowResBuffer {
     full_size: (u32, u32),
+    color_format: wgpu::TextureFormat,
     color: wgpu::Texture,
     geometry: wgpu::Texture,
     depth: wgpu::Texture,
 }
 
+impl TextureSet for LowResBuffer {
+    const USAGE: wgpu::TextureUsages = wgpu::TextureUsages::RENDER_ATTACHMENT
+        .union(wgpu::TextureUsages::TEXTURE_BINDING)
+        .union(wgpu::TextureUsages::COPY_SRC);
+
+    fn allocate(
+        gpu: &GpuContext,
+        size: (u32, u32),
+        color_format: wgpu::TextureFormat,
+    ) -> Result<Self, GpuError> {
+        let usage = Self::USAGE;
+        let depth_usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        Ok(Self {
+            full_size: size,
+            color_format,
+            color: texture_2d(gpu, size, color_format, usage, "low-res color")?,
+            geometry: texture_2d(gpu, size, GEOMETRY_FORMAT, usage, "low-res geometry")?,
+            depth: texture_2d(gpu, size, LOW_DEPTH_FORMAT, depth_usage, "low-res depth")?,
+        })
+    }
+
+    fn extent(&self) -> (u32, u32) {
+        self.full_size
+    }
+
+    fn format(&self) -> wgpu::TextureFormat {
+        self.color_format
+    }
+
+    fn textures(&self) -> Vec<&wgpu::Texture> {
+        vec![&self.color, &self.geometry, &self.depth]
+    }
+}
+
 impl LowResBuffer {
-    /// Allocates L for a `width` x `height` target with color format `color_format`.
+    /// Allocates L for a `width` x `height` target (a zero side is taken as 1) with color format
+    /// `color_format`, a floating-point color format the device can render to, sample and copy.
     pub fn new(
         gpu: &GpuContext,
         width: u32,
         height: u32,
         color_format: wgpu::TextureFormat,
-    ) -> Self {
-        let size = (width.max(1), height.max(1));
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC;
-        Self {
-            full_size: size,
-            color: texture_2d(gpu, size, color_format, usage, "low-res color"),
-            geometry: texture_2d(gpu, size, GEOMETRY_FORMAT, usage, "low-res geometry"),
-            depth: texture_2d(
-                gpu,
-                size,
-                LOW_DEPTH_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-                "low-res depth",
-            ),
-        }
+    ) -> Result<Self, GpuError> {
+        new_set(gpu, "LowResBuffer::new", (width, height), color_format)
+    }
+
+    /// Reallocates for a new target size (a no-op at the same size; a zero side is taken as 1).
+    /// The old textures are destroyed once the new ones exist; on an error L is unchanged.
+    pub fn resize(&mut self, gpu: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
+        resize_set(gpu, "LowResBuffer::resize", self, (width, height))
     }
 
     /// Size of the full-resolution target.
     pub fn full_size(&self) -> (u32, u32) {
         self.full_size
+    }
+
+    /// Format of the color texture.
+    pub fn color_format(&self) -> wgpu::TextureFormat {
+        self.color_format
     }
 
     /// The part of L used at resize factor `r` (clamped to >= 1): ceil(size / r).
@@ -132,25 +164,32 @@ pub struct UpsampleParams {
 pub struct UpsamplePass {
     pipeline: wgpu::RenderPipeline,
     params: wgpu::Buffer,
+    target_format: wgpu::TextureFormat,
 }
 
 impl UpsamplePass {
-    /// Builds the pipeline for targets of `target_format`.
-    pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat) -> Result<Self, ShaderError> {
-        let module = gpu.pass_module("upsample", &[])?;
-        Ok(Self {
-            pipeline: fullscreen_pipeline(gpu, &module, target_format, "lodkit upsample"),
-            params: uniform_buffer(
-                gpu,
-                std::mem::size_of::<UpsampleParams>(),
-                "upsample params",
-            ),
+    /// Builds the pipeline for targets of `target_format` (a floating-point color format the
+    /// device can render to).
+    pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat) -> Result<Self, GpuError> {
+        const CALL: &str = "UpsamplePass::new";
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        check_color_format(gpu, CALL, "target_format", target_format, usage)?;
+        gpu.guarded(CALL, || {
+            let module = gpu.pass_module("upsample", &[])?;
+            let size = std::mem::size_of::<UpsampleParams>();
+            Ok(Self {
+                pipeline: fullscreen_pipeline(gpu, &module, target_format, "lodkit upsample")?,
+                params: uniform_buffer(gpu, size, "upsample params")?,
+                target_format,
+            })
         })
     }
 
     /// Records the upsampling of `low` (rendered at resize factor `r`) into `target`, with the
-    /// full-resolution geometry `full_geometry` (gbuffer layout) and range sigmas. The parameters
-    /// go through one uniform buffer: record one `encode` per submit.
+    /// full-resolution geometry `full_geometry` (gbuffer layout) and range sigmas (each > 0;
+    /// +inf drops its term). `target` must have the format the pass was built for and, like
+    /// `full_geometry` (in `GEOMETRY_FORMAT`), L's full size: [`GpuError::Mismatch`] otherwise.
+    /// The parameters go through one uniform buffer: record one `encode` per submit.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -162,30 +201,63 @@ impl UpsamplePass {
         sigma_z: f32,
         sigma_n: f32,
         target: &wgpu::TextureView,
-    ) {
-        let (vw, vh) = low.viewport(r);
-        let (w, h) = low.full_size();
-        let params = UpsampleParams {
-            low_viewport: [vw as f32, vh as f32],
-            full_size: [w as f32, h as f32],
-            sigma_z,
-            sigma_n,
-            pad: [0.0; 2],
-        };
-        gpu.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
-        let layout = self.pipeline.get_bind_group_layout(0);
-        let textures = [low.color(), low.geometry(), full_geometry];
-        let bind_group = textures_and_uniform(
-            gpu,
-            &layout,
-            &textures,
-            Some(&self.params),
-            "lodkit upsample",
-        );
-        let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit upsample");
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.draw(0..3, 0..1);
+    ) -> Result<(), GpuError> {
+        const CALL: &str = "UpsamplePass::encode";
+        for (parameter, value) in [("sigma_z", sigma_z), ("sigma_n", sigma_n)] {
+            if value.is_nan() || value <= 0.0 {
+                return Err(GpuError::Invalid {
+                    call: CALL,
+                    parameter,
+                    value: value.to_string(),
+                    rule: "must be positive (+inf: no range term)",
+                });
+            }
+        }
+        let size = low.full_size();
+        let what = "the full-resolution geometry of L";
+        texture_matches(
+            CALL,
+            "full_geometry",
+            full_geometry,
+            size,
+            GEOMETRY_FORMAT,
+            what,
+        )?;
+        let what = "the pass (built for its format, drawing L's full size)";
+        texture_matches(
+            CALL,
+            "target",
+            target.texture(),
+            size,
+            self.target_format,
+            what,
+        )?;
+        gpu.guarded(CALL, || {
+            let (vw, vh) = low.viewport(r);
+            let (w, h) = low.full_size();
+            let params = UpsampleParams {
+                low_viewport: [vw as f32, vh as f32],
+                full_size: [w as f32, h as f32],
+                sigma_z,
+                sigma_n,
+                pad: [0.0; 2],
+            };
+            gpu.queue
+                .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            let layout = self.pipeline.get_bind_group_layout(0);
+            let textures = [low.color(), low.geometry(), full_geometry];
+            let bind_group = textures_and_uniform(
+                gpu,
+                &layout,
+                &textures,
+                Some(&self.params),
+                "lodkit upsample",
+            )?;
+            let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit upsample");
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.draw(0..3, 0..1);
+            Ok(())
+        })
     }
 }

@@ -4,14 +4,14 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::GpuContext;
+use super::error::{check_color_format, same_color_format};
 use super::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
 use super::resources::{
     DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, uniform_buffer,
 };
 use super::scene::GpuMesh;
+use super::{GpuContext, GpuError};
 use crate::gbuffer::GEOMETRY_FORMAT;
-use crate::shaders::ShaderError;
 
 /// Rust mirror of `GCamera` in `passes/gbuffer_mesh.wgsl`.
 #[repr(C)]
@@ -68,6 +68,7 @@ pub struct GBufferRenderer {
     draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
     shading_work: u32,
+    color_format: wgpu::TextureFormat,
 }
 
 impl GBufferRenderer {
@@ -79,7 +80,18 @@ impl GBufferRenderer {
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,
         term: ShadingTerm,
-    ) -> Result<Self, ShaderError> {
+    ) -> Result<Self, GpuError> {
+        const CALL: &str = "GBufferRenderer::new";
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        check_color_format(gpu, CALL, "color_format", color_format, usage)?;
+        gpu.guarded(CALL, || Self::build(gpu, color_format, term))
+    }
+
+    fn build(
+        gpu: &GpuContext,
+        color_format: wgpu::TextureFormat,
+        term: ShadingTerm,
+    ) -> Result<Self, GpuError> {
         let defs: &[&str] = match term {
             ShadingTerm::Full => &[],
             ShadingTerm::Lighting => &["GBUFFER_MESH_LIGHTING_ONLY"],
@@ -87,7 +99,7 @@ impl GBufferRenderer {
         };
         let module = gpu.pass_module("gbuffer_mesh", defs)?;
         let device = &gpu.device;
-        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "gbuffer_mesh");
+        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "gbuffer_mesh")?;
         let pipeline = mesh_pipeline(
             gpu,
             &module,
@@ -95,8 +107,8 @@ impl GBufferRenderer {
             &[Some(color_format.into()), Some(GEOMETRY_FORMAT.into())],
             depth_write_state(LOW_DEPTH_FORMAT, wgpu::CompareFunction::Less),
             "gbuffer_mesh",
-        );
-        let camera = uniform_buffer(gpu, std::mem::size_of::<GCameraUniform>(), "gbuffer camera");
+        )?;
+        let camera = uniform_buffer(gpu, std::mem::size_of::<GCameraUniform>(), "gbuffer camera")?;
         let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
             layout: &camera_layout,
@@ -110,8 +122,8 @@ impl GBufferRenderer {
             std::mem::size_of::<GDrawUniform>(),
             Self::MAX_DRAWS,
             "gbuffer draws",
-        );
-        let draw_group = draws.bind_group(gpu, &draw_layout);
+        )?;
+        let draw_group = draws.bind_group(gpu, &draw_layout)?;
         Ok(Self {
             pipeline,
             camera,
@@ -119,6 +131,7 @@ impl GBufferRenderer {
             draws,
             draw_group,
             shading_work: 0,
+            color_format,
         })
     }
 
@@ -131,6 +144,7 @@ impl GBufferRenderer {
 
     /// Renders `items` into `target` at resize factor `r` (the viewport shrinks with r; the
     /// textures do not change), cleared to `clear` with geometry (`far_view_depth`, +z).
+    /// `target` must have the color format the renderer was built for.
     #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
@@ -142,35 +156,40 @@ impl GBufferRenderer {
         items: &[GDrawItem],
         clear: wgpu::Color,
         far_view_depth: f32,
-    ) {
-        let camera = GCameraUniform {
-            view_proj: (proj * view).to_cols_array_2d(),
-            view: view.to_cols_array_2d(),
-            light_dir: Vec3::new(0.5, 0.8, 0.4)
-                .extend(self.shading_work as f32)
-                .to_array(),
-        };
-        gpu.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
-        let uniforms: Vec<GDrawUniform> = items
-            .iter()
-            .map(|i| GDrawUniform {
-                model: i.model.to_cols_array_2d(),
-                color: i.color.to_array(),
-            })
-            .collect();
-        let n = self.draws.write(gpu, &uniforms);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = target.begin_pass(&mut encoder, r, clear, far_view_depth);
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.camera_group, &[]);
-            for (i, item) in items[..n].iter().enumerate() {
-                pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
-                item.mesh.draw(&mut pass);
+    ) -> Result<(), GpuError> {
+        const CALL: &str = "GBufferRenderer::render";
+        same_color_format(CALL, "target", target.color_format(), self.color_format)?;
+        gpu.guarded(CALL, || {
+            let camera = GCameraUniform {
+                view_proj: (proj * view).to_cols_array_2d(),
+                view: view.to_cols_array_2d(),
+                light_dir: Vec3::new(0.5, 0.8, 0.4)
+                    .extend(self.shading_work as f32)
+                    .to_array(),
+            };
+            gpu.queue
+                .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+            let uniforms: Vec<GDrawUniform> = items
+                .iter()
+                .map(|i| GDrawUniform {
+                    model: i.model.to_cols_array_2d(),
+                    color: i.color.to_array(),
+                })
+                .collect();
+            let n = self.draws.write(gpu, &uniforms);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = target.begin_pass(&mut encoder, r, clear, far_view_depth);
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.camera_group, &[]);
+                for (i, item) in items[..n].iter().enumerate() {
+                    pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
+                    item.mesh.draw(&mut pass);
+                }
             }
-        }
-        gpu.queue.submit([encoder.finish()]);
+            gpu.queue.submit([encoder.finish()]);
+            Ok(())
+        })
     }
 }
 
@@ -188,21 +207,35 @@ impl EdgeScene {
     /// View depth of the background (cleared geometry).
     pub const FAR_VIEW_DEPTH: f32 = 40.0;
 
-    /// Uploads the meshes and builds the renderer for targets of `color_format` and `aspect`.
+    /// Uploads the meshes and builds the renderer for targets of `color_format` and `aspect`
+    /// (width / height: finite and positive).
     pub fn new(
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,
         aspect: f32,
-    ) -> Result<Self, ShaderError> {
-        Ok(Self {
-            renderers: [
-                GBufferRenderer::new(gpu, color_format, ShadingTerm::Full)?,
-                GBufferRenderer::new(gpu, color_format, ShadingTerm::Lighting)?,
-                GBufferRenderer::new(gpu, color_format, ShadingTerm::Albedo)?,
-            ],
-            sphere: GpuMesh::new(gpu, &super::scene::Mesh::sphere(24, 48)),
-            cube: GpuMesh::new(gpu, &super::scene::Mesh::cube()),
-            aspect,
+    ) -> Result<Self, GpuError> {
+        const CALL: &str = "EdgeScene::new";
+        if !(aspect.is_finite() && aspect > 0.0) {
+            return Err(GpuError::Invalid {
+                call: CALL,
+                parameter: "aspect",
+                value: aspect.to_string(),
+                rule: "must be finite and positive",
+            });
+        }
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        check_color_format(gpu, CALL, "color_format", color_format, usage)?;
+        gpu.guarded(CALL, || {
+            Ok(Self {
+                renderers: [
+                    GBufferRenderer::new(gpu, color_format, ShadingTerm::Full)?,
+                    GBufferRenderer::new(gpu, color_format, ShadingTerm::Lighting)?,
+                    GBufferRenderer::new(gpu, color_format, ShadingTerm::Albedo)?,
+                ],
+                sphere: GpuMesh::new(gpu, &super::scene::Mesh::sphere(24, 48))?,
+                cube: GpuMesh::new(gpu, &super::scene::Mesh::cube())?,
+                aspect,
+            })
         })
     }
 
@@ -214,12 +247,18 @@ impl EdgeScene {
     }
 
     /// Renders the full shading into `target` at resize factor `r`.
-    pub fn render(&self, gpu: &GpuContext, target: &LowResBuffer, r: f32) {
-        self.render_term(gpu, target, r, ShadingTerm::Full);
+    pub fn render(&self, gpu: &GpuContext, target: &LowResBuffer, r: f32) -> Result<(), GpuError> {
+        self.render_term(gpu, target, r, ShadingTerm::Full)
     }
 
     /// Renders one shading term into `target` at resize factor `r`.
-    pub fn render_term(&self, gpu: &GpuContext, target: &LowResBuffer, r: f32, term: ShadingTerm) {
+    pub fn render_term(
+        &self,
+        gpu: &GpuContext,
+        target: &LowResBuffer,
+        r: f32,
+        term: ShadingTerm,
+    ) -> Result<(), GpuError> {
         let view = glam::camera::rh::view::look_at_mat4(
             Vec3::new(0.5, 1.2, 6.0),
             Vec3::new(0.0, 0.0, -1.0),
@@ -281,6 +320,6 @@ impl EdgeScene {
             &items,
             clear,
             Self::FAR_VIEW_DEPTH,
-        );
+        )
     }
 }

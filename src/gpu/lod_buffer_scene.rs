@@ -3,15 +3,15 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::GpuContext;
 use super::counters::FragmentCounter;
+use super::error::{check_color_format, same_color_format};
 use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
 use super::resources::{
     DrawUniforms, depth_write_state, mesh_pipeline, r32float_texture, uniform_buffer, uniform_entry,
 };
 use super::scene::{CameraUniform, GpuMesh};
+use super::{GpuContext, GpuError};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
-use crate::shaders::ShaderError;
 use crate::visibility::VisibilityTexture;
 
 /// Rust mirror of `LodDraw` in `passes/lod_buffer_mesh.wgsl`.
@@ -56,47 +56,45 @@ pub struct LodBufferRenderer {
     draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
     vis_scale: f32,
+    color_format: wgpu::TextureFormat,
 }
 
 impl LodBufferRenderer {
     /// Most draws per [`render`](Self::render).
     pub const MAX_DRAWS: usize = 1024;
 
-    /// Builds the pipeline for color format `color_format`, with visibility texture `vis`
-    /// repeating `vis_scale` times per object-space unit.
+    /// Builds the pipeline for LOD buffers of color format `color_format`, with visibility
+    /// texture `vis` repeating `vis_scale` (finite, > 0) times per object-space unit.
     pub fn new(
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,
         vis: &VisibilityTexture,
         vis_scale: f32,
-    ) -> Result<Self, ShaderError> {
+    ) -> Result<Self, GpuError> {
+        const CALL: &str = "LodBufferRenderer::new";
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        check_color_format(gpu, CALL, "color_format", color_format, usage)?;
+        if !(vis_scale.is_finite() && vis_scale > 0.0) {
+            return Err(GpuError::Invalid {
+                call: CALL,
+                parameter: "vis_scale",
+                value: vis_scale.to_string(),
+                rule: "must be finite and positive",
+            });
+        }
+        gpu.guarded(CALL, || Self::build(gpu, color_format, vis, vis_scale))
+    }
+
+    fn build(
+        gpu: &GpuContext,
+        color_format: wgpu::TextureFormat,
+        vis: &VisibilityTexture,
+        vis_scale: f32,
+    ) -> Result<Self, GpuError> {
+        let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture")?;
         let module = gpu.pass_module("lod_buffer_mesh", &[])?;
         let device = &gpu.device;
-        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lod_buffer_mesh view"),
-            entries: &[
-                uniform_entry(0, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("lod_buffer_mesh draw"),
-            entries: &[uniform_entry(0, true)],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("lod_buffer_mesh"),
-            bind_group_layouts: &[Some(&view_layout), Some(&draw_layout)],
-            immediate_size: 0,
-        });
+        let (view_layout, draw_layout, layout) = layouts(device);
         let pipeline = mesh_pipeline(
             gpu,
             &module,
@@ -104,15 +102,14 @@ impl LodBufferRenderer {
             &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
             depth_write_state(LOD_DEPTH_FORMAT, wgpu::CompareFunction::Less),
             "lod_buffer_mesh",
-        );
-        let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture");
-        let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera");
+        )?;
+        let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
         let draws = DrawUniforms::new(
             gpu,
             std::mem::size_of::<LodDrawUniform>(),
             Self::MAX_DRAWS,
             "lod draws",
-        );
+        )?;
         let vis_view = vis_texture.create_view(&Default::default());
         let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
@@ -128,7 +125,7 @@ impl LodBufferRenderer {
                 },
             ],
         });
-        let draw_group = draws.bind_group(gpu, &draw_layout);
+        let draw_group = draws.bind_group(gpu, &draw_layout)?;
         Ok(Self {
             pipeline,
             camera,
@@ -136,6 +133,7 @@ impl LodBufferRenderer {
             draws,
             draw_group,
             vis_scale,
+            color_format,
         })
     }
 
@@ -152,51 +150,92 @@ impl LodBufferRenderer {
         items: &[LodDrawItem],
         clear: wgpu::Color,
         counter: Option<&FragmentCounter>,
-    ) -> (u64, u64) {
-        let items = &items[..items.len().min(self.draws.capacity())];
-        let camera = CameraUniform {
-            view_proj: view_proj.to_cols_array_2d(),
-            light_dir: Vec3::new(0.4, 0.8, 0.6).extend(0.0).to_array(),
-        };
-        gpu.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
-        let uniforms: Vec<LodDrawUniform> = items
-            .iter()
-            .map(|item| LodDrawUniform {
-                model: item.model.to_cols_array_2d(),
-                color: item.color.to_array(),
-                instance_id: item.id,
-                tau: item.tau,
-                vis_scale: self.vis_scale,
-                pad: 0.0,
-            })
-            .collect();
-        self.draws.write(gpu, &uniforms);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let mut triangles = 0u64;
-        {
-            let occlusion = counter.and_then(FragmentCounter::occlusion_query_set);
-            let mut pass = buffers.begin_pass(&mut encoder, index, clear, 1.0, occlusion);
-            if let Some(c) = counter {
-                c.begin(&mut pass);
+    ) -> Result<(u64, u64), GpuError> {
+        const CALL: &str = "LodBufferRenderer::render";
+        same_color_format(CALL, "buffers", buffers.color_format(), self.color_format)?;
+        gpu.guarded(CALL, || {
+            let items = &items[..items.len().min(self.draws.capacity())];
+            let camera = CameraUniform {
+                view_proj: view_proj.to_cols_array_2d(),
+                light_dir: Vec3::new(0.4, 0.8, 0.6).extend(0.0).to_array(),
+            };
+            gpu.queue
+                .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+            let uniforms: Vec<LodDrawUniform> = items
+                .iter()
+                .map(|item| LodDrawUniform {
+                    model: item.model.to_cols_array_2d(),
+                    color: item.color.to_array(),
+                    instance_id: item.id,
+                    tau: item.tau,
+                    vis_scale: self.vis_scale,
+                    pad: 0.0,
+                })
+                .collect();
+            self.draws.write(gpu, &uniforms);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let mut triangles = 0u64;
+            {
+                let occlusion = counter.and_then(FragmentCounter::occlusion_query_set);
+                let mut pass = buffers.begin_pass(&mut encoder, index, clear, 1.0, occlusion);
+                if let Some(c) = counter {
+                    c.begin(&mut pass);
+                }
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &self.camera_group, &[]);
+                for (i, item) in items.iter().enumerate() {
+                    pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
+                    item.mesh.draw(&mut pass);
+                    triangles += u64::from(item.mesh.triangles());
+                }
+                if let Some(c) = counter {
+                    c.end(&mut pass);
+                }
             }
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.camera_group, &[]);
-            for (i, item) in items.iter().enumerate() {
-                pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
-                item.mesh.draw(&mut pass);
-                triangles += u64::from(item.mesh.triangles());
+            match counter {
+                Some(c) => Ok((triangles, c.read(gpu, encoder)?)),
+                None => {
+                    gpu.queue.submit([encoder.finish()]);
+                    Ok((triangles, 0))
+                }
             }
-            if let Some(c) = counter {
-                c.end(&mut pass);
-            }
-        }
-        match counter {
-            Some(c) => (triangles, c.read(gpu, encoder)),
-            None => {
-                gpu.queue.submit([encoder.finish()]);
-                (triangles, 0)
-            }
-        }
+        })
     }
+}
+
+/// The view (camera, visibility texture) and per-draw bind group layouts of
+/// `passes/lod_buffer_mesh.wgsl`, and the pipeline layout over both.
+fn layouts(
+    device: &wgpu::Device,
+) -> (
+    wgpu::BindGroupLayout,
+    wgpu::BindGroupLayout,
+    wgpu::PipelineLayout,
+) {
+    let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("lod_buffer_mesh view"),
+        entries: &[
+            uniform_entry(0, false),
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            },
+        ],
+    });
+    let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("lod_buffer_mesh draw"),
+        entries: &[uniform_entry(0, true)],
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("lod_buffer_mesh"),
+        bind_group_layouts: &[Some(&view_layout), Some(&draw_layout)],
+        immediate_size: 0,
+    });
+    (view_layout, draw_layout, layout)
 }

@@ -1,8 +1,13 @@
 //! wgpu glue (feature `wgpu`): headless devices, readback, and the passes and render states of
 //! each technique.
+//!
+//! Every call here returns [`GpuError`] instead of panicking: sizes and formats are checked
+//! against the device's limits before wgpu sees them, the device work of each call runs inside
+//! error scopes, and a lost device is reported by the next call (docs/errors.md).
 
 mod context;
 pub mod counters;
+mod error;
 pub mod frame_sequential;
 pub mod framebuffer_lod;
 pub mod gbuffer_scene;
@@ -13,4 +18,5 @@ pub mod scene;
 pub mod transition_scene;
 pub mod unpopping;
 
-pub use context::{GpuContext, GpuError, GpuOptions};
+pub use context::{GpuContext, GpuOptions};
+pub use error::GpuError;

@@ -1,65 +1,133 @@
-//! Small constructors shared by the passes and renderers: 2D textures, uniform buffers for
-//! per-draw data with dynamic offsets, and a single-target render pass.
+//! Small constructors shared by the passes and renderers: 2D textures, buffers with contents,
+//! uniform buffers for per-draw data with dynamic offsets, pipelines and render passes. Each one
+//! that creates a resource checks its sizes and formats against the device and runs inside error
+//! scopes (see [`GpuError`]).
 
 use bytemuck::Pod;
-use wgpu::util::DeviceExt;
 
-use super::GpuContext;
+use super::error::{buffer_size, target_extent, texture_extent};
+use super::{GpuContext, GpuError};
 
-/// A 2D texture with one mip level and one sample.
+/// A 2D texture with one mip level and one sample (a zero side is taken as 1).
 pub fn texture_2d(
     gpu: &GpuContext,
     (width, height): (u32, u32),
     format: wgpu::TextureFormat,
     usage: wgpu::TextureUsages,
     label: &str,
-) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage,
-        view_formats: &[],
-    })
-}
-
-/// A square `R32Float` texture holding `texels` (row-major), for `textureLoad` (unfilterable).
-pub fn r32float_texture(gpu: &GpuContext, size: u32, texels: &[f32], label: &str) -> wgpu::Texture {
-    gpu.device.create_texture_with_data(
-        &gpu.queue,
-        &wgpu::TextureDescriptor {
+) -> Result<wgpu::Texture, GpuError> {
+    const CALL: &str = "resources::texture_2d";
+    let (width, height) = texture_extent(gpu, CALL, width, height)?;
+    let missing_features = format.required_features() - gpu.device.features();
+    let allowed = gpu.format_features(format).allowed_usages;
+    if !missing_features.is_empty() || !allowed.contains(usage) {
+        return Err(GpuError::UnsupportedFormat {
+            call: CALL,
+            parameter: "format",
+            format,
+            reason: format!(
+                "the device does not allow it as {:?} (missing features: {missing_features:?})",
+                usage - allowed
+            ),
+        });
+    }
+    gpu.guarded(CALL, || {
+        Ok(gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
             size: wgpu::Extent3d {
-                width: size,
-                height: size,
+                width,
+                height,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            format,
+            usage,
             view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
-        bytemuck::cast_slice(texels),
-    )
+        }))
+    })
+}
+
+/// A square `R32Float` texture holding `texels` (row-major, `size` x `size` of them), for
+/// `textureLoad` (unfilterable).
+pub fn r32float_texture(
+    gpu: &GpuContext,
+    size: u32,
+    texels: &[f32],
+    label: &str,
+) -> Result<wgpu::Texture, GpuError> {
+    const CALL: &str = "resources::r32float_texture";
+    let expected = u64::from(size) * u64::from(size);
+    if size == 0 || texels.len() as u64 != expected {
+        return Err(GpuError::Mismatch {
+            call: CALL,
+            parameter: "texels",
+            found: format!("{} values", texels.len()),
+            expected: format!("a {size} x {size} texture needs {expected} (and size >= 1)"),
+        });
+    }
+    let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+    let format = wgpu::TextureFormat::R32Float;
+    let texture = texture_2d(gpu, (size, size), format, usage, label)?;
+    gpu.guarded(CALL, || {
+        gpu.queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(size * 4),
+                rows_per_image: Some(size),
+            },
+            texture.size(),
+        );
+        Ok(())
+    })?;
+    Ok(texture)
+}
+
+/// A buffer of `usage` holding `contents` (padded to 4 bytes; at least 4 bytes long).
+pub fn buffer_with_data(
+    gpu: &GpuContext,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+    label: &str,
+) -> Result<wgpu::Buffer, GpuError> {
+    const CALL: &str = "resources::buffer_with_data";
+    let size = (contents.len() as u64).div_ceil(4).max(1) * 4;
+    buffer_size(gpu, CALL, "contents", size)?;
+    gpu.guarded(CALL, || {
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: true,
+        });
+        match buffer.get_mapped_range_mut(..) {
+            Ok(mut view) => view.slice(..contents.len()).copy_from_slice(contents),
+            // The creation failed: the error scope holds the reason.
+            Err(_) => return Ok(buffer),
+        }
+        buffer.unmap();
+        Ok(buffer)
+    })
 }
 
 /// A uniform buffer of `size` bytes that can be written.
-pub fn uniform_buffer(gpu: &GpuContext, size: usize, label: &str) -> wgpu::Buffer {
-    gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
+pub fn uniform_buffer(
+    gpu: &GpuContext,
+    size: usize,
+    label: &str,
+) -> Result<wgpu::Buffer, GpuError> {
+    const CALL: &str = "resources::uniform_buffer";
+    buffer_size(gpu, CALL, "size", size as u64)?;
+    gpu.guarded(CALL, || {
+        Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }))
     })
 }
 
@@ -88,15 +156,36 @@ pub struct DrawUniforms {
 
 impl DrawUniforms {
     /// Room for `capacity` items of `item_size` bytes each.
-    pub fn new(gpu: &GpuContext, item_size: usize, capacity: usize, label: &str) -> Self {
-        let align = u64::from(gpu.device.limits().min_uniform_buffer_offset_alignment);
-        let stride = (item_size as u64).div_ceil(align) * align;
-        Self {
-            buffer: uniform_buffer(gpu, (stride * capacity as u64) as usize, label),
+    pub fn new(
+        gpu: &GpuContext,
+        item_size: usize,
+        capacity: usize,
+        label: &str,
+    ) -> Result<Self, GpuError> {
+        let limits = gpu.device.limits();
+        let max_binding = limits.max_uniform_buffer_binding_size;
+        if item_size as u64 > max_binding {
+            return Err(GpuError::TooLarge {
+                call: "DrawUniforms::new",
+                parameter: "item_size",
+                value: item_size as u64,
+                limit: "max_uniform_buffer_binding_size",
+                max: max_binding,
+            });
+        }
+        let align = u64::from(limits.min_uniform_buffer_offset_alignment.max(1));
+        let stride = (item_size as u64).div_ceil(align).max(1) * align;
+        let bytes = stride.saturating_mul(capacity.max(1) as u64);
+        buffer_size(gpu, "DrawUniforms::new", "item_size x capacity", bytes)?;
+        let buffer = gpu.guarded("DrawUniforms::new", || {
+            uniform_buffer(gpu, bytes as usize, label)
+        })?;
+        Ok(Self {
+            buffer,
             stride,
             item_size: item_size as u64,
             capacity,
-        }
+        })
     }
 
     /// Most items it holds.
@@ -125,18 +214,24 @@ impl DrawUniforms {
     }
 
     /// A bind group holding the buffer at `binding` 0 of `layout` (one item wide).
-    pub fn bind_group(&self, gpu: &GpuContext, layout: &wgpu::BindGroupLayout) -> wgpu::BindGroup {
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &self.buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(self.item_size),
-                }),
-            }],
+    pub fn bind_group(
+        &self,
+        gpu: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+    ) -> Result<wgpu::BindGroup, GpuError> {
+        gpu.guarded("DrawUniforms::bind_group", || {
+            Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.buffer,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(self.item_size),
+                    }),
+                }],
+            }))
         })
     }
 }
@@ -173,29 +268,32 @@ pub fn fullscreen_pipeline(
     module: &wgpu::ShaderModule,
     format: wgpu::TextureFormat,
     label: &str,
-) -> wgpu::RenderPipeline {
-    gpu.device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+) -> Result<wgpu::RenderPipeline, GpuError> {
+    gpu.guarded("resources::fullscreen_pipeline", || {
+        Ok(gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: Default::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(format.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            }))
+    })
 }
 
 /// A render pipeline for [`Mesh`](super::scene::Mesh) geometry: `vs_main` / `fs_main` of
@@ -207,32 +305,35 @@ pub fn mesh_pipeline(
     targets: &[Option<wgpu::ColorTargetState>],
     depth: wgpu::DepthStencilState,
     label: &str,
-) -> wgpu::RenderPipeline {
-    gpu.device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(super::scene::MESH_VERTEX_LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: Some(wgpu::Face::Back),
-                ..Default::default()
-            },
-            depth_stencil: Some(depth),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        })
+) -> Result<wgpu::RenderPipeline, GpuError> {
+    gpu.guarded("resources::mesh_pipeline", || {
+        Ok(gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(super::scene::MESH_VERTEX_LAYOUT)],
+                },
+                primitive: wgpu::PrimitiveState {
+                    cull_mode: Some(wgpu::Face::Back),
+                    ..Default::default()
+                },
+                depth_stencil: Some(depth),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            }))
+    })
 }
 
 /// Depth-tested, depth-writing state with `compare` (`Less` for standard Z).
@@ -252,6 +353,20 @@ pub fn depth_write_state(
 /// A bind group of `textures` at bindings 0.. followed, if given, by `uniform` at the next
 /// binding.
 pub fn textures_and_uniform(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    textures: &[&wgpu::Texture],
+    uniform: Option<&wgpu::Buffer>,
+    label: &str,
+) -> Result<wgpu::BindGroup, GpuError> {
+    gpu.guarded("resources::textures_and_uniform", || {
+        Ok(bind_textures_and_uniform(
+            gpu, layout, textures, uniform, label,
+        ))
+    })
+}
+
+fn bind_textures_and_uniform(
     gpu: &GpuContext,
     layout: &wgpu::BindGroupLayout,
     textures: &[&wgpu::Texture],
@@ -327,6 +442,22 @@ pub fn begin_targets_pass<'e>(
 pub fn camera_draw_layouts(
     gpu: &GpuContext,
     label: &str,
+) -> Result<
+    (
+        wgpu::BindGroupLayout,
+        wgpu::BindGroupLayout,
+        wgpu::PipelineLayout,
+    ),
+    GpuError,
+> {
+    gpu.guarded("resources::camera_draw_layouts", || {
+        Ok(camera_draw_layouts_unguarded(gpu, label))
+    })
+}
+
+fn camera_draw_layouts_unguarded(
+    gpu: &GpuContext,
+    label: &str,
 ) -> (
     wgpu::BindGroupLayout,
     wgpu::BindGroupLayout,
@@ -348,4 +479,54 @@ pub fn camera_draw_layouts(
             immediate_size: 0,
         });
     (camera, draw, layout)
+}
+
+/// Textures of one size and color format allocated together (the LOD buffer pair, the
+/// low-resolution buffer), made and resized by [`new_set`] and [`resize_set`].
+pub(crate) trait TextureSet: Sized {
+    /// Usage of the color textures.
+    const USAGE: wgpu::TextureUsages;
+    /// Allocates every texture at `size` (already checked).
+    fn allocate(
+        gpu: &GpuContext,
+        size: (u32, u32),
+        color_format: wgpu::TextureFormat,
+    ) -> Result<Self, GpuError>;
+    /// The size the textures have.
+    fn extent(&self) -> (u32, u32);
+    /// The color format.
+    fn format(&self) -> wgpu::TextureFormat;
+    /// Every texture, to destroy when replaced.
+    fn textures(&self) -> Vec<&wgpu::Texture>;
+}
+
+/// A [`TextureSet`] at `width` x `height` in `color_format`, checked and allocated as `call`.
+pub(crate) fn new_set<T: TextureSet>(
+    gpu: &GpuContext,
+    call: &'static str,
+    (width, height): (u32, u32),
+    color_format: wgpu::TextureFormat,
+) -> Result<T, GpuError> {
+    let size = target_extent(gpu, call, (width, height), color_format, T::USAGE)?;
+    gpu.guarded(call, || T::allocate(gpu, size, color_format))
+}
+
+/// Reallocates `set` at `width` x `height` as `call` (a no-op at the same size). The old
+/// textures are destroyed once the new ones exist; on an error `set` is unchanged.
+pub(crate) fn resize_set<T: TextureSet>(
+    gpu: &GpuContext,
+    call: &'static str,
+    set: &mut T,
+    (width, height): (u32, u32),
+) -> Result<(), GpuError> {
+    let size = texture_extent(gpu, call, width, height)?;
+    if size == set.extent() {
+        return gpu.check(call);
+    }
+    let new = gpu.guarded(call, || T::allocate(gpu, size, set.format()))?;
+    let old = std::mem::replace(set, new);
+    for t in old.textures() {
+        t.destroy();
+    }
+    Ok(())
 }

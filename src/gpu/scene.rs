@@ -6,16 +6,15 @@ use std::f32::consts::{PI, TAU};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
-use wgpu::util::DeviceExt;
 
-use super::GpuContext;
 use super::counters::FragmentCounter;
+use super::error::texture_extent;
 use super::resources::{
-    DrawUniforms, begin_targets_pass, camera_draw_layouts, mesh_pipeline, texture_2d,
-    uniform_buffer,
+    DrawUniforms, begin_targets_pass, buffer_with_data, camera_draw_layouts, mesh_pipeline,
+    texture_2d, uniform_buffer,
 };
 use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
-use crate::shaders::ShaderError;
+use super::{GpuContext, GpuError};
 use crate::unpopping::LodRenderState;
 
 /// Depth format of [`RenderTarget`].
@@ -117,27 +116,26 @@ pub struct GpuMesh {
 }
 
 impl GpuMesh {
-    /// Uploads `mesh`.
-    pub fn new(gpu: &GpuContext, mesh: &Mesh) -> Self {
-        let make = |contents: &[u8], usage| {
-            gpu.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: None,
-                    contents,
-                    usage,
-                })
-        };
-        GpuMesh {
-            vertices: make(
-                bytemuck::cast_slice(&mesh.vertices),
-                wgpu::BufferUsages::VERTEX,
-            ),
-            indices: make(
-                bytemuck::cast_slice(&mesh.indices),
-                wgpu::BufferUsages::INDEX,
-            ),
-            count: mesh.indices.len() as u32,
-        }
+    /// Uploads `mesh` (an empty mesh is allowed and draws nothing).
+    pub fn new(gpu: &GpuContext, mesh: &Mesh) -> Result<Self, GpuError> {
+        gpu.guarded("GpuMesh::new", || Self::upload(gpu, mesh))
+    }
+
+    fn upload(gpu: &GpuContext, mesh: &Mesh) -> Result<Self, GpuError> {
+        let count = u32::try_from(mesh.indices.len()).map_err(|_| GpuError::TooLarge {
+            call: "GpuMesh::new",
+            parameter: "mesh.indices.len()",
+            value: mesh.indices.len() as u64,
+            limit: "u32 index count",
+            max: u32::MAX.into(),
+        })?;
+        let vertices = bytemuck::cast_slice(&mesh.vertices);
+        let indices = bytemuck::cast_slice(&mesh.indices);
+        Ok(GpuMesh {
+            vertices: buffer_with_data(gpu, vertices, wgpu::BufferUsages::VERTEX, "mesh vertices")?,
+            indices: buffer_with_data(gpu, indices, wgpu::BufferUsages::INDEX, "mesh indices")?,
+            count,
+        })
     }
 
     /// Triangles drawn per draw call.
@@ -147,6 +145,9 @@ impl GpuMesh {
 
     /// Binds the buffers and draws one instance (vertex layout: position, normal).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if self.count == 0 {
+            return;
+        }
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..self.count, 0, 0..1);
@@ -213,27 +214,26 @@ pub struct RenderTarget {
 }
 
 impl RenderTarget {
-    /// Allocates both textures.
-    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
+    /// Allocates both textures at `width` x `height` (a zero side is taken as 1).
+    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, GpuError> {
+        gpu.guarded("RenderTarget::new", || Self::allocate(gpu, width, height))
+    }
+
+    fn allocate(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, GpuError> {
+        let size = texture_extent(gpu, "RenderTarget::new", width, height)?;
         let color_usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::TEXTURE_BINDING;
-        Self {
-            color: texture_2d(
-                gpu,
-                (width, height),
-                COLOR_FORMAT,
-                color_usage,
-                "scene color",
-            ),
-            depth: texture_2d(
-                gpu,
-                (width, height),
-                DEPTH_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-                "scene depth",
-            ),
-        }
+        let depth_usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        Ok(Self {
+            color: texture_2d(gpu, size, COLOR_FORMAT, color_usage, "scene color")?,
+            depth: texture_2d(gpu, size, DEPTH_FORMAT, depth_usage, "scene depth")?,
+        })
+    }
+
+    /// Width and height.
+    pub fn size(&self) -> (u32, u32) {
+        (self.color.width(), self.color.height())
     }
 }
 
@@ -253,7 +253,11 @@ impl MeshRenderer {
     pub const MAX_DRAWS: usize = 256;
 
     /// Builds the pipelines (`blue_noise` selects the screen-door pattern).
-    pub fn new(gpu: &GpuContext, blue_noise: bool) -> Result<Self, ShaderError> {
+    pub fn new(gpu: &GpuContext, blue_noise: bool) -> Result<Self, GpuError> {
+        gpu.guarded("MeshRenderer::new", || Self::build(gpu, blue_noise))
+    }
+
+    fn build(gpu: &GpuContext, blue_noise: bool) -> Result<Self, GpuError> {
         let defs: &[&str] = if blue_noise {
             &["LODKIT_SCREEN_DOOR_BLUE_NOISE"]
         } else {
@@ -261,7 +265,7 @@ impl MeshRenderer {
         };
         let module = gpu.pass_module("lod_mesh", defs)?;
         let device = &gpu.device;
-        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "lod_mesh");
+        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "lod_mesh")?;
         let pipeline = |state: LodRenderState| {
             let target = wgpu::ColorTargetState {
                 format: COLOR_FORMAT,
@@ -278,26 +282,28 @@ impl MeshRenderer {
             depth_write: false,
             blend: true,
         };
-        let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera");
-        let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &camera_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: camera.as_entire_binding(),
-            }],
-        });
+        let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
+        let camera_group = gpu.guarded("MeshRenderer::new", || {
+            Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &camera_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: camera.as_entire_binding(),
+                }],
+            }))
+        })?;
         let draws = DrawUniforms::new(
             gpu,
             std::mem::size_of::<DrawUniform>(),
             Self::MAX_DRAWS,
             "draws",
-        );
+        )?;
         Ok(Self {
-            opaque: pipeline(opaque_state),
-            blended: pipeline(blended_state),
+            opaque: pipeline(opaque_state)?,
+            blended: pipeline(blended_state)?,
             camera_group,
-            draw_group: draws.bind_group(gpu, &draw_layout),
+            draw_group: draws.bind_group(gpu, &draw_layout)?,
             camera,
             draws,
         })
@@ -306,6 +312,8 @@ impl MeshRenderer {
     /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]; the
     /// rest are dropped), lit from `light_dir`, counting the pass's fragments with `counter` if
     /// given. Returns the count (0 without a counter).
+    ///
+    /// The meshes and the counter must come from `gpu`'s device.
     #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
@@ -316,60 +324,62 @@ impl MeshRenderer {
         light_dir: Vec3,
         items: &[DrawItem],
         counter: Option<&FragmentCounter>,
-    ) -> u64 {
-        let items = &items[..items.len().min(self.draws.capacity())];
-        let camera = CameraUniform {
-            view_proj: view_proj.to_cols_array_2d(),
-            light_dir: light_dir.extend(0.0).to_array(),
-        };
-        gpu.queue
-            .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
-        let uniforms: Vec<DrawUniform> = items
-            .iter()
-            .map(|item| DrawUniform {
-                model: item.model.to_cols_array_2d(),
-                color: item.color.to_array(),
-                dither_alpha: item.dither_alpha.unwrap_or(DITHER_OFF),
-                pad: [0.0; 3],
-            })
-            .collect();
-        self.draws.write(gpu, &uniforms);
-        let color_view = target.color.create_view(&Default::default());
-        let depth_view = target.depth.create_view(&Default::default());
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = begin_targets_pass(
-                &mut encoder,
-                &[(&color_view, clear)],
-                &depth_view,
-                1.0,
-                counter.and_then(FragmentCounter::occlusion_query_set),
-                "lod_mesh",
-            );
-            if let Some(c) = counter {
-                c.begin(&mut pass);
+    ) -> Result<u64, GpuError> {
+        gpu.guarded("MeshRenderer::render", || {
+            let items = &items[..items.len().min(self.draws.capacity())];
+            let camera = CameraUniform {
+                view_proj: view_proj.to_cols_array_2d(),
+                light_dir: light_dir.extend(0.0).to_array(),
+            };
+            gpu.queue
+                .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));
+            let uniforms: Vec<DrawUniform> = items
+                .iter()
+                .map(|item| DrawUniform {
+                    model: item.model.to_cols_array_2d(),
+                    color: item.color.to_array(),
+                    dither_alpha: item.dither_alpha.unwrap_or(DITHER_OFF),
+                    pad: [0.0; 3],
+                })
+                .collect();
+            self.draws.write(gpu, &uniforms);
+            let color_view = target.color.create_view(&Default::default());
+            let depth_view = target.depth.create_view(&Default::default());
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = begin_targets_pass(
+                    &mut encoder,
+                    &[(&color_view, clear)],
+                    &depth_view,
+                    1.0,
+                    counter.and_then(FragmentCounter::occlusion_query_set),
+                    "lod_mesh",
+                );
+                if let Some(c) = counter {
+                    c.begin(&mut pass);
+                }
+                pass.set_bind_group(0, &self.camera_group, &[]);
+                for (i, item) in items.iter().enumerate() {
+                    pass.set_pipeline(if item.state.blend {
+                        &self.blended
+                    } else {
+                        &self.opaque
+                    });
+                    pass.set_blend_constant(lod_blend_constant(&item.state));
+                    pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
+                    item.mesh.draw(&mut pass);
+                }
+                if let Some(c) = counter {
+                    c.end(&mut pass);
+                }
             }
-            pass.set_bind_group(0, &self.camera_group, &[]);
-            for (i, item) in items.iter().enumerate() {
-                pass.set_pipeline(if item.state.blend {
-                    &self.blended
-                } else {
-                    &self.opaque
-                });
-                pass.set_blend_constant(lod_blend_constant(&item.state));
-                pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
-                item.mesh.draw(&mut pass);
+            match counter {
+                Some(c) => c.read(gpu, encoder),
+                None => {
+                    gpu.queue.submit([encoder.finish()]);
+                    Ok(0)
+                }
             }
-            if let Some(c) = counter {
-                c.end(&mut pass);
-            }
-        }
-        match counter {
-            Some(c) => c.read(gpu, encoder),
-            None => {
-                gpu.queue.submit([encoder.finish()]);
-                0
-            }
-        }
+        })
     }
 }

@@ -4,12 +4,11 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::GpuContext;
 use super::readback::read_texture_rgba8;
 use super::scene::{DrawItem, GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use super::{GpuContext, GpuError};
 use crate::screen_door::DitherPattern;
 use crate::select::LodSelection;
-use crate::shaders::ShaderError;
 use crate::unpopping::{LodRenderState, LodRole, TransitionPlan, cross_fade_plan, unpopping_plan};
 
 /// How a single-frame transition is drawn.
@@ -85,20 +84,25 @@ pub enum SceneParts {
 }
 
 impl TransitionScene {
-    /// Builds meshes, pipelines and a `width` x `height` target.
-    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, ShaderError> {
+    /// Builds meshes, pipelines and a `width` x `height` target (a zero side is taken as 1).
+    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, GpuError> {
+        gpu.guarded("TransitionScene::new", || Self::build(gpu, width, height))
+    }
+
+    fn build(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, GpuError> {
+        let target = RenderTarget::new(gpu, width, height)?;
         let bayer = MeshRenderer::new(gpu, false)?;
         let blue = MeshRenderer::new(gpu, true)?;
-        let fine = GpuMesh::new(gpu, &Mesh::sphere(24, 48));
-        let coarse = GpuMesh::new(gpu, &Mesh::sphere(3, 6));
-        let backdrop = GpuMesh::new(gpu, &Mesh::cube());
+        let fine = GpuMesh::new(gpu, &Mesh::sphere(24, 48))?;
+        let coarse = GpuMesh::new(gpu, &Mesh::sphere(3, 6))?;
+        let backdrop = GpuMesh::new(gpu, &Mesh::cube())?;
         Ok(Self {
             renderers: [bayer, blue],
             fine,
             coarse,
             backdrop,
-            target: RenderTarget::new(gpu, width, height),
-            size: (width, height),
+            size: target.size(),
+            target,
         })
     }
 
@@ -123,7 +127,7 @@ impl TransitionScene {
         technique: SingleFrameTechnique,
         t: f32,
         parts: SceneParts,
-    ) -> Vec<u8> {
+    ) -> Result<Vec<u8>, GpuError> {
         let model = Mat4::from_scale(Vec3::splat(1.1));
         let mut items = Vec::new();
         if parts == SceneParts::All {
@@ -159,16 +163,18 @@ impl TransitionScene {
             b: 0.05,
             a: 1.0,
         };
-        renderer.render(
-            gpu,
-            &self.target,
-            clear,
-            self.view_proj(),
-            Vec3::new(0.4, 0.8, 0.6),
-            &items,
-            None,
-        );
-        read_texture_rgba8(gpu, &self.target.color)
+        gpu.guarded("TransitionScene::render", || {
+            renderer.render(
+                gpu,
+                &self.target,
+                clear,
+                self.view_proj(),
+                Vec3::new(0.4, 0.8, 0.6),
+                &items,
+                None,
+            )?;
+            read_texture_rgba8(gpu, &self.target.color)
+        })
     }
 }
 
@@ -235,14 +241,18 @@ pub fn transition_items<'a>(
 
 /// See-through of a transition image: among the pixels both LODs cover (`fine_mask` and
 /// `coarse_mask` rendered with [`SceneParts`]), the share where the red backdrop contributes
-/// (red above 2/255), and the mean red there (0..1).
+/// (red above 2/255), and the mean red there (0..1). Pixels past the end of a shorter mask count
+/// as not covered.
 pub fn see_through(image: &[u8], fine_mask: &[u8], coarse_mask: &[u8]) -> (f32, f32) {
-    let covered = |mask: &[u8], i: usize| mask[i * 4 + 1] > 20 || mask[i * 4 + 2] > 20;
+    let covered = |mask: &[u8], i: usize| {
+        mask.get(i * 4 + 1..i * 4 + 3)
+            .is_some_and(|gb| gb[0] > 20 || gb[1] > 20)
+    };
     let (mut interior, mut seen, mut red) = (0usize, 0usize, 0.0f32);
-    for i in 0..image.len() / 4 {
+    for (i, pixel) in image.chunks_exact(4).enumerate() {
         if covered(fine_mask, i) && covered(coarse_mask, i) {
             interior += 1;
-            let r = image[i * 4];
+            let r = pixel[0];
             if r > 2 {
                 seen += 1;
             }

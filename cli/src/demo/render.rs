@@ -6,7 +6,6 @@ use glam::{Mat4, Vec3, Vec4};
 use super::scene::DemoScene;
 use lodkit::combine::{DepthConvention, PixelSource, combine_images};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
-use lodkit::gpu::GpuContext;
 use lodkit::gpu::counters::FragmentCounter;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
@@ -14,9 +13,9 @@ use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshRenderer, RenderTarget};
 use lodkit::gpu::transition_scene::{SingleFrameTechnique, transition_items};
+use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::screen_door::DitherPattern;
-use lodkit::shaders::ShaderError;
 use lodkit::unpopping::LodRenderState;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
@@ -126,17 +125,17 @@ impl<'a> SceneRenderer<'a> {
         scene: &'a DemoScene,
         size: (u32, u32),
         frames: usize,
-    ) -> Result<Self, ShaderError> {
+    ) -> Result<Self, GpuError> {
         let meshes = scene
             .objects
             .iter()
             .map(|o| {
-                [
-                    GpuMesh::new(gpu, &o.fine.mesh()),
-                    GpuMesh::new(gpu, &o.coarse.mesh()),
-                ]
+                Ok([
+                    GpuMesh::new(gpu, &o.fine.mesh())?,
+                    GpuMesh::new(gpu, &o.coarse.mesh())?,
+                ])
             })
-            .collect();
+            .collect::<Result<_, GpuError>>()?;
         let vis = |p| visibility_texture(p, 64, 1);
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         Ok(Self {
@@ -148,15 +147,15 @@ impl<'a> SceneRenderer<'a> {
                 MeshRenderer::new(gpu, false)?,
                 MeshRenderer::new(gpu, true)?,
             ],
-            target: RenderTarget::new(gpu, size.0, size.1),
+            target: RenderTarget::new(gpu, size.0, size.1)?,
             lod_buffer: [
                 LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::WhiteNoise), 0.25)?,
                 LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), 0.25)?,
             ],
-            buffers: LodBuffers::new(gpu, size.0, size.1, FORMAT),
+            buffers: LodBuffers::new(gpu, size.0, size.1, FORMAT)?,
             combine: CombinePass::new(gpu, FORMAT, false)?,
-            combined: texture_2d(gpu, size, FORMAT, usage, "combined"),
-            counter: FragmentCounter::new(gpu),
+            combined: texture_2d(gpu, size, FORMAT, usage, "combined")?,
+            counter: FragmentCounter::new(gpu)?,
         })
     }
 
@@ -218,12 +217,13 @@ impl<'a> SceneRenderer<'a> {
         wanted: &dyn Fn(usize) -> bool,
         on_frame: &mut dyn FnMut(usize, Frame),
         on_sources: Option<&mut dyn FnMut(Vec<PixelSource>)>,
-    ) {
+    ) -> Result<(), GpuError> {
         match spec.technique {
             Technique::Single(t) => {
                 for f in (0..self.run_length()).filter(|&f| wanted(f)) {
-                    on_frame(f, self.render_single(gpu, t, f, spec));
+                    on_frame(f, self.render_single(gpu, t, f, spec)?);
                 }
+                Ok(())
             }
             Technique::FrameSequential(p) => {
                 self.run_frame_sequential(gpu, p, spec, wanted, on_frame, on_sources)
@@ -237,7 +237,7 @@ impl<'a> SceneRenderer<'a> {
         technique: SingleFrameTechnique,
         frame: usize,
         spec: RunSpec,
-    ) -> Frame {
+    ) -> Result<Frame, GpuError> {
         let (view, proj) = self.camera(frame, spec.moving);
         let t = self.progress(frame);
         let mut items: Vec<DrawItem> = Vec::new();
@@ -286,12 +286,12 @@ impl<'a> SceneRenderer<'a> {
             LIGHT,
             &items,
             Some(&self.counter),
-        );
-        Frame {
-            pixels: read_texture_rgba8(gpu, &self.target.color),
+        )?;
+        Ok(Frame {
+            pixels: read_texture_rgba8(gpu, &self.target.color)?,
             triangles,
             fragments,
-        }
+        })
     }
 
     fn run_frame_sequential(
@@ -302,7 +302,7 @@ impl<'a> SceneRenderer<'a> {
         wanted: &dyn Fn(usize) -> bool,
         on_frame: &mut dyn FnMut(usize, Frame),
         mut on_sources: Option<&mut dyn FnMut(Vec<PixelSource>)>,
-    ) {
+    ) -> Result<(), GpuError> {
         let renderer = &self.lod_buffer[usize::from(pattern == VisibilityPattern::BlueNoise)];
         let mut scheduler = TransitionScheduler::new();
         let keys: Vec<_> = self
@@ -360,25 +360,25 @@ impl<'a> SceneRenderer<'a> {
                 &items,
                 color(clear),
                 Some(&self.counter),
-            );
+            )?;
             let m = previous.map_or(CombinePass::NO_HISTORY, |old| {
                 new_to_old_matrix(&view, &proj, &old, &proj)
             });
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let target = self.combined.create_view(&Default::default());
             self.combine
-                .encode(gpu, &mut encoder, &self.buffers, index, m, &target);
+                .encode(gpu, &mut encoder, &self.buffers, index, m, &target)?;
             gpu.queue.submit([encoder.finish()]);
             if let Some(f) = on_sources.as_mut().filter(|_| frame == middle) {
-                let newer = read_lod_image(gpu, &self.buffers, index);
-                let older = read_lod_image(gpu, &self.buffers, 1 - index);
+                let newer = read_lod_image(gpu, &self.buffers, index)?;
+                let older = read_lod_image(gpu, &self.buffers, 1 - index)?;
                 let sources = combine_images(&newer, &older, &m, DepthConvention::Standard);
                 f(sources.iter().map(|p| p.source).collect());
             }
             if wanted(frame) {
                 // The combine pass shades every pixel once more.
                 let combine = u64::from(self.size.0) * u64::from(self.size.1);
-                let pixels = read_texture_rgba8(gpu, &self.combined);
+                let pixels = read_texture_rgba8(gpu, &self.combined)?;
                 let fragments = fragments + combine;
                 on_frame(
                     frame,
@@ -391,14 +391,15 @@ impl<'a> SceneRenderer<'a> {
             }
             previous = Some(view);
         }
+        Ok(())
     }
 
     /// Masks of the transitioning objects drawn opaque at the fine and at the coarse LOD (the
     /// scenery in black, so hidden parts do not count), at the middle frame of the static
     /// camera: `true` where the object covers the pixel.
-    pub fn lod_masks(&self, gpu: &GpuContext) -> [Vec<bool>; 2] {
+    pub fn lod_masks(&self, gpu: &GpuContext) -> Result<[Vec<bool>; 2], GpuError> {
         let (view, proj) = self.camera(LEAD_FRAMES + self.frames / 2, false);
-        [0usize, 1].map(|lod| {
+        let mask = |lod: usize| -> Result<Vec<bool>, GpuError> {
             let items: Vec<DrawItem> = self
                 .scene
                 .objects
@@ -423,11 +424,12 @@ impl<'a> SceneRenderer<'a> {
                 LIGHT,
                 &items,
                 None,
-            );
-            read_texture_rgba8(gpu, &self.target.color)
+            )?;
+            Ok(read_texture_rgba8(gpu, &self.target.color)?
                 .chunks(4)
                 .map(|p| p[..3].iter().any(|&c| c > 8))
-                .collect()
-        })
+                .collect())
+        };
+        Ok([mask(0)?, mask(1)?])
     }
 }

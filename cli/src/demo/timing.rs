@@ -10,7 +10,6 @@ use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
 
 use super::upsampling::{SIGMA_N, SIGMA_Z};
-use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::EdgeScene;
@@ -19,8 +18,9 @@ use lodkit::gpu::resources::{
     begin_color_pass, fullscreen_pipeline, texture_2d, textures_and_uniform, uniform_buffer,
 };
 use lodkit::gpu::scene::{GpuMesh, Mesh};
+use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::reproject::new_to_old_matrix;
-use lodkit::shaders::{ComposeDescriptor, ShaderError, ShaderLibrary};
+use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 /// A pass timed against its baseline.
@@ -50,34 +50,38 @@ pub fn median(v: &[f64]) -> f64 {
 }
 
 /// Wall time of `f` in milliseconds.
-pub fn wall_ms(f: &dyn Fn()) -> f64 {
+pub fn wall_ms(f: &dyn Fn() -> Result<(), GpuError>) -> Result<f64, GpuError> {
     let t = Instant::now();
-    f();
-    t.elapsed().as_secs_f64() * 1e3
+    f()?;
+    Ok(t.elapsed().as_secs_f64() * 1e3)
 }
 
 /// Times `a` and `b` (each must wait for the GPU itself) in `pairs` interleaved pairs after a
 /// few warm-up rounds, alternating which goes first. Returns the medians of a, b and a/b.
-pub fn interleaved(a: &dyn Fn(), b: &dyn Fn(), pairs: usize) -> (f64, f64, f64) {
+pub fn interleaved(
+    a: &dyn Fn() -> Result<(), GpuError>,
+    b: &dyn Fn() -> Result<(), GpuError>,
+    pairs: usize,
+) -> Result<(f64, f64, f64), GpuError> {
     let time = wall_ms;
     for _ in 0..5 {
-        a();
-        b();
+        a()?;
+        b()?;
     }
     let (mut ta, mut tb, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..pairs.max(1) {
         let (x, y) = if i % 2 == 0 {
-            let x = time(a);
-            (x, time(b))
+            let x = time(a)?;
+            (x, time(b)?)
         } else {
-            let y = time(b);
-            (time(a), y)
+            let y = time(b)?;
+            (time(a)?, y)
         };
         ta.push(x);
         tb.push(y);
         ratio.push(x / y);
     }
-    (median(&ta), median(&tb), median(&ratio))
+    Ok((median(&ta), median(&tb), median(&ratio)))
 }
 
 /// A fullscreen pipeline (`vs_main`, `fs_main`, RGBA8 target) from WGSL `source` that may
@@ -86,14 +90,14 @@ pub fn plain_pass(
     gpu: &GpuContext,
     source: &str,
     name: &str,
-) -> Result<wgpu::RenderPipeline, ShaderError> {
+) -> Result<wgpu::RenderPipeline, GpuError> {
     let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
         source,
         file_path: name,
         ..Default::default()
     })?;
-    let module = gpu.shader_module(name, &composed);
-    Ok(fullscreen_pipeline(gpu, &module, FORMAT, name))
+    let module = gpu.shader_module(name, &composed)?;
+    fullscreen_pipeline(gpu, &module, FORMAT, name)
 }
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -127,7 +131,7 @@ fn draw_fullscreen(
     pipeline: &wgpu::RenderPipeline,
     group: &wgpu::BindGroup,
     target: &wgpu::TextureView,
-) {
+) -> Result<(), GpuError> {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     {
         let mut pass = begin_color_pass(&mut encoder, target, wgpu::Color::BLACK, "baseline");
@@ -136,23 +140,19 @@ fn draw_fullscreen(
         pass.draw(0..3, 0..1);
     }
     gpu.queue.submit([encoder.finish()]);
-    gpu.wait_idle();
+    gpu.wait_idle()
 }
 
 /// The combine pass against a plain pass reading the same four textures (two colors, two
 /// id/depth) at `size` x `size`, on two LOD buffers of a grid of spheres and boxes with a third
 /// of them in transition and the camera moved between the frames.
-pub fn combine_vs_copy(
-    gpu: &GpuContext,
-    size: u32,
-    pairs: usize,
-) -> Result<PassRatio, ShaderError> {
-    let buffers = LodBuffers::new(gpu, size, size, FORMAT);
+pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<PassRatio, GpuError> {
+    let buffers = LodBuffers::new(gpu, size, size, FORMAT)?;
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
     let renderer = LodBufferRenderer::new(gpu, FORMAT, &vis, 0.25)?;
     let meshes = [
-        GpuMesh::new(gpu, &Mesh::sphere(16, 24)),
-        GpuMesh::new(gpu, &Mesh::cube()),
+        GpuMesh::new(gpu, &Mesh::sphere(16, 24))?,
+        GpuMesh::new(gpu, &Mesh::cube())?,
     ];
     let proj = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 0.1, 100.0);
     let views = [0.0f32, 0.1]
@@ -179,7 +179,7 @@ pub fn combine_vs_copy(
             &items,
             wgpu::Color::BLACK,
             None,
-        );
+        )?;
     }
     let target = texture_2d(
         gpu,
@@ -187,7 +187,7 @@ pub fn combine_vs_copy(
         FORMAT,
         wgpu::TextureUsages::RENDER_ATTACHMENT,
         "target",
-    );
+    )?;
     let target_view = target.create_view(&Default::default());
     let combine = CombinePass::new(gpu, FORMAT, false)?;
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
@@ -199,15 +199,15 @@ pub fn combine_vs_copy(
         buffers.id_depth(0),
     ];
     let layout = copy4.get_bind_group_layout(0);
-    let group = textures_and_uniform(gpu, &layout, &textures, None, "copy4");
+    let group = textures_and_uniform(gpu, &layout, &textures, None, "copy4")?;
     let run_combine = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        combine.encode(gpu, &mut encoder, &buffers, 1, m, &target_view);
+        combine.encode(gpu, &mut encoder, &buffers, 1, m, &target_view)?;
         gpu.queue.submit([encoder.finish()]);
-        gpu.wait_idle();
+        gpu.wait_idle()
     };
     let run_copy = || draw_fullscreen(gpu, &copy4, &group, &target_view);
-    let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs);
+    let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs)?;
     Ok(PassRatio {
         pass: "combine (frame-sequential)".to_owned(),
         baseline: "plain copy of the same 4 textures".to_owned(),
@@ -226,13 +226,13 @@ pub fn upsample_vs_bilinear(
     size: (u32, u32),
     r: f32,
     pairs: usize,
-) -> Result<PassRatio, ShaderError> {
+) -> Result<PassRatio, GpuError> {
     let (w, h) = size;
     let scene = EdgeScene::new(gpu, FORMAT, w as f32 / h as f32)?;
-    let full = LowResBuffer::new(gpu, w, h, FORMAT);
-    scene.render(gpu, &full, 1.0);
-    let low = LowResBuffer::new(gpu, w, h, FORMAT);
-    scene.render(gpu, &low, r);
+    let full = LowResBuffer::new(gpu, w, h, FORMAT)?;
+    scene.render(gpu, &full, 1.0)?;
+    let low = LowResBuffer::new(gpu, w, h, FORMAT)?;
+    scene.render(gpu, &low, r)?;
     let upsample = UpsamplePass::new(gpu, FORMAT)?;
     let target = texture_2d(
         gpu,
@@ -240,7 +240,7 @@ pub fn upsample_vs_bilinear(
         FORMAT,
         wgpu::TextureUsages::RENDER_ATTACHMENT,
         "target",
-    );
+    )?;
     let view = target.create_view(&Default::default());
     let bilinear = plain_pass(gpu, BILINEAR, "bilinear.wgsl")?;
     let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
@@ -248,7 +248,7 @@ pub fn upsample_vs_bilinear(
         min_filter: wgpu::FilterMode::Linear,
         ..Default::default()
     });
-    let scale = uniform_buffer(gpu, 16, "scale");
+    let scale = uniform_buffer(gpu, 16, "scale")?;
     let (vw, vh) = low.viewport(r);
     let s = [vw as f32 / w as f32, vh as f32 / h as f32, 0.0, 0.0];
     gpu.queue.write_buffer(&scale, 0, bytemuck::cast_slice(&s));
@@ -282,12 +282,12 @@ pub fn upsample_vs_bilinear(
             SIGMA_Z,
             SIGMA_N,
             &view,
-        );
+        )?;
         gpu.queue.submit([encoder.finish()]);
-        gpu.wait_idle();
+        gpu.wait_idle()
     };
     let run_bilinear = || draw_fullscreen(gpu, &bilinear, &group, &view);
-    let (pass_ms, baseline_ms, ratio) = interleaved(&run_bilateral, &run_bilinear, pairs);
+    let (pass_ms, baseline_ms, ratio) = interleaved(&run_bilateral, &run_bilinear, pairs)?;
     Ok(PassRatio {
         pass: format!("bilateral upsample (r = {r})"),
         baseline: "bilinear upsample (hardware filter)".to_owned(),

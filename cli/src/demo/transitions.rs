@@ -9,7 +9,7 @@ use serde::Serialize;
 use super::DemoError;
 use super::render::{Background, Frame, LEAD_FRAMES, RunSpec, SceneRenderer, Technique};
 use lodkit::combine::PixelSource;
-use lodkit::gpu::GpuContext;
+use lodkit::gpu::{GpuContext, GpuError};
 
 /// Metrics of one technique on one scene.
 #[derive(Clone, Debug, Serialize)]
@@ -91,7 +91,7 @@ fn reference_run(
     renderer: &SceneRenderer,
     technique: Technique,
     moving: bool,
-) -> Vec<Vec<u8>> {
+) -> Result<Vec<Vec<u8>>, GpuError> {
     let spec = RunSpec {
         technique,
         moving,
@@ -100,8 +100,8 @@ fn reference_run(
     };
     let wanted = |f: usize| moving || f == 0;
     let mut frames = Vec::new();
-    renderer.run(gpu, spec, &wanted, &mut |_, f| frames.push(f.pixels), None);
-    frames
+    renderer.run(gpu, spec, &wanted, &mut |_, f| frames.push(f.pixels), None)?;
+    Ok(frames)
 }
 
 /// What one transition run measured.
@@ -176,7 +176,7 @@ fn transition_run(
             previous = Some(frame.pixels);
         },
         (frame_sequential && moving).then_some(&mut on_sources as &mut dyn FnMut(Vec<PixelSource>)),
-    );
+    )?;
     run.sources = sources;
     match failed {
         Some(e) => Err(e),
@@ -205,7 +205,7 @@ fn see_through(
             background: Background::Flat(flat),
         };
         let mut pixels = Vec::new();
-        renderer.run(gpu, spec, &only_middle, &mut |_, f| pixels = f.pixels, None);
+        renderer.run(gpu, spec, &only_middle, &mut |_, f| pixels = f.pixels, None)?;
         over.push(pixels);
     }
     let (mut interior, mut seen) = (0usize, 0usize);
@@ -256,7 +256,7 @@ pub fn measure_scene(
     out: &Path,
     tick: &mut dyn FnMut(&str),
 ) -> Result<Vec<TransitionMetrics>, DemoError> {
-    let masks = renderer.lod_masks(gpu);
+    let masks = renderer.lod_masks(gpu)?;
     let counts = renderer.counter().kind().is_count();
     let mut rows: Vec<TransitionMetrics> = Vec::new();
     // Reference runs of the current technique family (single-frame or frame-sequential),
@@ -267,8 +267,8 @@ pub fn measure_scene(
         let family = matches!(technique, Technique::FrameSequential(_));
         if references.as_ref().is_none_or(|(f, _)| *f != family) {
             drop(references.take()); // frees the other family's frames first
-            let runs = [false, true].map(|moving| reference_run(gpu, renderer, technique, moving));
-            references = Some((family, runs));
+            let run = |moving| reference_run(gpu, renderer, technique, moving);
+            references = Some((family, [run(false)?, run(true)?]));
         }
         let Some((_, reference)) = &references else {
             return Err(DemoError::Internal("no reference run".to_owned()));

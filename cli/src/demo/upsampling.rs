@@ -12,11 +12,11 @@ use lodkit::framebuffer_lod::{
     FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
     RlsController, StepController, multiply_rgba8, psnr_rgba8, simulate, ssim_rgba8, step_response,
 };
-use lodkit::gpu::GpuContext;
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
+use lodkit::gpu::{GpuContext, GpuError};
 
 /// Resize factors the demo measures.
 pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];
@@ -74,33 +74,34 @@ pub fn measure_upsampling(
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let mut scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
     scene.set_shading_work(SHADING_WORK);
-    let full = LowResBuffer::new(gpu, w, h, format);
-    scene.render(gpu, &full, 1.0);
-    let reference = read_texture_rgba8(gpu, full.color());
-    let low = LowResBuffer::new(gpu, w, h, format);
-    let albedo = LowResBuffer::new(gpu, w, h, format);
+    let full = LowResBuffer::new(gpu, w, h, format)?;
+    scene.render(gpu, &full, 1.0)?;
+    let reference = read_texture_rgba8(gpu, full.color())?;
+    let low = LowResBuffer::new(gpu, w, h, format)?;
+    let albedo = LowResBuffer::new(gpu, w, h, format)?;
     let upsample = UpsamplePass::new(gpu, format)?;
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let target = texture_2d(gpu, size, format, usage, "upsampled");
+    let target = texture_2d(gpu, size, format, usage, "upsampled")?;
     let view = target.create_view(&Default::default());
     let upsample_with = |r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        upsample.encode(gpu, &mut encoder, &low, r, geometry, sz, sn, &view);
+        upsample.encode(gpu, &mut encoder, &low, r, geometry, sz, sn, &view)?;
         gpu.queue.submit([encoder.finish()]);
+        Ok::<(), GpuError>(())
     };
     let mut rows = Vec::new();
     for r in RESIZE_FACTORS {
-        scene.render(gpu, &low, r);
-        upsample_with(r, full.geometry(), f32::INFINITY, f32::INFINITY);
-        let bilinear = read_texture_rgba8(gpu, &target);
-        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N);
-        let bilateral = read_texture_rgba8(gpu, &target);
+        scene.render(gpu, &low, r)?;
+        upsample_with(r, full.geometry(), f32::INFINITY, f32::INFINITY)?;
+        let bilinear = read_texture_rgba8(gpu, &target)?;
+        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N)?;
+        let bilateral = read_texture_rgba8(gpu, &target)?;
         // Fine-grained: only the lighting goes through the low-res buffer; albedo at full res.
-        scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
-        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N);
-        let lighting = read_texture_rgba8(gpu, &target);
-        scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
-        let fine = multiply_rgba8(&lighting, &read_texture_rgba8(gpu, albedo.color()));
+        scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
+        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N)?;
+        let lighting = read_texture_rgba8(gpu, &target)?;
+        scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
+        let fine = multiply_rgba8(&lighting, &read_texture_rgba8(gpu, albedo.color())?);
         let images = [bilinear, bilateral, fine];
         let psnr = images.clone().map(|i| psnr_rgba8(&i, &reference));
         let ssim = images.clone().map(|i| ssim_rgba8(&i, &reference, w));
@@ -127,29 +128,29 @@ pub fn measure_upsampling(
     // Whole frames, interleaved round by round: full-res shading against a full-res geometry
     // prepass (with the cheap albedo) + low-res shading + upsample, and against the fine-grained
     // route (low-res lighting + full-res albedo, which writes the geometry too, + upsample).
-    let prepass = LowResBuffer::new(gpu, w, h, format);
-    let time = |f: &dyn Fn()| {
+    let prepass = LowResBuffer::new(gpu, w, h, format)?;
+    let time = |f: &dyn Fn() -> Result<(), GpuError>| {
         wall_ms(&|| {
-            f();
-            gpu.wait_idle();
+            f()?;
+            gpu.wait_idle()
         })
     };
     let mut base = Vec::new();
     let mut times = vec![[Vec::new(), Vec::new()]; RESIZE_FACTORS.len()];
     for round in 0..rounds + 2 {
-        let t0 = time(&|| scene.render(gpu, &full, 1.0));
+        let t0 = time(&|| scene.render(gpu, &full, 1.0))?;
         let mut ts = Vec::new();
         for &r in &RESIZE_FACTORS {
             let a = time(&|| {
-                scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo);
-                scene.render(gpu, &low, r);
-                upsample_with(r, prepass.geometry(), SIGMA_Z, SIGMA_N);
-            });
+                scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo)?;
+                scene.render(gpu, &low, r)?;
+                upsample_with(r, prepass.geometry(), SIGMA_Z, SIGMA_N)
+            })?;
             let b = time(&|| {
-                scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo);
-                scene.render_term(gpu, &low, r, ShadingTerm::Lighting);
-                upsample_with(r, albedo.geometry(), SIGMA_Z, SIGMA_N);
-            });
+                scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
+                scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
+                upsample_with(r, albedo.geometry(), SIGMA_Z, SIGMA_N)
+            })?;
             ts.push([a, b]);
         }
         if round >= 2 {

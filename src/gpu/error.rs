@@ -1,0 +1,337 @@
+//! The one error type of `lodkit::gpu`, and the checks every allocating call runs against the
+//! device's limits and format capabilities before wgpu would see the request.
+//!
+//! Rule for sizes: a width or height of 0 is taken as 1 (so a minimized window keeps working);
+//! the object's `size()` reports the size it really has. A side larger than
+//! `Limits::max_texture_dimension_2d` is [`GpuError::TooLarge`]. docs/errors.md lists every
+//! error a host call can return and what an engine does about it.
+
+use crate::shaders::ShaderError;
+
+use super::GpuContext;
+
+/// Everything a call in `lodkit::gpu` can fail with.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum GpuError {
+    /// No adapter on any backend that was tried.
+    #[error(
+        "no GPU adapter found (tried: {tried}). On Debian/Ubuntu, `apt-get install \
+         mesa-vulkan-drivers libvulkan1` gives a software Vulkan device (lavapipe)"
+    )]
+    NoAdapter {
+        /// The backends that were tried, in order.
+        tried: String,
+    },
+    /// `LODKIT_BACKEND` names no backend wgpu knows.
+    #[error("LODKIT_BACKEND=`{0}` is not a backend (expected vulkan, gl, metal, dx12)")]
+    UnknownBackend(String),
+    /// The adapter refused to create a device.
+    #[error("the adapter `{adapter}` could not create a device: {source}")]
+    RequestDevice {
+        /// Adapter name.
+        adapter: String,
+        /// wgpu's reason.
+        #[source]
+        source: wgpu::RequestDeviceError,
+    },
+    /// A size is larger than the device allows.
+    #[error("{call}: {parameter} = {value} is larger than the device allows ({limit} = {max})")]
+    TooLarge {
+        /// The lodkit call, e.g. `LodBuffers::new`.
+        call: &'static str,
+        /// The parameter, e.g. `width`.
+        parameter: &'static str,
+        /// The value asked for.
+        value: u64,
+        /// The limit it was checked against, e.g. `max_texture_dimension_2d`.
+        limit: &'static str,
+        /// The device's value of that limit.
+        max: u64,
+    },
+    /// A texture format the call cannot use on this device.
+    #[error("{call}: {parameter} = {format:?} cannot be used: {reason}")]
+    UnsupportedFormat {
+        /// The lodkit call.
+        call: &'static str,
+        /// The parameter.
+        parameter: &'static str,
+        /// The format given.
+        format: wgpu::TextureFormat,
+        /// Why not.
+        reason: String,
+    },
+    /// An input that does not match what the object was built for, or another input.
+    #[error("{call}: {parameter} is {found}, but {expected}")]
+    Mismatch {
+        /// The lodkit call.
+        call: &'static str,
+        /// The parameter.
+        parameter: &'static str,
+        /// What was given.
+        found: String,
+        /// What was expected and why, e.g. `the pass was built for Rgba8Unorm`.
+        expected: String,
+    },
+    /// A parameter outside its domain (not a size).
+    #[error("{call}: {parameter} = {value} {rule}")]
+    Invalid {
+        /// The lodkit call.
+        call: &'static str,
+        /// The parameter.
+        parameter: &'static str,
+        /// The value given.
+        value: String,
+        /// The rule it breaks, e.g. `must be finite and positive`.
+        rule: &'static str,
+    },
+    /// wgpu rejected work of this call (caught by an error scope).
+    #[error("{call}: wgpu validation error: {description}")]
+    Validation {
+        /// The lodkit call.
+        call: &'static str,
+        /// wgpu's description.
+        description: String,
+    },
+    /// The device ran out of memory during this call.
+    #[error("{call}: out of GPU memory: {description}")]
+    OutOfMemory {
+        /// The lodkit call.
+        call: &'static str,
+        /// wgpu's description.
+        description: String,
+    },
+    /// An internal error of wgpu or the driver during this call.
+    #[error("{call}: internal GPU error: {description}")]
+    Internal {
+        /// The lodkit call.
+        call: &'static str,
+        /// wgpu's description.
+        description: String,
+    },
+    /// wgpu reported errors outside any lodkit call (the engine's own work on the device, or a
+    /// submission lodkit did not make); the context's handler recorded them and this is the
+    /// first lodkit call since.
+    #[error(
+        "{call}: wgpu reported {count} error(s) outside lodkit's calls since the last one; the \
+         first: {first}"
+    )]
+    Uncaptured {
+        /// The lodkit call that found them.
+        call: &'static str,
+        /// How many were recorded.
+        count: usize,
+        /// The first one's description.
+        first: String,
+    },
+    /// The device is lost (driver reset, `Device::destroy`, GPU removed). Every object made
+    /// from the context is dead: recreate the [`GpuContext`] and the lodkit objects.
+    #[error(
+        "{call}: the GPU device was lost ({reason}: {message}); create a new GpuContext and \
+         rebuild the lodkit objects made from the old one"
+    )]
+    DeviceLost {
+        /// The lodkit call that found it.
+        call: &'static str,
+        /// wgpu's reason (`Destroyed` or `Unknown`).
+        reason: String,
+        /// wgpu's message.
+        message: String,
+    },
+    /// Copying data back to the CPU failed.
+    #[error("{call}: reading back from the GPU failed: {reason}")]
+    Readback {
+        /// The lodkit call.
+        call: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// A lodkit pass did not compose or validate.
+    #[error(transparent)]
+    Shader(#[from] ShaderError),
+}
+
+impl GpuError {
+    /// Whether the device is lost: the caller must rebuild the context and its objects.
+    pub fn is_device_lost(&self) -> bool {
+        matches!(self, Self::DeviceLost { .. })
+    }
+
+    /// The error for a wgpu error caught while running `call`.
+    pub(crate) fn from_wgpu(call: &'static str, error: wgpu::Error) -> Self {
+        match error {
+            wgpu::Error::OutOfMemory { source } => Self::OutOfMemory {
+                call,
+                description: source.to_string(),
+            },
+            wgpu::Error::Validation { description, .. } => Self::Validation { call, description },
+            wgpu::Error::Internal { description, .. } => Self::Internal { call, description },
+        }
+    }
+}
+
+/// `width` and `height` with 0 taken as 1, checked against `max_texture_dimension_2d`.
+pub(crate) fn texture_extent(
+    gpu: &GpuContext,
+    call: &'static str,
+    width: u32,
+    height: u32,
+) -> Result<(u32, u32), GpuError> {
+    let max = gpu.device.limits().max_texture_dimension_2d;
+    for (parameter, value) in [("width", width), ("height", height)] {
+        if value > max {
+            return Err(GpuError::TooLarge {
+                call,
+                parameter,
+                value: value.into(),
+                limit: "max_texture_dimension_2d",
+                max: max.into(),
+            });
+        }
+    }
+    Ok((width.max(1), height.max(1)))
+}
+
+/// Checks a buffer of `bytes` bytes against `max_buffer_size`.
+pub(crate) fn buffer_size(
+    gpu: &GpuContext,
+    call: &'static str,
+    parameter: &'static str,
+    bytes: u64,
+) -> Result<(), GpuError> {
+    let max = gpu.device.limits().max_buffer_size;
+    if bytes > max {
+        return Err(GpuError::TooLarge {
+            call,
+            parameter,
+            value: bytes,
+            limit: "max_buffer_size",
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// Checks that `format` is a floating-point color format (what lodkit's passes read and write
+/// as `vec4<f32>`) that the device allows with `usages`.
+pub(crate) fn check_color_format(
+    gpu: &GpuContext,
+    call: &'static str,
+    parameter: &'static str,
+    format: wgpu::TextureFormat,
+    usages: wgpu::TextureUsages,
+) -> Result<(), GpuError> {
+    let unsupported = |reason: String| GpuError::UnsupportedFormat {
+        call,
+        parameter,
+        format,
+        reason,
+    };
+    if format.is_depth_stencil_format() {
+        return Err(unsupported(
+            "it is a depth/stencil format; a color format is needed".into(),
+        ));
+    }
+    if !matches!(
+        format.sample_type(None, None),
+        Some(wgpu::TextureSampleType::Float { .. })
+    ) {
+        return Err(unsupported(
+            "its texels are integers; lodkit's passes read and write floating-point color".into(),
+        ));
+    }
+    let missing_features = format.required_features() - gpu.device.features();
+    if !missing_features.is_empty() {
+        return Err(unsupported(format!(
+            "it needs device features {missing_features:?}"
+        )));
+    }
+    let allowed = gpu.format_features(format).allowed_usages;
+    if !allowed.contains(usages) {
+        return Err(unsupported(format!(
+            "the device does not allow it as {:?}",
+            usages - allowed
+        )));
+    }
+    Ok(())
+}
+
+/// Checks that `texture` is 2D, `size` and of `format`, naming `what` expected it.
+pub(crate) fn texture_matches(
+    call: &'static str,
+    parameter: &'static str,
+    texture: &wgpu::Texture,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    what: &str,
+) -> Result<(), GpuError> {
+    if texture.format() != format {
+        return Err(GpuError::Mismatch {
+            call,
+            parameter,
+            found: format!("{:?}", texture.format()),
+            expected: format!("{what} needs {format:?}"),
+        });
+    }
+    let found = (texture.width(), texture.height());
+    if found != size {
+        return Err(GpuError::Mismatch {
+            call,
+            parameter,
+            found: format!("{} x {}", found.0, found.1),
+            expected: format!("{what} is {} x {}", size.0, size.1),
+        });
+    }
+    Ok(())
+}
+
+/// The size of a target of `width` x `height` in `color_format` for `usages` (see
+/// [`texture_extent`] and [`check_color_format`]).
+pub(crate) fn target_extent(
+    gpu: &GpuContext,
+    call: &'static str,
+    (width, height): (u32, u32),
+    color_format: wgpu::TextureFormat,
+    usages: wgpu::TextureUsages,
+) -> Result<(u32, u32), GpuError> {
+    let size = texture_extent(gpu, call, width, height)?;
+    check_color_format(gpu, call, "color_format", color_format, usages)?;
+    Ok(size)
+}
+
+/// Checks that `parameter` has the color format `built_for` that a renderer was built for.
+pub(crate) fn same_color_format(
+    call: &'static str,
+    parameter: &'static str,
+    found: wgpu::TextureFormat,
+    built_for: wgpu::TextureFormat,
+) -> Result<(), GpuError> {
+    if found == built_for {
+        return Ok(());
+    }
+    Err(GpuError::Mismatch {
+        call,
+        parameter,
+        found: format!("of color format {found:?}"),
+        expected: format!("the renderer was built for {built_for:?}"),
+    })
+}
+
+/// Checks that a resource with `usage` has the flag `needed` (`contains` says whether it does).
+pub(crate) fn has_usage<U: std::fmt::Debug>(
+    call: &'static str,
+    parameter: &'static str,
+    usage: U,
+    contains: bool,
+    needed: &str,
+) -> Result<(), GpuError> {
+    if contains {
+        return Ok(());
+    }
+    Err(GpuError::Mismatch {
+        call,
+        parameter,
+        found: format!("{usage:?}"),
+        expected: format!("this needs {needed}"),
+    })
+}
