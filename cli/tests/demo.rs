@@ -275,6 +275,21 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             "{doc}"
         );
     }
+    // Every picture a guide in docs/ shows is one the demo writes with --docs.
+    let guides = crate::support::workspace_root().join("docs");
+    for guide in std::fs::read_dir(&guides).unwrap().flatten() {
+        let text = std::fs::read_to_string(guide.path()).unwrap_or_default();
+        for picture in text.split("](img/").skip(1) {
+            let name = &picture[..picture.find(')').unwrap()];
+            let written = out.join("docs/img").join(name);
+            let size = std::fs::metadata(&written).map_or(0, |m| m.len());
+            assert!(
+                size > 1000,
+                "{:?} shows img/{name}, which --docs did not write",
+                guide.path()
+            );
+        }
+    }
     let Some(mut page) = browser_script("page.mjs") else {
         return;
     };

@@ -11,6 +11,7 @@
 //! ```
 
 pub mod cpu;
+pub mod doc_pictures;
 pub mod plots;
 pub mod render;
 pub mod report;
@@ -337,6 +338,7 @@ pub fn run_on(
     report::write_report(&report, out)?;
     if let Some(docs) = &options.docs {
         report::write_docs(&report, docs)?;
+        doc_pictures::write_doc_pictures(&report, out, docs)?;
     }
     bar.inc(1);
     bar.finish_and_clear();
