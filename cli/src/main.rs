@@ -117,9 +117,13 @@ enum Command {
         /// Interleaved pairs per pass-time ratio (a quarter of it: whole-frame timing rounds).
         #[arg(long, default_value_t = 40)]
         pairs: usize,
-        /// Also write benchmarks.md and quality.md into this folder (e.g. `docs`).
+        /// Also write benchmarks.md, quality.md and the guides' pictures into this folder
+        /// (e.g. `docs`).
         #[arg(long, value_name = "DIR")]
         docs: Option<PathBuf>,
+        /// Size of the framebuffer-LOD frame-cost and closed-loop measurements.
+        #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
+        fb_size: (u32, u32),
     },
     /// Compose a shader and write it through one of naga's back ends.
     Export {
@@ -254,6 +258,7 @@ fn main() -> ExitCode {
             scene,
             pairs,
             docs,
+            fb_size,
         } => demo(lodkit_cli::demo::DemoOptions {
             out,
             size,
@@ -261,6 +266,7 @@ fn main() -> ExitCode {
             scene,
             timing_pairs: pairs,
             docs,
+            fb_size,
             progress: true,
         }),
         Command::Modules { format } => modules(format),

@@ -193,6 +193,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
         scene: None,
         timing_pairs: 3,
         docs: Some(out.join("docs")),
+        fb_size: (128, 72),
         progress: false,
     };
     let scenes = DemoScene::built_in();
@@ -256,6 +257,34 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             .unwrap_or(f32::INFINITY)
     };
     assert!(settle("lodkit") < settle("paper"));
+
+    // Framebuffer LOD at --fb-size: every pass of every configuration timed, the sweep's shading
+    // work really costs (the full-resolution frame at the largest work is slower than without),
+    // and each controller ran the whole closed loop.
+    let cost = &report.frame_cost;
+    assert_eq!(cost.breakdown.len(), 1 + 2 * 4);
+    assert!(
+        cost.breakdown[1..]
+            .iter()
+            .all(|p| p.ms.iter().all(|t| *t > 0.0))
+    );
+    let (first, last) = (&cost.sweep[0], cost.sweep.last().unwrap());
+    assert!(
+        last.full_ms > 2.0 * first.full_ms,
+        "{:?} vs {:?}",
+        last,
+        first
+    );
+    let closed = &report.closed_loop;
+    assert_eq!(closed.runs.len(), 3);
+    for run in &closed.runs {
+        assert_eq!(run.ms.len(), lodkit_cli::demo::closed_loop::FRAMES);
+        assert!(
+            run.r.iter().all(|r| (1.0..=4.0).contains(r)),
+            "{}",
+            run.name
+        );
+    }
 
     // Every image the page refers to exists, and the generated docs name the adapter.
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();

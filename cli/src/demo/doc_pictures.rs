@@ -1,6 +1,7 @@
 //! The pictures the technique guides show (`docs/img/`), cut from this run's output so that
 //! `lodkit demo --docs docs` keeps them in step with the code: a strip of each transition
-//! technique, the framebuffer-LOD comparison at r = 2, and the controller plot.
+//! technique, the framebuffer-LOD comparison at r = 2, the controller plots, the frame-cost
+//! breakdown and the shading-cost sweep.
 
 use std::path::Path;
 
@@ -48,6 +49,14 @@ pub fn write_doc_pictures(report: &DemoReport, out: &Path, docs: &Path) -> Resul
         &open(&out.join("upsample/r2.png"))?,
         &img.join("framebuffer-lod.png"),
     )?;
-    let controllers = open(&out.join("plots/controllers.png"))?;
-    save(&controllers, &img.join("framerate-control.png"))
+    for (plot, name) in [
+        ("controllers", "framerate-control"),
+        ("frame-breakdown", "frame-breakdown"),
+        ("speedup-vs-shading", "speedup-vs-shading"),
+        ("closed-loop-ms", "closed-loop-ms"),
+    ] {
+        let picture = open(&out.join("plots").join(format!("{plot}.png")))?;
+        save(&picture, &img.join(format!("{name}.png")))?;
+    }
+    Ok(())
 }

@@ -10,11 +10,14 @@
 //! # Ok::<(), lodkit_cli::demo::DemoError>(())
 //! ```
 
+pub mod closed_loop;
 pub mod cpu;
 pub mod doc_pictures;
+pub mod frame_cost;
 pub mod plots;
 pub mod render;
 pub mod report;
+pub mod report_fb;
 pub mod scene;
 pub mod timing;
 pub mod transitions;
@@ -42,8 +45,12 @@ pub struct DemoOptions {
     /// Interleaved pairs per pass-time ratio (1..=10000); a quarter of it (at least 3) is the
     /// number of rounds of whole-frame timing.
     pub timing_pairs: usize,
-    /// Folder to write `benchmarks.md` and `quality.md` into.
+    /// Folder to write `benchmarks.md`, `quality.md` and the guides' pictures (`img/`) into.
     pub docs: Option<PathBuf>,
+    /// Size of the framebuffer-LOD frame-cost breakdown, shading-cost sweep and closed-loop
+    /// controller runs (64..=4096 each way; default 1280x720, where a pass is not dominated by
+    /// submission overhead).
+    pub fb_size: (u32, u32),
     /// Show a progress bar on the terminal.
     pub progress: bool,
 }
@@ -52,8 +59,13 @@ impl DemoOptions {
     /// The `lodkit demo` command line that runs these options.
     pub fn command_line(&self) -> String {
         let mut s = format!(
-            "lodkit demo --size {}x{} --frames {} --pairs {}",
-            self.size.0, self.size.1, self.frames, self.timing_pairs
+            "lodkit demo --size {}x{} --frames {} --pairs {} --fb-size {}x{}",
+            self.size.0,
+            self.size.1,
+            self.frames,
+            self.timing_pairs,
+            self.fb_size.0,
+            self.fb_size.1
         );
         if let Some(scene) = &self.scene {
             s.push_str(&format!(" --scene {}", scene.display()));
@@ -74,6 +86,7 @@ impl Default for DemoOptions {
             scene: None,
             timing_pairs: 40,
             docs: None,
+            fb_size: (1280, 720),
             progress: true,
         }
     }
@@ -166,7 +179,11 @@ pub struct DemoReport {
     pub upsampling: Vec<upsampling::UpsampleRow>,
     /// Pass time ratios.
     pub pass_ratios: Vec<timing::PassRatio>,
-    /// Framerate controllers.
+    /// Framebuffer LOD: where a frame's time goes, and the speed-up against shading cost.
+    pub frame_cost: frame_cost::FrameCost,
+    /// Framebuffer LOD: the controllers on the real frame.
+    pub closed_loop: closed_loop::ClosedLoop,
+    /// Framerate controllers (simulated).
     pub controllers: Vec<upsampling::ControllerRow>,
     /// Host-side figures (composition, selection).
     pub cpu: Vec<cpu::CpuFigure>,
@@ -180,12 +197,14 @@ pub struct DemoReport {
 pub const MAX_FRAME_MEMORY_MIB: u64 = 2048;
 
 fn check_options(o: &DemoOptions) -> Result<(), DemoError> {
-    let (w, h) = o.size;
-    if !(64..=4096).contains(&w) || !(64..=4096).contains(&h) {
-        return Err(DemoError::Options(format!(
-            "--size {w}x{h}: each side must be within 64..=4096"
-        )));
+    for (flag, (w, h)) in [("--size", o.size), ("--fb-size", o.fb_size)] {
+        if !(64..=4096).contains(&w) || !(64..=4096).contains(&h) {
+            return Err(DemoError::Options(format!(
+                "{flag} {w}x{h}: each side must be within 64..=4096"
+            )));
+        }
     }
+    let (w, h) = o.size;
     if !(4..=600).contains(&o.frames) {
         return Err(DemoError::Options(format!(
             "--frames {}: must be within 4..=600",
@@ -259,7 +278,7 @@ pub fn run_on(
     let start = std::time::Instant::now();
     let out = &options.out;
     std::fs::create_dir_all(out).map_err(|e| DemoError::io(out, e))?;
-    let steps = scenes.len() * render::Technique::ALL.len() + upsampling::RESIZE_FACTORS.len() + 4;
+    let steps = scenes.len() * render::Technique::ALL.len() + upsampling::RESIZE_FACTORS.len() + 6;
     let bar = if options.progress {
         indicatif::ProgressBar::new(steps as u64)
     } else {
@@ -300,6 +319,12 @@ pub fn run_on(
     };
     let rounds = (options.timing_pairs / 4).max(3);
     let upsampling = upsampling::measure_upsampling(gpu, options.size, rounds, out, &mut tick)?;
+    bar.set_message("framebuffer LOD: frame cost and shading sweep");
+    let frame_cost = frame_cost::measure_frame_cost(gpu, options.fb_size, rounds)?;
+    bar.inc(1);
+    bar.set_message("framebuffer LOD: controllers on the real frame");
+    let closed_loop = closed_loop::measure_closed_loop(gpu, options.fb_size)?;
+    bar.inc(1);
     bar.set_message("pass time ratios");
     let pass_ratios = vec![
         timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?,
@@ -327,6 +352,8 @@ pub fn run_on(
         transitions,
         upsampling,
         pass_ratios,
+        frame_cost,
+        closed_loop,
         controllers,
         cpu,
         plot_text: plots::plot_font().is_some(),
@@ -334,6 +361,7 @@ pub fn run_on(
     };
     bar.set_message("plots and report");
     report::write_plots(&report, out)?;
+    report_fb::write_plots(&report, out)?;
     report.seconds = start.elapsed().as_secs_f64();
     report::write_report(&report, out)?;
     if let Some(docs) = &options.docs {

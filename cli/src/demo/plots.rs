@@ -1,4 +1,4 @@
-//! PNG line plots (plotters) for the report. Text needs a TrueType font: `LODKIT_FONT` names
+//! PNG line plots and stacked bar charts (plotters) for the report. Text needs a TrueType font: `LODKIT_FONT` names
 //! one, else common system fonts are tried; without any, plots are drawn without text (the
 //! report's tables carry the same figures).
 
@@ -142,6 +142,92 @@ pub fn line_chart(path: &Path, chart: &Chart) -> Result<(), DemoError> {
         if chart.markers {
             ctx.draw_series(s.points.iter().map(|&p| Circle::new(p, 4, color.filled())))
                 .map_err(plot_error)?;
+        }
+    }
+    if text {
+        ctx.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.85))
+            .draw()
+            .map_err(plot_error)?;
+    }
+    root.present().map_err(plot_error)?;
+    Ok(())
+}
+
+/// A stacked bar chart: one bar per entry, its parts stacked bottom to top.
+#[derive(Clone, Debug)]
+pub struct BarChart {
+    /// Caption.
+    pub title: String,
+    /// Y axis description.
+    pub y_label: String,
+    /// Names of the parts, bottom to top (the legend).
+    pub parts: Vec<String>,
+    /// Bars: label and one value per part.
+    pub bars: Vec<(String, Vec<f32>)>,
+}
+
+/// Draws `chart` into a 900 x 420 PNG at `path`.
+pub fn stacked_bars(path: &Path, chart: &BarChart) -> Result<(), DemoError> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| DemoError::io(dir, e))?;
+    }
+    let text = plot_font().is_some();
+    let top = chart
+        .bars
+        .iter()
+        .map(|(_, v)| v.iter().filter(|x| x.is_finite()).sum::<f32>())
+        .fold(0.0f32, f32::max)
+        .max(1e-3)
+        * 1.1;
+    let n = chart.bars.len().max(1) as f32;
+    let root = BitMapBackend::new(path, (900, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(plot_error)?;
+    let mut builder = ChartBuilder::on(&root);
+    builder.margin(14);
+    if text {
+        builder
+            .caption(&chart.title, ("sans-serif", 20))
+            .x_label_area_size(40)
+            .y_label_area_size(60);
+    }
+    let mut ctx = builder
+        .build_cartesian_2d(0f32..n, 0f32..top)
+        .map_err(plot_error)?;
+    let mut mesh = ctx.configure_mesh();
+    mesh.disable_x_mesh();
+    let label_of = |x: &f32| {
+        let i = (*x - 0.5).round();
+        let near = (*x - 0.5 - i).abs() < 0.05 && i >= 0.0;
+        chart
+            .bars
+            .get(i as usize)
+            .filter(|_| near)
+            .map_or(String::new(), |b| b.0.clone())
+    };
+    if text {
+        mesh.y_desc(&chart.y_label)
+            .x_labels(chart.bars.len() * 2 + 1)
+            .x_label_formatter(&label_of);
+    } else {
+        mesh.x_labels(0).y_labels(0);
+    }
+    mesh.draw().map_err(plot_error)?;
+    for (k, part) in chart.parts.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let rects = chart.bars.iter().enumerate().map(|(i, (_, v))| {
+            let below: f32 = v[..k.min(v.len())].iter().filter(|x| x.is_finite()).sum();
+            let h = v.get(k).copied().filter(|x| x.is_finite()).unwrap_or(0.0);
+            let x = i as f32;
+            Rectangle::new([(x + 0.15, below), (x + 0.85, below + h)], color.filled())
+        });
+        let drawn = ctx.draw_series(rects).map_err(plot_error)?;
+        if text {
+            drawn.label(part.clone()).legend(move |(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 14, y + 5)], color.filled())
+            });
         }
     }
     if text {

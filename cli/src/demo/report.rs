@@ -137,13 +137,15 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
 }
 
 /// A table of the report, written as Markdown (docs) or HTML (`index.html`).
-struct Table {
-    header: &'static [&'static str],
-    rows: Vec<Vec<String>>,
+pub(super) struct Table {
+    /// Column titles.
+    pub(super) header: &'static [&'static str],
+    /// Cells, row by row.
+    pub(super) rows: Vec<Vec<String>>,
 }
 
 impl Table {
-    fn markdown(&self) -> String {
+    pub(super) fn markdown(&self) -> String {
         let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
         let header: Vec<String> = self.header.iter().map(|h| h.to_string()).collect();
         let mut s = line(&header);
@@ -154,7 +156,7 @@ impl Table {
         s
     }
 
-    fn html(&self) -> String {
+    pub(super) fn html(&self) -> String {
         let mut s = String::from("<table>\n<tr>");
         for h in self.header {
             let _ = write!(s, "<th>{}</th>", esc(h));
@@ -375,6 +377,7 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
         "target {TARGET_MS} ms, workload doubling at frame 60; medians over {CONTROLLER_SEEDS} seeds.\n"
     );
     q.push_str(&controller_table(report).markdown());
+    q.push_str(&super::report_fb::quality_markdown(report));
     write(&docs.join("quality.md"), &q)?;
     let mut b = header(report, "Benchmarks");
     b.push_str("\n## Cost of a transition\n\nTriangles submitted and fragments counted over the transition's frames, static camera. Frame-sequential adds one fullscreen combine pass (one fragment per pixel, included).\n");
@@ -387,6 +390,7 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
         "Median wall time of a full-resolution frame over a framebuffer-LOD frame: the full-resolution geometry prepass the upsampling needs (depth and normals, with the cheap albedo), the low-res shading pass and the upsample pass (fine-grained: the low-res lighting pass, the full-resolution albedo pass that also writes the geometry, and the upsample). Edge scene with {SHADING_WORK} sky directions of shading work per fragment.\n"
     );
     b.push_str(&speed_table(report).markdown());
+    b.push_str(&super::report_fb::benchmarks_markdown(report));
     b.push_str("\n## Host side (CPU)\n\nMedians of repeated runs in the same process (the machine's CPU, not the GPU). The criterion benches measure the same workloads more thoroughly: `cargo bench -p lodkit-cli --bench compose`, `cargo bench -p lodkit-cli --bench select`; `cargo bench -p lodkit-cli --bench combine` and `--bench upsample` print the pass ratios above on their own.\n\n");
     b.push_str(&cpu_table(report).markdown());
     write(&docs.join("benchmarks.md"), &b)
@@ -476,6 +480,7 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
             ),
         ));
     }
+    h.push_str(&super::report_fb::html(report));
     h.push_str("<h2>Pass time ratios</h2>\n");
     h.push_str(&ratio_table(report).html());
     h.push_str("<h2>Host side (CPU)</h2>\n");

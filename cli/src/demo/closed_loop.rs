@@ -1,0 +1,284 @@
+//! The resize controllers on the real framebuffer-LOD frame: each frame (prepass, low-resolution
+//! shading at the controller's r, upsample) is rendered and timed, the controller gets the
+//! measured time and answers the next r, and the scene's shading work doubles mid-run.
+//!
+//! Frame times are wall time around the frame's submissions and one wait. The passes submit their
+//! own command buffers, so GPU timestamp queries would need a query per submission; on a software
+//! GPU, where the GPU is the CPU, the wall time is the GPU time, and on a real GPU it adds the
+//! submission overhead the frame pays anyway.
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::DemoError;
+use super::plots::{Chart, Series, line_chart};
+use super::report::Table;
+use super::upsampling::{SIGMA_N, SIGMA_Z};
+use lodkit::framebuffer_lod::{
+    PaperController, ResizeController, ResizeLimits, RlsController, SimulatedFrame, StepController,
+    step_response,
+};
+use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
+use lodkit::gpu::resources::texture_2d;
+use lodkit::gpu::{GpuContext, GpuError};
+
+/// Shading work before the step (sky directions per fragment); it doubles at [`STEP_FRAME`].
+pub const BASE_WORK: u32 = 64;
+/// Frame at which the shading work doubles.
+pub const STEP_FRAME: usize = 30;
+/// Frames per run.
+pub const FRAMES: usize = 75;
+/// Settling band: within this fraction of the target.
+pub const BAND: f32 = 0.10;
+/// Resize factor whose frame time (measured before the runs) is the target.
+pub const TARGET_R: f32 = 1.6;
+/// Frames in the median that stands for the noise-free frame time (centred on the frame).
+pub const SMOOTHING: usize = 5;
+/// Frames timed to calibrate the target, K and the noise.
+const CALIBRATION: usize = 9;
+
+/// One controller's run.
+#[derive(Clone, Debug, Serialize)]
+pub struct ClosedLoopRun {
+    /// Controller.
+    pub name: String,
+    /// Frames after the step until the frame time (median of [`SMOOTHING`] consecutive
+    /// frames) stays within [`BAND`] of the target for the rest of the run (`None`: never).
+    pub settling_frames: Option<usize>,
+    /// Share of single frames after settling within [`BAND`] of the target (noise included).
+    pub frames_within: f32,
+    /// Largest drop of that time below the target after the step (fraction of the target).
+    pub overshoot: f32,
+    /// Standard deviation of the measured time over the last half after the step (fraction).
+    pub spread: f32,
+    /// Measured frame times (ms).
+    pub ms: Vec<f32>,
+    /// r of each frame.
+    pub r: Vec<f32>,
+}
+
+/// The closed-loop measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct ClosedLoop {
+    /// Image size.
+    pub size: (u32, u32),
+    /// Target frame time (ms): the measured frame at [`TARGET_R`] before the step.
+    pub target_ms: f32,
+    /// K calibrated for the paper's controller (ms per unit of 1/r^2).
+    pub paper_k: f32,
+    /// Relative standard deviation of the calibration frames at [`TARGET_R`]: the noise lodkit's
+    /// controller is told to expect.
+    pub noise: f32,
+    /// The runs.
+    pub runs: Vec<ClosedLoopRun>,
+}
+
+/// Runs lodkit's controller, the paper's and the step heuristic on the edge scene at `size`.
+pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedLoop, DemoError> {
+    let (w, h) = size;
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let mut scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
+    let low = LowResBuffer::new(gpu, w, h, format)?;
+    let prepass = LowResBuffer::new(gpu, w, h, format)?;
+    let upsample = UpsamplePass::new(gpu, format)?;
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+    let view = texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default());
+    let frame = |scene: &EdgeScene, r: f32| -> Result<f32, GpuError> {
+        let start = Instant::now();
+        scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo)?;
+        scene.render_term(gpu, &low, r, ShadingTerm::Full)?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let g = prepass.geometry();
+        upsample.encode(gpu, &mut encoder, &low, r, g, SIGMA_Z, SIGMA_N, &view)?;
+        gpu.queue.submit([encoder.finish()]);
+        gpu.wait_idle()?;
+        Ok(start.elapsed().as_secs_f32() * 1e3)
+    };
+    let times = |scene: &EdgeScene, r: f32| -> Result<Vec<f32>, GpuError> {
+        let mut t = (0..CALIBRATION)
+            .map(|_| frame(scene, r))
+            .collect::<Result<Vec<_>, _>>()?;
+        t.sort_by(f32::total_cmp);
+        Ok(t)
+    };
+    scene.set_shading_work(BASE_WORK);
+    frame(&scene, 1.0)?;
+    let at_target = times(&scene, TARGET_R)?;
+    let target_ms = at_target[CALIBRATION / 2];
+    let mean = at_target.iter().sum::<f32>() / CALIBRATION as f32;
+    let variance = at_target.iter().map(|t| (t - mean).powi(2)).sum::<f32>() / CALIBRATION as f32;
+    let noise = (variance.sqrt() / mean).clamp(0.01, 0.2);
+    // The paper calibrates K once: t(1) - t(2) = K (1 - 1/4).
+    let (t1, t2) = (times(&scene, 1.0)?, times(&scene, 2.0)?);
+    let paper_k = ((t1[CALIBRATION / 2] - t2[CALIBRATION / 2]) / 0.75).max(1e-3);
+    let limits = ResizeLimits::default();
+    let mut lodkit = RlsController::new(target_ms, limits);
+    lodkit.noise = noise;
+    let controllers: [(&str, Box<dyn ResizeController>); 3] = [
+        ("lodkit (online K, C)", Box::new(lodkit)),
+        (
+            "paper (calibrated K)",
+            Box::new(PaperController::new(target_ms, paper_k, limits)),
+        ),
+        (
+            "step heuristic",
+            Box::new(StepController::new(target_ms, limits)),
+        ),
+    ];
+    let mut runs = Vec::new();
+    for (name, mut controller) in controllers {
+        let (mut ms, mut rs) = (Vec::new(), Vec::new());
+        for f in 0..FRAMES {
+            let work = if f < STEP_FRAME {
+                BASE_WORK
+            } else {
+                2 * BASE_WORK
+            };
+            scene.set_shading_work(work);
+            let r = controller.r();
+            let t = frame(&scene, r)?;
+            controller.update(t);
+            ms.push(t);
+            rs.push(r);
+        }
+        // The noise-free time of the simulation becomes the median of SMOOTHING frames around
+        // each frame, on the same side of the step (fewer at the ends and next to the step).
+        let frames: Vec<SimulatedFrame> = (0..FRAMES)
+            .map(|i| {
+                let half = SMOOTHING / 2;
+                let (first, end) = if i < STEP_FRAME {
+                    (0, STEP_FRAME)
+                } else {
+                    (STEP_FRAME, FRAMES)
+                };
+                let window = i.saturating_sub(half).max(first)..(i + half + 1).min(end);
+                let mut w = ms[window].to_vec();
+                w.sort_by(f32::total_cmp);
+                SimulatedFrame {
+                    r: rs[i],
+                    measured: ms[i],
+                    expected: w[w.len() / 2],
+                }
+            })
+            .collect();
+        let response = step_response(&frames, STEP_FRAME, target_ms, BAND);
+        let settled = STEP_FRAME + response.settling_frames.unwrap_or(FRAMES);
+        let tail = ms.get(settled..).unwrap_or_default();
+        let within = tail
+            .iter()
+            .filter(|t| (*t - target_ms).abs() <= BAND * target_ms)
+            .count();
+        runs.push(ClosedLoopRun {
+            name: name.to_owned(),
+            settling_frames: response.settling_frames,
+            frames_within: within as f32 / tail.len().max(1) as f32,
+            overshoot: response.overshoot,
+            spread: response.spread,
+            ms,
+            r: rs,
+        });
+    }
+    Ok(ClosedLoop {
+        size,
+        target_ms,
+        paper_k,
+        noise,
+        runs,
+    })
+}
+
+/// The runs as a table.
+pub(super) fn table(closed: &ClosedLoop) -> Table {
+    Table {
+        header: &[
+            "controller",
+            "settling frames (within 10 %)",
+            "single frames within 10 % after settling",
+            "overshoot",
+            "spread",
+            "r at the end",
+        ],
+        rows: closed
+            .runs
+            .iter()
+            .map(|run| {
+                vec![
+                    run.name.clone(),
+                    run.settling_frames
+                        .map_or("never".to_owned(), |s| s.to_string()),
+                    format!("{:.0} %", run.frames_within * 100.0),
+                    format!("{:.1} %", run.overshoot * 100.0),
+                    format!("{:.1} %", run.spread * 100.0),
+                    format!("{:.2}", run.r.last().copied().unwrap_or(f32::NAN)),
+                ]
+            })
+            .collect(),
+    }
+}
+
+/// One sentence on the setting of the runs.
+pub fn summary(closed: &ClosedLoop) -> String {
+    let (w, h) = closed.size;
+    format!(
+        "The edge scene at {w}x{h}, rendered frame by frame (prepass, low-resolution shading at \
+         the controller's r, upsample), timed as wall time around the frame's submissions and one \
+         wait. Target {:.1} ms (the frame at r = {TARGET_R} measured before the runs); the shading \
+         work doubles from {BASE_WORK} to {} sky directions at frame {STEP_FRAME}; the paper's K \
+         calibrated from frames at r = 1 and r = 2: {:.1} ms; lodkit's controller is told the \
+         noise measured in the calibration frames ({:.1} %). Settling: frames after the step until \
+         the median of {SMOOTHING} consecutive frame times stays within 10 % of the target for the \
+         rest of the run; single frames scatter around it by the noise.",
+        closed.target_ms,
+        2 * BASE_WORK,
+        closed.paper_k,
+        closed.noise * 100.0
+    )
+}
+
+/// Writes `plots/closed-loop-ms.png` and `plots/closed-loop-r.png` under `out`.
+pub fn write_plots(closed: &ClosedLoop, out: &Path) -> Result<(), DemoError> {
+    let series = |of: &dyn Fn(&ClosedLoopRun) -> &Vec<f32>| -> Vec<Series> {
+        closed
+            .runs
+            .iter()
+            .map(|run| Series {
+                name: run.name.clone(),
+                points: of(run)
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &v)| (i as f32, v))
+                    .collect(),
+            })
+            .collect()
+    };
+    let (w, h) = closed.size;
+    line_chart(
+        &out.join("plots/closed-loop-ms.png"),
+        &Chart {
+            title: format!(
+                "Measured frame time, shading work doubling at frame {STEP_FRAME} ({w}x{h})"
+            ),
+            x_label: "frame".to_owned(),
+            y_label: "ms".to_owned(),
+            series: series(&|run| &run.ms),
+            markers: false,
+            reference: Some(closed.target_ms),
+            y_from_zero: true,
+        },
+    )?;
+    line_chart(
+        &out.join("plots/closed-loop-r.png"),
+        &Chart {
+            title: "Resize factor chosen by each controller".to_owned(),
+            x_label: "frame".to_owned(),
+            y_label: "r".to_owned(),
+            series: series(&|run| &run.r),
+            markers: false,
+            reference: None,
+            y_from_zero: false,
+        },
+    )
+}
