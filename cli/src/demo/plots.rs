@@ -74,9 +74,6 @@ fn plot_error(e: impl std::fmt::Display) -> DemoError {
 
 /// Draws `chart` into a 900 x 420 PNG at `path`.
 pub fn line_chart(path: &Path, chart: &Chart) -> Result<(), DemoError> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| DemoError::io(dir, e))?;
-    }
     let text = plot_font().is_some();
     let points = chart.series.iter().flat_map(|s| s.points.iter());
     let (mut x0, mut x1, mut y0, mut y1) = (f32::MAX, f32::MIN, f32::MAX, f32::MIN);
@@ -105,19 +102,17 @@ pub fn line_chart(path: &Path, chart: &Chart) -> Result<(), DemoError> {
     let y1 = y1 + pad;
     let xpad = if chart.markers { (x1 - x0) * 0.04 } else { 0.0 };
     let (x0, x1) = (x0 - xpad, x1 + xpad);
-    let root = BitMapBackend::new(path, (900, 420)).into_drawing_area();
-    root.fill(&WHITE).map_err(plot_error)?;
-    let mut builder = ChartBuilder::on(&root);
-    builder.margin(14);
-    if text {
-        builder
-            .caption(&chart.title, ("sans-serif", 20))
-            .x_label_area_size(40)
-            .y_label_area_size(60);
-    }
-    let mut ctx = builder
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(plot_error)?;
+    with_chart(path, &chart.title, x0..x1, y0..y1, |ctx| {
+        draw_lines(ctx, chart, (x0, x1), text)
+    })
+}
+
+fn draw_lines(
+    ctx: &mut Ctx<'_>,
+    chart: &Chart,
+    (x0, x1): (f32, f32),
+    text: bool,
+) -> Result<(), DemoError> {
     let mut mesh = ctx.configure_mesh();
     if text {
         mesh.x_desc(&chart.x_label).y_desc(&chart.y_label);
@@ -144,6 +139,40 @@ pub fn line_chart(path: &Path, chart: &Chart) -> Result<(), DemoError> {
                 .map_err(plot_error)?;
         }
     }
+    Ok(())
+}
+
+type Ctx<'a> = ChartContext<
+    'a,
+    BitMapBackend<'a>,
+    Cartesian2d<plotters::coord::types::RangedCoordf32, plotters::coord::types::RangedCoordf32>,
+>;
+
+/// A 900 x 420 PNG at `path` over `x` and `y`, with `title` and a legend when a font exists;
+/// `draw` draws the mesh and the series.
+fn with_chart(
+    path: &Path,
+    title: &str,
+    x: std::ops::Range<f32>,
+    y: std::ops::Range<f32>,
+    draw: impl FnOnce(&mut Ctx<'_>) -> Result<(), DemoError>,
+) -> Result<(), DemoError> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| DemoError::io(dir, e))?;
+    }
+    let text = plot_font().is_some();
+    let root = BitMapBackend::new(path, (900, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(plot_error)?;
+    let mut builder = ChartBuilder::on(&root);
+    builder.margin(14);
+    if text {
+        builder
+            .caption(title, ("sans-serif", 20))
+            .x_label_area_size(40)
+            .y_label_area_size(60);
+    }
+    let mut ctx = builder.build_cartesian_2d(x, y).map_err(plot_error)?;
+    draw(&mut ctx)?;
     if text {
         ctx.configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
@@ -171,9 +200,6 @@ pub struct BarChart {
 
 /// Draws `chart` into a 900 x 420 PNG at `path`.
 pub fn stacked_bars(path: &Path, chart: &BarChart) -> Result<(), DemoError> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| DemoError::io(dir, e))?;
-    }
     let text = plot_font().is_some();
     let top = chart
         .bars
@@ -183,19 +209,12 @@ pub fn stacked_bars(path: &Path, chart: &BarChart) -> Result<(), DemoError> {
         .max(1e-3)
         * 1.1;
     let n = chart.bars.len().max(1) as f32;
-    let root = BitMapBackend::new(path, (900, 420)).into_drawing_area();
-    root.fill(&WHITE).map_err(plot_error)?;
-    let mut builder = ChartBuilder::on(&root);
-    builder.margin(14);
-    if text {
-        builder
-            .caption(&chart.title, ("sans-serif", 20))
-            .x_label_area_size(40)
-            .y_label_area_size(60);
-    }
-    let mut ctx = builder
-        .build_cartesian_2d(0f32..n, 0f32..top)
-        .map_err(plot_error)?;
+    with_chart(path, &chart.title, 0f32..n, 0f32..top, |ctx| {
+        draw_bars(ctx, chart, text)
+    })
+}
+
+fn draw_bars(ctx: &mut Ctx<'_>, chart: &BarChart, text: bool) -> Result<(), DemoError> {
     let mut mesh = ctx.configure_mesh();
     mesh.disable_x_mesh();
     let label_of = |x: &f32| {
@@ -230,14 +249,5 @@ pub fn stacked_bars(path: &Path, chart: &BarChart) -> Result<(), DemoError> {
             });
         }
     }
-    if text {
-        ctx.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .draw()
-            .map_err(plot_error)?;
-    }
-    root.present().map_err(plot_error)?;
     Ok(())
 }
