@@ -478,6 +478,18 @@ fn passes_given_mismatched_inputs_name_both() {
         matches!(r, Err(GpuError::UnsupportedFormat { .. })),
         "{r:?}"
     );
+    let draws = DrawUniforms::new(gpu, 16, 4, "d").unwrap();
+    mismatch(
+        draws.write(gpu, &[[0u32; 8]]).map(drop),
+        "items",
+        "32 bytes",
+        "16 bytes",
+    );
+    assert_eq!(
+        draws.write(gpu, &[[0u32; 4]; 9]).unwrap(),
+        4,
+        "the rest are dropped"
+    );
     let buffer = uniform_buffer(gpu, 16, "u").unwrap();
     mismatch(
         read_buffer(gpu, encoder(), &buffer, 32).map(drop),

@@ -176,7 +176,7 @@ impl GBufferRenderer {
                     color: i.color.to_array(),
                 })
                 .collect();
-            let n = self.draws.write(gpu, &uniforms);
+            let n = self.draws.write(gpu, &uniforms)?;
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = target.begin_pass(&mut encoder, r, clear, far_view_depth);

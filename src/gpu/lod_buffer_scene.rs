@@ -172,7 +172,7 @@ impl LodBufferRenderer {
                     pad: 0.0,
                 })
                 .collect();
-            self.draws.write(gpu, &uniforms);
+            self.draws.write(gpu, &uniforms)?;
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let mut triangles = 0u64;
             {

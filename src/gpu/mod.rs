@@ -1,7 +1,8 @@
 //! wgpu glue (feature `wgpu`): headless devices, readback, and the passes and render states of
 //! each technique.
 //!
-//! Every call here returns [`GpuError`] instead of panicking: sizes and formats are checked
+//! Every call here that creates, records, submits or reads back returns [`GpuError`] instead of
+//! panicking (the others are accessors that cannot fail): sizes and formats are checked
 //! against the device's limits before wgpu sees them, the device work of each call runs inside
 //! error scopes, and a lost device is reported by the next call (docs/errors.md).
 

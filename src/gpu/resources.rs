@@ -194,18 +194,31 @@ impl DrawUniforms {
     }
 
     /// Writes `items` (at most [`capacity`](Self::capacity); the rest are dropped) and returns
-    /// how many were written.
-    pub fn write<T: Pod>(&self, gpu: &GpuContext, items: &[T]) -> usize {
+    /// how many were written. An item larger than the item size the buffer was made for is
+    /// [`GpuError::Mismatch`].
+    pub fn write<T: Pod>(&self, gpu: &GpuContext, items: &[T]) -> Result<usize, GpuError> {
+        const CALL: &str = "DrawUniforms::write";
+        let size = std::mem::size_of::<T>();
+        if size as u64 > self.item_size {
+            return Err(GpuError::Mismatch {
+                call: CALL,
+                parameter: "items",
+                found: format!("of {size} bytes each"),
+                expected: format!("the buffer was made for items of {} bytes", self.item_size),
+            });
+        }
         let n = items.len().min(self.capacity);
         let mut data = vec![0u8; self.stride as usize * n];
-        for (i, item) in items[..n].iter().enumerate() {
-            let at = i * self.stride as usize;
-            data[at..at + std::mem::size_of::<T>()].copy_from_slice(bytemuck::bytes_of(item));
+        for (item, slot) in items[..n].iter().zip(data.chunks_mut(self.stride as usize)) {
+            slot[..size].copy_from_slice(bytemuck::bytes_of(item));
         }
         if !data.is_empty() {
-            gpu.queue.write_buffer(&self.buffer, 0, &data);
+            gpu.guarded(CALL, || {
+                gpu.queue.write_buffer(&self.buffer, 0, &data);
+                Ok(())
+            })?;
         }
-        n
+        Ok(n)
     }
 
     /// Dynamic offset of item `i`.

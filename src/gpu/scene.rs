@@ -34,9 +34,10 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    /// A unit-radius UV sphere; few segments make a coarse LOD.
+    /// A unit-radius UV sphere; few segments make a coarse LOD. Rings are clamped to 2..=2048
+    /// and segments to 3..=4096 (at most 8.4 million vertices).
     pub fn sphere(rings: u32, segments: u32) -> Self {
-        let (rings, segments) = (rings.max(2), segments.max(3));
+        let (rings, segments) = (rings.clamp(2, 2048), segments.clamp(3, 4096));
         let mut m = Mesh::default();
         for r in 0..=rings {
             let theta = PI * r as f32 / rings as f32;
@@ -342,7 +343,7 @@ impl MeshRenderer {
                     pad: [0.0; 3],
                 })
                 .collect();
-            self.draws.write(gpu, &uniforms);
+            self.draws.write(gpu, &uniforms)?;
             let color_view = target.color.create_view(&Default::default());
             let depth_view = target.depth.create_view(&Default::default());
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
