@@ -172,3 +172,105 @@ fn resizing_lod_buffers_does_not_leak_textures() {
         _ => say("this wgpu build gives no resource report; only the final size was checked"),
     }
 }
+
+/// Coverage of the object (pixels not of the clear color) in an RGBA8 image.
+fn coverage(pixels: &[u8], clear: [u8; 3]) -> usize {
+    pixels
+        .chunks(4)
+        .filter(|p| p[..3].iter().zip(clear).any(|(a, b)| a.abs_diff(b) > 3))
+        .count()
+}
+
+#[test]
+fn a_transition_may_begin_on_any_frame_without_the_object_dropping_out() {
+    let gpu = lodkit_test_gpu!();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
+    let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.25).unwrap();
+    let combine = CombinePass::new(gpu, format, false).unwrap();
+    let lods = [
+        GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap(),
+        GpuMesh::new(gpu, &Mesh::cube()).unwrap(),
+    ];
+    let colors = [Vec4::new(1.0, 0.1, 0.1, 1.0), Vec4::new(0.1, 0.2, 1.0, 1.0)];
+    let clear = wgpu::Color {
+        r: 0.0,
+        g: 0.0,
+        b: 0.0,
+        a: 1.0,
+    };
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.1, 50.0);
+    let view = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.5, 5.0), Vec3::ZERO, Vec3::Y);
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target =
+        lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, "combined").unwrap();
+    let target_view = target.create_view(&Default::default());
+    // Renders one frame of `scheduler`'s instance and returns the combined image's coverage.
+    let frame = |buffers: &LodBuffers, scheduler: &TransitionScheduler, key, first: bool| {
+        let d = scheduler.draw(key).unwrap();
+        let item = LodDrawItem {
+            mesh: &lods[usize::from(d.lod)],
+            model: Mat4::from_rotation_y(0.5),
+            color: colors[usize::from(d.lod)],
+            id: d.id,
+            tau: d.tau,
+        };
+        let index = scheduler.buffer_index();
+        let vp = proj * view;
+        renderer
+            .render(gpu, buffers, index, vp, &[item], clear, None)
+            .unwrap();
+        let m = if first {
+            CombinePass::NO_HISTORY
+        } else {
+            new_to_old_matrix(&view, &proj, &view, &proj)
+        };
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        combine
+            .encode(gpu, &mut encoder, buffers, index, m, &target_view)
+            .unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        coverage(&read_texture_rgba8(gpu, &target).unwrap(), [0, 0, 0])
+    };
+    // Each LOD alone, as an n-instance.
+    let alone = [0u8, 1].map(|lod| {
+        let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
+        let mut s = TransitionScheduler::new();
+        let key = s.insert(lod);
+        frame(&buffers, &s, key, true)
+    });
+    let floor = alone[0].min(alone[1]);
+    assert!(floor > 300, "the object covers {alone:?} pixels");
+    let mut rows = Vec::new();
+    for start in [1u64, 2, 3, 4, 5] {
+        let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
+        let mut s = TransitionScheduler::new();
+        let key = s.insert(0);
+        let mut seen = Vec::new();
+        for f in 0..start + 10 {
+            if f > 0 {
+                s.advance(1.0 / 60.0);
+            }
+            if f == start {
+                s.begin_transition(key, 1, Drive::Progress).unwrap();
+            }
+            if f >= start {
+                s.set_progress(key, ((f - start) as f32 / 6.0).min(1.0))
+                    .unwrap();
+            }
+            let covered = frame(&buffers, &s, key, f == 0);
+            assert!(
+                covered >= floor,
+                "transition begun on frame {start} (parity {}): frame {f} covers {covered} \
+                 pixels, below both LODs alone ({alone:?})",
+                start % 2
+            );
+            seen.push(covered);
+        }
+        rows.push(format!("start {start}: {seen:?}"));
+    }
+    say(&format!(
+        "object coverage per frame (LODs alone: {alone:?}):\n{}",
+        rows.join("\n")
+    ));
+}

@@ -2,8 +2,10 @@
 //!
 //! Instances are n-instances (no transition: drawn normally, id 0) or t-instances (in a
 //! transition between two LODs). A t-instance is drawn with ONE of its two LODs per frame,
-//! alternating with the frame parity: even frames draw the outgoing LOD, odd frames the incoming,
-//! each with its visibility threshold tau (Fig. 2) and the instance's id. The combine pass merges
+//! alternating with its own phase: the frame its transition begins, and every other frame after,
+//! draw the outgoing LOD, the frames between the incoming, each with its visibility threshold tau
+//! (Fig. 2) and the instance's id. A transition may begin on any frame: its first frame draws the
+//! outgoing LOD whole (tau = 1 at progress 0), so the object never drops out of the newer buffer. The combine pass merges
 //! this frame's LOD buffer with last frame's. Pure math, no wgpu.
 //!
 //! ```
@@ -79,6 +81,8 @@ struct Transition {
     id: u32,
     progress: f32,
     drive: Drive,
+    /// Frame the transition began: its phase.
+    start: u64,
 }
 
 #[derive(Clone, Debug)]
@@ -215,6 +219,7 @@ impl TransitionScheduler {
             return Ok(());
         }
         let id = self.allocate_id()?;
+        let start = self.frame;
         let slot = self.slot_mut(key)?;
         slot.transition = Some(Transition {
             from: slot.lod,
@@ -222,6 +227,7 @@ impl TransitionScheduler {
             id,
             progress: 0.0,
             drive,
+            start,
         });
         Ok(())
     }
@@ -280,7 +286,7 @@ impl TransitionScheduler {
                 incoming: false,
             },
             Some(t) => {
-                let incoming = self.frame % 2 == 1;
+                let incoming = (self.frame - t.start) % 2 == 1;
                 FrameDraw {
                     lod: if incoming { t.to } else { t.from },
                     id: t.id,
