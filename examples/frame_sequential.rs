@@ -1,0 +1,161 @@
+//! Frame-sequential LOD interpolation (Scherzer & Wimmer 2008) in a wgpu frame loop, headless:
+//! the smallest complete use of the transition scheduler, the LOD buffer pair and the combine
+//! pass. Copy the loop body into your renderer.
+//!
+//! Each frame:
+//! 1. `TransitionScheduler::advance` moves every transition on; LOD selection (hard switches
+//!    here: the scheduler does the blending) says which level each instance wants, and an
+//!    instance whose level changes begins a time-driven transition;
+//! 2. `draw(key)` gives each instance this frame's LOD, id and visibility threshold tau; the
+//!    scene goes into LOD buffer `buffer_index()` (your forward pass writes color, id and depth;
+//!    `LodBufferRenderer` is lodkit's reference for it);
+//! 3. `CombinePass` merges that buffer with last frame's, reprojected through the camera motion
+//!    (`new_to_old_matrix`), into the frame's target.
+//!
+//! `cargo run --example frame_sequential -- [--out DIR]`
+//! Writes DIR/frame_sequential.png (default DIR: lodkit-out): frames of the camera pulling back
+//! while a row of spheres turns into boxes, nearest first.
+
+use std::error::Error;
+
+use glam::{Mat4, Vec3, Vec4};
+use lodkit::frame_sequential::{Drive, TransitionScheduler};
+use lodkit::gpu::GpuContext;
+use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::readback::read_texture_rgba8;
+use lodkit::gpu::resources::texture_2d;
+use lodkit::gpu::scene::{GpuMesh, Mesh};
+use lodkit::reproject::new_to_old_matrix;
+use lodkit::select::{LodCamera, LodGroup, LodSettings, LodState, TransitionMode};
+use lodkit::visibility::{VisibilityPattern, visibility_texture};
+
+const SIZE: (u32, u32) = (240, 135);
+const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Frames of the run, at 60 frames per second.
+const FRAMES: usize = 90;
+/// Columns of the strip: frames spread evenly over the run.
+const COLUMNS: usize = 6;
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let out = std::env::args()
+        .skip_while(|a| a != "--out")
+        .nth(1)
+        .unwrap_or_else(|| "lodkit-out".into());
+    let gpu = GpuContext::new_headless(&Default::default())?;
+    println!("adapter: {}", gpu.adapter_summary());
+    let (w, h) = SIZE;
+
+    // Made once: the two LOD buffers, the pass that draws into them, the combine, the target.
+    let buffers = LodBuffers::new(&gpu, w, h, FORMAT)?;
+    let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 1);
+    let renderer = LodBufferRenderer::new(&gpu, FORMAT, &vis, 0.25)?;
+    let combine = CombinePass::new(&gpu, FORMAT, false)?;
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target = texture_2d(&gpu, SIZE, FORMAT, usage, "frame")?;
+    let target_view = target.create_view(&Default::default());
+    let lods = [
+        (
+            GpuMesh::new(&gpu, &Mesh::sphere(16, 32))?,
+            Vec4::new(0.9, 0.2, 0.15, 1.0),
+        ),
+        (
+            GpuMesh::new(&gpu, &Mesh::cube())?,
+            Vec4::new(0.15, 0.3, 0.9, 1.0),
+        ),
+    ];
+
+    // Five instances in a row going away from the camera; level 1 beyond a view-normalized
+    // distance of 2.5. Selection switches hard: the scheduler spreads each switch over 0.3 s.
+    let group = LodGroup::from_distances(&[0.0, 2.5])?;
+    let settings = LodSettings {
+        transition: TransitionMode::Hard,
+        ..Default::default()
+    };
+    let positions: Vec<Vec3> = (0..5)
+        .map(|i| Vec3::new(-1.0 + 0.9 * i as f32, 0.0, -1.6 * i as f32))
+        .collect();
+    let mut scheduler = TransitionScheduler::new();
+    let keys: Vec<_> = positions.iter().map(|_| scheduler.insert(0)).collect();
+    let mut states = vec![LodState::NEW; positions.len()];
+
+    let aspect = w as f32 / h as f32;
+    let proj = glam::camera::rh::proj::directx::perspective(0.7, aspect, 0.1, 100.0);
+    let mut previous_view: Option<Mat4> = None;
+    let mut strip = image::RgbaImage::new(w * COLUMNS as u32, h);
+    let mut transitions = 0;
+    for frame in 0..FRAMES {
+        let dt = 1.0 / 60.0;
+        if frame > 0 {
+            scheduler.advance(dt);
+        }
+        // The camera pulls back from 2 to 9 units in front of the row.
+        let eye = Vec3::new(0.0, 0.5, 2.0 + 7.0 * frame as f32 / FRAMES as f32);
+        let view = glam::camera::rh::view::look_at_mat4(eye, Vec3::new(0.0, 0.0, -3.0), Vec3::Y);
+        let camera = LodCamera::from_view(&view, proj);
+
+        // 1. Selection: begin a transition where an instance wants another level.
+        for ((key, state), &p) in keys.iter().zip(&mut states).zip(&positions) {
+            let wanted = group.select(camera.lod_distance(p, 1.0, 1.0), &settings, dt, state);
+            let draws = scheduler.draw(*key)?;
+            if !scheduler.in_transition(*key) && draws.lod != wanted.current {
+                scheduler.begin_transition(*key, wanted.current, Drive::Time { seconds: 0.3 })?;
+                transitions += 1;
+            }
+        }
+
+        // 2. The scene into this frame's LOD buffer, each instance with this frame's draw.
+        let items = keys
+            .iter()
+            .zip(&positions)
+            .map(|(key, &p)| {
+                let d = scheduler.draw(*key)?;
+                let (mesh, color) = &lods[usize::from(d.lod.min(1))];
+                Ok(LodDrawItem {
+                    mesh,
+                    model: Mat4::from_translation(p) * Mat4::from_scale(Vec3::splat(0.45)),
+                    color: *color,
+                    id: d.id,
+                    tau: d.tau,
+                })
+            })
+            .collect::<Result<Vec<_>, Box<dyn Error>>>()?;
+        let index = scheduler.buffer_index();
+        let clear = wgpu::Color {
+            r: 0.05,
+            g: 0.06,
+            b: 0.09,
+            a: 1.0,
+        };
+        renderer.render(&gpu, &buffers, index, proj * view, &items, clear, None)?;
+
+        // 3. Combine with last frame's buffer, reprojected through the camera motion.
+        let new_to_old = previous_view.map_or(CombinePass::NO_HISTORY, |old| {
+            new_to_old_matrix(&view, &proj, &old, &proj)
+        });
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        combine.encode(
+            &gpu,
+            &mut encoder,
+            &buffers,
+            index,
+            new_to_old,
+            &target_view,
+        )?;
+        gpu.queue.submit([encoder.finish()]);
+        previous_view = Some(view);
+
+        if frame % (FRAMES / COLUMNS) == FRAMES / COLUMNS - 1 {
+            let column = (frame / (FRAMES / COLUMNS)) as i64;
+            let pixels = read_texture_rgba8(&gpu, &target)?;
+            let tile = image::RgbaImage::from_raw(w, h, pixels).ok_or("tile size")?;
+            image::imageops::replace(&mut strip, &tile, i64::from(w) * column, 0);
+        }
+    }
+    println!("{transitions} transitions over {FRAMES} frames");
+    std::fs::create_dir_all(&out)?;
+    let path = std::path::Path::new(&out).join("frame_sequential.png");
+    strip.save(&path)?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
