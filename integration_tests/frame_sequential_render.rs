@@ -274,3 +274,44 @@ fn a_transition_may_begin_on_any_frame_without_the_object_dropping_out() {
         rows.join("\n")
     ));
 }
+
+#[test]
+fn a_lod_whose_tau_is_zero_is_not_submitted() {
+    let gpu = lodkit_test_gpu!();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
+    let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.25).unwrap();
+    let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
+    let sphere = GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap();
+    let cube = GpuMesh::new(gpu, &Mesh::cube()).unwrap();
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.1, 50.0);
+    let view = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.5, 5.0), Vec3::ZERO, Vec3::Y);
+    let item = |mesh, tau| LodDrawItem {
+        mesh,
+        model: Mat4::IDENTITY,
+        color: Vec4::ONE,
+        id: 7,
+        tau,
+    };
+    let render = |items: &[LodDrawItem]| {
+        let clear = wgpu::Color::BLACK;
+        let (triangles, _) = renderer
+            .render(gpu, &buffers, 0, proj * view, items, clear, None)
+            .unwrap();
+        (triangles, read_lod_image(gpu, &buffers, 0).unwrap())
+    };
+    let (alone, image) = render(&[item(&sphere, 1.0)]);
+    for tau in [0.0, -1.0, f32::NAN] {
+        let (both, with_cube) = render(&[item(&sphere, 1.0), item(&cube, tau)]);
+        assert_eq!(
+            both, alone,
+            "tau {tau}: only the sphere's triangles are submitted"
+        );
+        assert_eq!(
+            with_cube.ids, image.ids,
+            "tau {tau}: and the buffer is the same"
+        );
+    }
+    let (both, _) = render(&[item(&sphere, 1.0), item(&cube, 0.01)]);
+    assert_eq!(both, alone + 12, "a cube at tau 0.01 is drawn");
+}

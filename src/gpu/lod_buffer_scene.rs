@@ -139,7 +139,8 @@ impl LodBufferRenderer {
 
     /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers`, cleared to
     /// `clear`, counting the pass's fragments with `counter` if given. Returns the triangles
-    /// drawn and the count (0 without a counter).
+    /// drawn and the count (0 without a counter). An item whose tau is not above 0 keeps no
+    /// fragment (visibility texels lie strictly between 0 and 1), so it is not submitted.
     #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
@@ -183,7 +184,7 @@ impl LodBufferRenderer {
                 }
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.camera_group, &[]);
-                for (i, item) in items.iter().enumerate() {
+                for (i, item) in items.iter().enumerate().filter(|(_, item)| item.tau > 0.0) {
                     pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                     item.mesh.draw(&mut pass);
                     triangles += u64::from(item.mesh.triangles());
