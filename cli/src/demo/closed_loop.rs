@@ -35,7 +35,7 @@ pub const FRAMES: usize = 75;
 pub const BAND: f32 = 0.10;
 /// Resize factor whose frame time (measured before the runs) is the target.
 pub const TARGET_R: f32 = 1.6;
-/// Frames in the median that stands for the noise-free frame time (centred on the frame).
+/// Frames in the median that stands for the noise-free frame time (the frame and those before).
 pub const SMOOTHING: usize = 5;
 /// Frames timed to calibrate the target, K and the noise.
 const CALIBRATION: usize = 9;
@@ -144,17 +144,12 @@ pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedL
             ms.push(t);
             rs.push(r);
         }
-        // The noise-free time of the simulation becomes the median of SMOOTHING frames around
-        // each frame, on the same side of the step (fewer at the ends and next to the step).
+        // The noise-free time of the simulation becomes the median of the last SMOOTHING frames
+        // (what a frame-time monitor sees), not reaching back across the step.
         let frames: Vec<SimulatedFrame> = (0..FRAMES)
             .map(|i| {
-                let half = SMOOTHING / 2;
-                let (first, end) = if i < STEP_FRAME {
-                    (0, STEP_FRAME)
-                } else {
-                    (STEP_FRAME, FRAMES)
-                };
-                let window = i.saturating_sub(half).max(first)..(i + half + 1).min(end);
+                let first = if i < STEP_FRAME { 0 } else { STEP_FRAME };
+                let window = (i + 1).saturating_sub(SMOOTHING).max(first)..i + 1;
                 let mut w = ms[window].to_vec();
                 w.sort_by(f32::total_cmp);
                 SimulatedFrame {
@@ -229,7 +224,7 @@ pub fn summary(closed: &ClosedLoop) -> String {
          work doubles from {BASE_WORK} to {} sky directions at frame {STEP_FRAME}; the paper's K \
          calibrated from frames at r = 1 and r = 2: {:.1} ms; lodkit's controller is told the \
          noise measured in the calibration frames ({:.1} %). Settling: frames after the step until \
-         the median of {SMOOTHING} consecutive frame times stays within 10 % of the target for the \
+         the median of the last {SMOOTHING} frame times stays within 10 % of the target for the \
          rest of the run; single frames scatter around it by the noise.",
         closed.target_ms,
         2 * BASE_WORK,
