@@ -18,12 +18,32 @@ const H: u32 = 80;
 
 #[test]
 fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.1, 50.0);
+    combine_matches_the_cpu_rule(DepthConvention::Standard, proj);
+}
+
+#[test]
+fn reversed_z_with_an_infinite_far_plane_runs_end_to_end() {
+    // Depth 1 at the near plane, 0 at infinity: the LOD pass tests Greater and clears to 0, the
+    // combine pass is built with LODKIT_REVERSE_Z, and the CPU rule uses the same convention.
+    let proj = glam::camera::rh::proj::directx::perspective_infinite_reverse(
+        0.9,
+        W as f32 / H as f32,
+        0.1,
+    );
+    combine_matches_the_cpu_rule(DepthConvention::Reversed, proj);
+}
+
+/// Two frames of a t-instance and an n-instance through the LOD pass and the combine pass in
+/// depth convention `depth` with projection `proj`, held pixel by pixel against the CPU rule.
+fn combine_matches_the_cpu_rule(depth: DepthConvention, proj: Mat4) {
     let gpu = lodkit_test_gpu!();
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
-    let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.25).unwrap();
+    let renderer = LodBufferRenderer::with_depth(gpu, format, &vis, 0.25, depth).unwrap();
     let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
-    let combine = CombinePass::new(gpu, format, false).unwrap();
+    let reversed = depth == DepthConvention::Reversed;
+    let combine = CombinePass::new(gpu, format, reversed).unwrap();
     let sphere = GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap();
     let cube = GpuMesh::new(gpu, &Mesh::cube()).unwrap();
 
@@ -35,7 +55,6 @@ fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
         .unwrap();
     scheduler.set_progress(t_instance, 0.35).unwrap();
 
-    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.1, 50.0);
     let views = [
         glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.5, 5.0), Vec3::ZERO, Vec3::Y),
         glam::camera::rh::view::look_at_mat4(
@@ -111,7 +130,7 @@ fn combine_pass_matches_the_cpu_rule_on_two_rendered_frames() {
     let got = read_texture_rgba8(gpu, &target).unwrap();
     let newer_image = read_lod_image(gpu, &buffers, newer).unwrap();
     let older_image = read_lod_image(gpu, &buffers, 1 - newer).unwrap();
-    let want = combine_images(&newer_image, &older_image, &m, DepthConvention::Standard);
+    let want = combine_images(&newer_image, &older_image, &m, depth);
     let (mut compared, mut ambiguous) = (0, 0);
     let count = |s: PixelSource| want.iter().filter(|p| p.source == s).count();
     let (averaged, older_won, outside) = (

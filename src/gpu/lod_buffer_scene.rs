@@ -11,6 +11,7 @@ use super::resources::{
 };
 use super::scene::{CameraUniform, GpuMesh};
 use super::{GpuContext, GpuError};
+use crate::combine::DepthConvention;
 use crate::lod_buffer::ID_DEPTH_FORMAT;
 use crate::visibility::VisibilityTexture;
 
@@ -47,7 +48,7 @@ pub struct LodDrawItem<'a> {
     pub tau: f32,
 }
 
-/// Draws [`LodDrawItem`]s into one buffer of a [`LodBuffers`] pair (standard Z).
+/// Draws [`LodDrawItem`]s into one buffer of a [`LodBuffers`] pair, in standard or reversed Z.
 #[derive(Debug)]
 pub struct LodBufferRenderer {
     pipeline: wgpu::RenderPipeline,
@@ -57,6 +58,7 @@ pub struct LodBufferRenderer {
     draw_group: wgpu::BindGroup,
     vis_scale: f32,
     color_format: wgpu::TextureFormat,
+    depth: DepthConvention,
 }
 
 impl LodBufferRenderer {
@@ -64,12 +66,26 @@ impl LodBufferRenderer {
     pub const MAX_DRAWS: usize = 1024;
 
     /// Builds the pipeline for LOD buffers of color format `color_format`, with visibility
-    /// texture `vis` repeating `vis_scale` (finite, > 0) times per object-space unit.
+    /// texture `vis` repeating `vis_scale` (finite, > 0) times per object-space unit; standard Z
+    /// (depth test `Less`, cleared to 1).
     pub fn new(
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,
         vis: &VisibilityTexture,
         vis_scale: f32,
+    ) -> Result<Self, GpuError> {
+        Self::with_depth(gpu, color_format, vis, vis_scale, DepthConvention::Standard)
+    }
+
+    /// [`new`](Self::new) for the depth convention `depth`: reversed Z tests `Greater` and clears
+    /// the depth buffer and the stored depth to 0 (pair it with `CombinePass::new(.., true)` and a
+    /// reversed, possibly infinite-far, projection).
+    pub fn with_depth(
+        gpu: &GpuContext,
+        color_format: wgpu::TextureFormat,
+        vis: &VisibilityTexture,
+        vis_scale: f32,
+        depth: DepthConvention,
     ) -> Result<Self, GpuError> {
         const CALL: &str = "LodBufferRenderer::new";
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
@@ -82,7 +98,9 @@ impl LodBufferRenderer {
                 rule: "must be finite and positive",
             });
         }
-        gpu.guarded(CALL, || Self::build(gpu, color_format, vis, vis_scale))
+        gpu.guarded(CALL, || {
+            Self::build(gpu, color_format, vis, vis_scale, depth)
+        })
     }
 
     fn build(
@@ -90,6 +108,7 @@ impl LodBufferRenderer {
         color_format: wgpu::TextureFormat,
         vis: &VisibilityTexture,
         vis_scale: f32,
+        depth: DepthConvention,
     ) -> Result<Self, GpuError> {
         let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture")?;
         let module = gpu.pass_module("lod_buffer_mesh", &[])?;
@@ -100,7 +119,7 @@ impl LodBufferRenderer {
             &module,
             &layout,
             &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
-            depth_write_state(LOD_DEPTH_FORMAT, wgpu::CompareFunction::Less),
+            depth_write_state(LOD_DEPTH_FORMAT, depth_compare(depth)),
             "lod_buffer_mesh",
         )?;
         let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
@@ -134,6 +153,7 @@ impl LodBufferRenderer {
             draw_group,
             vis_scale,
             color_format,
+            depth,
         })
     }
 
@@ -178,7 +198,11 @@ impl LodBufferRenderer {
             let mut triangles = 0u64;
             {
                 let occlusion = counter.and_then(FragmentCounter::occlusion_query_set);
-                let mut pass = buffers.begin_pass(&mut encoder, index, clear, 1.0, occlusion);
+                let far = match self.depth {
+                    DepthConvention::Standard => 1.0,
+                    DepthConvention::Reversed => 0.0,
+                };
+                let mut pass = buffers.begin_pass(&mut encoder, index, clear, far, occlusion);
                 if let Some(c) = counter {
                     c.begin(&mut pass);
                 }
@@ -239,4 +263,12 @@ fn layouts(
         immediate_size: 0,
     });
     (view_layout, draw_layout, layout)
+}
+
+/// The depth test that keeps the nearer fragment under `depth`.
+fn depth_compare(depth: DepthConvention) -> wgpu::CompareFunction {
+    match depth {
+        DepthConvention::Standard => wgpu::CompareFunction::Less,
+        DepthConvention::Reversed => wgpu::CompareFunction::Greater,
+    }
 }
