@@ -167,13 +167,7 @@ impl GpuContext {
         // wgpu notices a destroyed device, and calls the lost callback, when it is polled. A
         // device the driver lost makes wgpu 30's poll panic instead of returning an error; that
         // panic is caught here and reported as a lost device.
-        let polled = catch_unwind(AssertUnwindSafe(|| self.device.poll(wgpu::PollType::Poll)));
-        if polled.is_err() {
-            self.state.record_lost(
-                "Unknown".into(),
-                "wgpu panicked while polling the device".into(),
-            );
-        }
+        self.poll(wgpu::PollType::Poll);
         if let Some((reason, message)) = self.state.lost() {
             return Err(GpuError::DeviceLost {
                 call,
@@ -214,6 +208,18 @@ impl GpuContext {
         match caught {
             Some(error) => Err(GpuError::from_wgpu(call, error)),
             None => Ok(value),
+        }
+    }
+
+    /// Polls the device; a panic inside wgpu's poll (its answer to a driver-lost device) is
+    /// caught and recorded as a lost device.
+    fn poll(&self, poll_type: wgpu::PollType) {
+        let polled = catch_unwind(AssertUnwindSafe(|| self.device.poll(poll_type)));
+        if polled.is_err() {
+            self.state.record_lost(
+                "Unknown".into(),
+                "wgpu panicked while polling the device".into(),
+            );
         }
     }
 
@@ -285,15 +291,7 @@ impl GpuContext {
     pub fn wait_idle(&self) -> Result<(), GpuError> {
         const CALL: &str = "GpuContext::wait_idle";
         self.check(CALL)?;
-        let waited = catch_unwind(AssertUnwindSafe(|| {
-            self.device.poll(wgpu::PollType::wait_indefinitely())
-        }));
-        if waited.is_err() {
-            self.state.record_lost(
-                "Unknown".into(),
-                "wgpu panicked while waiting for the device".into(),
-            );
-        }
+        self.poll(wgpu::PollType::wait_indefinitely());
         self.check(CALL)
     }
 }

@@ -240,6 +240,23 @@ pub(crate) fn check_color_format(
             "its texels are integers; lodkit's passes read and write floating-point color".into(),
         ));
     }
+    check_format_usages(gpu, call, parameter, format, usages)
+}
+
+/// Checks that the device has the features `format` needs and allows it with `usages`.
+pub(crate) fn check_format_usages(
+    gpu: &GpuContext,
+    call: &'static str,
+    parameter: &'static str,
+    format: wgpu::TextureFormat,
+    usages: wgpu::TextureUsages,
+) -> Result<(), GpuError> {
+    let unsupported = |reason: String| GpuError::UnsupportedFormat {
+        call,
+        parameter,
+        format,
+        reason,
+    };
     let missing_features = format.required_features() - gpu.device.features();
     if !missing_features.is_empty() {
         return Err(unsupported(format!(

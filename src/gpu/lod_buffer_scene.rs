@@ -99,61 +99,51 @@ impl LodBufferRenderer {
             });
         }
         gpu.guarded(CALL, || {
-            Self::build(gpu, color_format, vis, vis_scale, depth)
-        })
-    }
-
-    fn build(
-        gpu: &GpuContext,
-        color_format: wgpu::TextureFormat,
-        vis: &VisibilityTexture,
-        vis_scale: f32,
-        depth: DepthConvention,
-    ) -> Result<Self, GpuError> {
-        let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture")?;
-        let module = gpu.pass_module("lod_buffer_mesh", &[])?;
-        let device = &gpu.device;
-        let (view_layout, draw_layout, layout) = layouts(device);
-        let pipeline = mesh_pipeline(
-            gpu,
-            &module,
-            &layout,
-            &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
-            depth_write_state(LOD_DEPTH_FORMAT, depth_compare(depth)),
-            "lod_buffer_mesh",
-        )?;
-        let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
-        let draws = DrawUniforms::new(
-            gpu,
-            std::mem::size_of::<LodDrawUniform>(),
-            Self::MAX_DRAWS,
-            "lod draws",
-        )?;
-        let vis_view = vis_texture.create_view(&Default::default());
-        let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &view_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&vis_view),
-                },
-            ],
-        });
-        let draw_group = draws.bind_group(gpu, &draw_layout)?;
-        Ok(Self {
-            pipeline,
-            camera,
-            camera_group,
-            draws,
-            draw_group,
-            vis_scale,
-            color_format,
-            depth,
+            let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture")?;
+            let module = gpu.pass_module("lod_buffer_mesh", &[])?;
+            let device = &gpu.device;
+            let (view_layout, draw_layout, layout) = layouts(device);
+            let pipeline = mesh_pipeline(
+                gpu,
+                &module,
+                &layout,
+                &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
+                depth_write_state(LOD_DEPTH_FORMAT, depth_compare(depth)),
+                "lod_buffer_mesh",
+            )?;
+            let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
+            let draws = DrawUniforms::new(
+                gpu,
+                std::mem::size_of::<LodDrawUniform>(),
+                Self::MAX_DRAWS,
+                "lod draws",
+            )?;
+            let vis_view = vis_texture.create_view(&Default::default());
+            let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &view_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: camera.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&vis_view),
+                    },
+                ],
+            });
+            let draw_group = draws.bind_group(gpu, &draw_layout)?;
+            Ok(Self {
+                pipeline,
+                camera,
+                camera_group,
+                draws,
+                draw_group,
+                vis_scale,
+                color_format,
+                depth,
+            })
         })
     }
 

@@ -5,7 +5,7 @@
 
 use bytemuck::Pod;
 
-use super::error::{buffer_size, target_extent, texture_extent};
+use super::error::{buffer_size, check_format_usages, target_extent, texture_extent};
 use super::{GpuContext, GpuError};
 
 /// A 2D texture with one mip level and one sample (a zero side is taken as 1).
@@ -18,19 +18,7 @@ pub fn texture_2d(
 ) -> Result<wgpu::Texture, GpuError> {
     const CALL: &str = "resources::texture_2d";
     let (width, height) = texture_extent(gpu, CALL, width, height)?;
-    let missing_features = format.required_features() - gpu.device.features();
-    let allowed = gpu.format_features(format).allowed_usages;
-    if !missing_features.is_empty() || !allowed.contains(usage) {
-        return Err(GpuError::UnsupportedFormat {
-            call: CALL,
-            parameter: "format",
-            format,
-            reason: format!(
-                "the device does not allow it as {:?} (missing features: {missing_features:?})",
-                usage - allowed
-            ),
-        });
-    }
+    check_format_usages(gpu, CALL, "format", format, usage)?;
     gpu.guarded(CALL, || {
         Ok(gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),

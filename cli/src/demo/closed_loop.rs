@@ -8,21 +8,18 @@
 //! submission overhead the frame pays anyway.
 
 use std::path::Path;
-use std::time::Instant;
 
 use serde::Serialize;
 
 use super::DemoError;
+use super::frame_cost::Frame;
 use super::plots::{Chart, Series, line_chart};
 use super::report::Table;
-use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::framebuffer_lod::{
     PaperController, ResizeController, ResizeLimits, RlsController, SimulatedFrame, StepController,
     step_response,
 };
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
-use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
-use lodkit::gpu::resources::texture_2d;
+use lodkit::gpu::gbuffer_scene::EdgeScene;
 use lodkit::gpu::{GpuContext, GpuError};
 
 /// Shading work before the step (sky directions per fragment); it doubles at [`STEP_FRAME`].
@@ -78,25 +75,8 @@ pub struct ClosedLoop {
 
 /// Runs lodkit's controller, the paper's and the step heuristic on the edge scene at `size`.
 pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedLoop, DemoError> {
-    let (w, h) = size;
-    let format = wgpu::TextureFormat::Rgba8Unorm;
-    let mut scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
-    let low = LowResBuffer::new(gpu, w, h, format)?;
-    let prepass = LowResBuffer::new(gpu, w, h, format)?;
-    let upsample = UpsamplePass::new(gpu, format)?;
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let view = texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default());
-    let frame = |scene: &EdgeScene, r: f32| -> Result<f32, GpuError> {
-        let start = Instant::now();
-        scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo)?;
-        scene.render_term(gpu, &low, r, ShadingTerm::Full)?;
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let g = prepass.geometry();
-        upsample.encode(gpu, &mut encoder, &low, r, g, SIGMA_Z, SIGMA_N, &view)?;
-        gpu.queue.submit([encoder.finish()]);
-        gpu.wait_idle()?;
-        Ok(start.elapsed().as_secs_f32() * 1e3)
-    };
+    let (frame, mut scene) = Frame::new(gpu, size)?;
+    let frame = |scene: &EdgeScene, r: f32| frame.whole(scene, r).map(|ms| ms as f32);
     let times = |scene: &EdgeScene, r: f32| -> Result<Vec<f32>, GpuError> {
         let mut t = (0..CALIBRATION)
             .map(|_| frame(scene, r))

@@ -101,8 +101,10 @@ fn timed(gpu: &GpuContext, f: impl Fn() -> Result<(), GpuError>) -> Result<f64, 
     })
 }
 
-/// The resources of a framebuffer-LOD frame on the edge scene.
-struct Frame<'a> {
+/// The resources of a framebuffer-LOD frame of the edge scene (the scene is passed to each
+/// call, since its shading work is the knob the measurements turn): the low-resolution buffer,
+/// the full-resolution prepass, the upsample pass and the target; each pass timed on request.
+pub(super) struct Frame<'a> {
     gpu: &'a GpuContext,
     low: LowResBuffer,
     prepass: LowResBuffer,
@@ -110,7 +112,25 @@ struct Frame<'a> {
     view: wgpu::TextureView,
 }
 
-impl Frame<'_> {
+impl<'a> Frame<'a> {
+    /// The resources at `size`, RGBA8, and the edge scene for that aspect.
+    pub(super) fn new(
+        gpu: &'a GpuContext,
+        size: (u32, u32),
+    ) -> Result<(Self, EdgeScene), GpuError> {
+        let ((w, h), format) = (size, wgpu::TextureFormat::Rgba8Unorm);
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
+        let frame = Self {
+            gpu,
+            low: LowResBuffer::new(gpu, w, h, format)?,
+            prepass: LowResBuffer::new(gpu, w, h, format)?,
+            upsample: UpsamplePass::new(gpu, format)?,
+            view: texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default()),
+        };
+        Ok((frame, scene))
+    }
+
     fn shade(&self, scene: &EdgeScene, r: f32, term: ShadingTerm) -> Result<f64, GpuError> {
         timed(self.gpu, || scene.render_term(self.gpu, &self.low, r, term))
     }
@@ -136,8 +156,8 @@ impl Frame<'_> {
         timed(self.gpu, || self.record_upsample(r))
     }
 
-    /// A whole frame at `r`, waited for once at its end.
-    fn whole(&self, scene: &EdgeScene, r: f32) -> Result<f64, GpuError> {
+    /// A whole frame at `r`, waited for once at its end; its wall time in ms.
+    pub(super) fn whole(&self, scene: &EdgeScene, r: f32) -> Result<f64, GpuError> {
         timed(self.gpu, || {
             scene.render_term(self.gpu, &self.prepass, 1.0, ShadingTerm::Albedo)?;
             scene.render_term(self.gpu, &self.low, r, ShadingTerm::Full)?;
@@ -161,18 +181,8 @@ pub fn measure_frame_cost(
     size: (u32, u32),
     rounds: usize,
 ) -> Result<FrameCost, DemoError> {
-    let (w, h) = size;
     let rounds = rounds.max(3);
-    let format = wgpu::TextureFormat::Rgba8Unorm;
-    let mut scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let frame = Frame {
-        gpu,
-        low: LowResBuffer::new(gpu, w, h, format)?,
-        prepass: LowResBuffer::new(gpu, w, h, format)?,
-        upsample: UpsamplePass::new(gpu, format)?,
-        view: texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default()),
-    };
+    let (frame, mut scene) = Frame::new(gpu, size)?;
     // Pass by pass, rounds interleaved over the configurations; round 0 warms up.
     scene.set_shading_work(BREAKDOWN_WORK);
     let full = ("full resolution", 1.0, ShadingTerm::Full);

@@ -396,7 +396,8 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     write(&docs.join("benchmarks.md"), &b)
 }
 
-fn img(src: &str, alt: &str) -> String {
+/// An image with its caption, for `index.html`.
+pub(super) fn img(src: &str, alt: &str) -> String {
     format!("<figure><img src=\"{src}\" alt=\"{alt}\"><figcaption>{alt}</figcaption></figure>\n")
 }
 
