@@ -3,15 +3,18 @@
 //! so read the ratio, not the absolute figures, on a software GPU. `lodkit demo` measures the
 //! same ratio, and whole-frame speed-ups per resize factor, for its report.
 //!
-//! `cargo bench -p lodkit-cli --bench upsample [-- WIDTH HEIGHT PAIRS]` (default 640 x 480, 60 pairs)
+//! Then the same for a pass that only makes eq. 1's nine texel loads: the floor of any per-pixel
+//! eq. 1 on this GPU.
+//!
+//! `cargo bench -p lodkit-cli --bench upsample [-- WIDTH HEIGHT PAIRS]` (default 1280 x 720, 60 pairs)
 
 use lodkit_cli::demo::{open_gpu, timing::upsample_vs_bilinear};
 
 fn main() {
     let args: Vec<u32> = std::env::args().filter_map(|a| a.parse().ok()).collect();
     let size = (
-        args.first().copied().unwrap_or(640),
-        args.get(1).copied().unwrap_or(480),
+        args.first().copied().unwrap_or(1280),
+        args.get(1).copied().unwrap_or(720),
     );
     let pairs = args.get(2).copied().unwrap_or(60) as usize;
     let gpu = match open_gpu() {
@@ -23,10 +26,14 @@ fn main() {
     };
     println!("adapter: {}", gpu.adapter_summary());
     match upsample_vs_bilinear(&gpu, size, 2.0, pairs) {
-        Ok(r) => println!(
-            "{}x{}, {pairs} interleaved pairs: {} {:.3} ms, {} {:.3} ms, median ratio {:.3}",
-            size.0, size.1, r.pass, r.pass_ms, r.baseline, r.baseline_ms, r.ratio
-        ),
+        Ok(ratios) => {
+            for r in ratios {
+                println!(
+                    "{}x{}, {pairs} interleaved pairs: {} {:.3} ms, {} {:.3} ms, median ratio {:.3}",
+                    size.0, size.1, r.pass, r.pass_ms, r.baseline, r.baseline_ms, r.ratio
+                );
+            }
+        }
         Err(e) => eprintln!("error: {e}"),
     }
 }

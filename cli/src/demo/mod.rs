@@ -326,10 +326,17 @@ pub fn run_on(
     let closed_loop = closed_loop::measure_closed_loop(gpu, options.fb_size)?;
     bar.inc(1);
     bar.set_message("pass time ratios");
-    let pass_ratios = vec![
-        timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?,
-        timing::upsample_vs_bilinear(gpu, options.size, 2.0, options.timing_pairs)?,
-    ];
+    let mut pass_ratios = vec![timing::combine_vs_copy(
+        gpu,
+        options.size.0.min(1024),
+        options.timing_pairs,
+    )?];
+    pass_ratios.extend(timing::upsample_vs_bilinear(
+        gpu,
+        options.fb_size,
+        2.0,
+        options.timing_pairs,
+    )?);
     bar.inc(1);
     bar.set_message("controllers and host-side figures");
     let controllers = upsampling::measure_controllers(upsampling::CONTROLLER_SEEDS);

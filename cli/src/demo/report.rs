@@ -5,6 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::plots::{Chart, Series, line_chart};
+use super::timing::Reads;
 use super::upsampling::{CONTROLLER_SEEDS, METHODS, SHADING_WORK, SIGMA_N, SIGMA_Z, TARGET_MS};
 use super::{DemoError, DemoReport};
 
@@ -278,6 +279,7 @@ fn ratio_table(report: &DemoReport) -> Table {
             "baseline ms",
             "median ratio",
             "pairs",
+            "fetches / texels / bytes per pixel, pass vs baseline",
         ],
         rows: report
             .pass_ratios
@@ -291,10 +293,15 @@ fn ratio_table(report: &DemoReport) -> Table {
                     format!("{:.3}", p.baseline_ms),
                     format!("{:.3}", p.ratio),
                     p.pairs.to_string(),
+                    format!("{} vs {}", reads(&p.pass_reads), reads(&p.baseline_reads)),
                 ]
             })
             .collect(),
     }
+}
+
+fn reads(r: &Reads) -> String {
+    format!("{} / {} / {} B", r.fetches, r.texels, r.bytes)
 }
 
 fn controller_table(report: &DemoReport) -> Table {
@@ -535,7 +542,15 @@ pub fn summary(report: &DemoReport) -> String {
     }
     s.push('\n');
     for p in &report.pass_ratios {
-        let _ = writeln!(s, "{} / {}: {:.3}x", p.pass, p.baseline, p.ratio);
+        let _ = writeln!(
+            s,
+            "{} / {}: {:.3}x ({} vs {} per pixel)",
+            p.pass,
+            p.baseline,
+            p.ratio,
+            reads(&p.pass_reads),
+            reads(&p.baseline_reads)
+        );
     }
     s
 }

@@ -10,6 +10,7 @@ use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
 
 use super::upsampling::{SIGMA_N, SIGMA_Z};
+use lodkit::gbuffer::GEOMETRY_FORMAT;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::EdgeScene;
@@ -19,6 +20,7 @@ use lodkit::gpu::resources::{
 };
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::gpu::{GpuContext, GpuError};
+use lodkit::lod_buffer::ID_DEPTH_FORMAT;
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
@@ -40,6 +42,42 @@ pub struct PassRatio {
     pub ratio: f64,
     /// Pairs timed.
     pub pairs: usize,
+    /// Texture reads per output pixel of the pass, counted from its shader.
+    pub pass_reads: Reads,
+    /// Texture reads per output pixel of the baseline.
+    pub baseline_reads: Reads,
+}
+
+/// Texture reads per output pixel, counted from a shader's code: they hold on any GPU (before
+/// caches), where milliseconds on a software GPU do not.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Reads {
+    /// Fetch instructions (`textureLoad`, `textureSample*`).
+    pub fetches: u32,
+    /// Texels those fetches touch (4 for a bilinear fetch).
+    pub texels: u32,
+    /// Bytes of those texels.
+    pub bytes: u64,
+}
+
+impl Reads {
+    /// No reads.
+    const NONE: Self = Self {
+        fetches: 0,
+        texels: 0,
+        bytes: 0,
+    };
+
+    /// Adds `fetches` fetches of `texels_each` texels of `format`.
+    fn plus(self, fetches: u32, texels_each: u32, format: wgpu::TextureFormat) -> Self {
+        let texels = fetches * texels_each;
+        let bytes = u64::from(format.block_copy_size(None).unwrap_or(0)) * u64::from(texels);
+        Self {
+            fetches: self.fetches + fetches,
+            texels: self.texels + texels,
+            bytes: self.bytes + bytes,
+        }
+    }
 }
 
 /// Median (the upper one for even lengths); NaN when empty.
@@ -126,6 +164,28 @@ struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 }
 ";
 
+/// The reads of eq. 1 at the same texels, summed so none is optimized away, no weights.
+const LOADS9: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
+@group(0) @binding(0) var low_color: texture_2d<f32>;
+@group(0) @binding(1) var low_geometry: texture_2d<f32>;
+@group(0) @binding(2) var full_geometry: texture_2d<f32>;
+@group(0) @binding(3) var<uniform> scale: Scale;
+@vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
+@fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
+    let t0 = vec2<u32>(v.position.xy * scale.uv_scale);
+    let t3 = t0 + 1u;
+    let t1 = vec2<u32>(t3.x, t0.y);
+    let t2 = vec2<u32>(t0.x, t3.y);
+    var s = textureLoad(full_geometry, vec2<u32>(v.position.xy), 0);
+    s += textureLoad(low_color, t0, 0) + textureLoad(low_color, t1, 0);
+    s += textureLoad(low_color, t2, 0) + textureLoad(low_color, t3, 0);
+    s += textureLoad(low_geometry, t0, 0) + textureLoad(low_geometry, t1, 0);
+    s += textureLoad(low_geometry, t2, 0) + textureLoad(low_geometry, t3, 0);
+    return s;
+}
+";
+
 fn draw_fullscreen(
     gpu: &GpuContext,
     pipeline: &wgpu::RenderPipeline,
@@ -208,6 +268,8 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     };
     let run_copy = || draw_fullscreen(gpu, &copy4, &group, &target_view);
     let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs)?;
+    // Both read one color and one id/depth texel of each buffer.
+    let reads = Reads::NONE.plus(2, 1, FORMAT).plus(2, 1, ID_DEPTH_FORMAT);
     Ok(PassRatio {
         pass: "combine (frame-sequential)".to_owned(),
         baseline: "plain copy of the same 4 textures".to_owned(),
@@ -216,17 +278,20 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
         baseline_ms,
         ratio,
         pairs,
+        pass_reads: reads,
+        baseline_reads: reads,
     })
 }
 
 /// The bilateral upsample pass against a hardware-filtered bilinear pass over the same low-res
-/// color, on the edge scene at resize factor `r`.
+/// color, on the edge scene at resize factor `r`; then, against the same baseline, a pass that
+/// only makes eq. 1's nine texel loads (no arithmetic): the floor of any per-pixel eq. 1.
 pub fn upsample_vs_bilinear(
     gpu: &GpuContext,
     size: (u32, u32),
     r: f32,
     pairs: usize,
-) -> Result<PassRatio, GpuError> {
+) -> Result<[PassRatio; 2], GpuError> {
     let (w, h) = size;
     let scene = EdgeScene::new(gpu, FORMAT, w as f32 / h as f32)?;
     let full = LowResBuffer::new(gpu, w, h, FORMAT)?;
@@ -287,14 +352,32 @@ pub fn upsample_vs_bilinear(
         gpu.wait_idle()
     };
     let run_bilinear = || draw_fullscreen(gpu, &bilinear, &group, &view);
-    let (pass_ms, baseline_ms, ratio) = interleaved(&run_bilateral, &run_bilinear, pairs)?;
-    Ok(PassRatio {
-        pass: format!("bilateral upsample (r = {r})"),
-        baseline: "bilinear upsample (hardware filter)".to_owned(),
-        size,
-        pass_ms,
-        baseline_ms,
-        ratio,
-        pairs,
-    })
+    let loads = plain_pass(gpu, LOADS9, "loads9.wgsl")?;
+    let textures = [low.color(), low.geometry(), full.geometry()];
+    let layout = loads.get_bind_group_layout(0);
+    let loads_group = textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads9")?;
+    let run_loads = || draw_fullscreen(gpu, &loads, &loads_group, &view);
+    // Eq. 1: the pixel's own geometry, then the 2x2 cell's colors and geometry, one load each.
+    let eq1_reads = Reads::NONE
+        .plus(1, 1, GEOMETRY_FORMAT)
+        .plus(4, 1, FORMAT)
+        .plus(4, 1, GEOMETRY_FORMAT);
+    let time = |pass: String, run: &dyn Fn() -> Result<(), GpuError>| {
+        let (pass_ms, baseline_ms, ratio) = interleaved(run, &run_bilinear, pairs)?;
+        Ok::<_, GpuError>(PassRatio {
+            pass,
+            baseline: "bilinear upsample (hardware filter)".to_owned(),
+            size,
+            pass_ms,
+            baseline_ms,
+            ratio,
+            pairs,
+            pass_reads: eq1_reads,
+            baseline_reads: Reads::NONE.plus(1, 4, FORMAT),
+        })
+    };
+    Ok([
+        time(format!("bilateral upsample (r = {r})"), &run_bilateral)?,
+        time("eq. 1's 9 texel loads alone".to_owned(), &run_loads)?,
+    ])
 }

@@ -46,26 +46,28 @@ float lodkit_bilateral_weight(float tent, float depth_diff, float normal_dist, f
     return tent * exp(-0.5 * (z * z + n * n));
 }
 
-/// Eq. 1 over the 2x2 low-res samples, with the closest-depth fallback.
+/// Eq. 1 over the 2x2 low-res samples, with the closest-depth fallback (the first of equals);
+/// no loop or dynamic indexing, the normal distance squared.
 vec4 lodkit_bilateral_upsample(vec2 f, vec4 values[4], vec4 depths, vec3 normals[4], float depth, vec3 normal, float sigma_z, float sigma_n) {
-    vec4 tent = lodkit_bilateral_tent(f);
+    // Differences scaled by 1 / sigma (0 for sigma = +inf: no range term).
+    float inv_z = 1.0 / sigma_z;
+    float inv_n = 1.0 / sigma_n;
     vec2 here = lodkit_foreshortened_normal(normal);
-    vec4 sum = vec4(0.0);
-    float total = 0.0;
-    uint closest = 0u;
-    for (uint i = 0u; i < 4u; i++) {
-        float normal_dist = distance(lodkit_foreshortened_normal(normals[i]), here);
-        float w = lodkit_bilateral_weight(tent[i], depths[i] - depth, normal_dist, sigma_z, sigma_n);
-        sum += w * values[i];
-        total += w;
-        if (abs(depths[i] - depth) < abs(depths[closest] - depth)) {
-            closest = i;
-        }
-    }
+    vec4 dz = depths - depth;
+    vec4 z = dz * inv_z;
+    vec2 n0 = (lodkit_foreshortened_normal(normals[0]) - here) * inv_n;
+    vec2 n1 = (lodkit_foreshortened_normal(normals[1]) - here) * inv_n;
+    vec2 n2 = (lodkit_foreshortened_normal(normals[2]) - here) * inv_n;
+    vec2 n3 = (lodkit_foreshortened_normal(normals[3]) - here) * inv_n;
+    vec4 nn = vec4(dot(n0, n0), dot(n1, n1), dot(n2, n2), dot(n3, n3));
+    vec4 w = lodkit_bilateral_tent(f) * exp(-0.5 * (z * z + nn));
+    float total = w.x + w.y + w.z + w.w;
     if (total < LODKIT_BILATERAL_MIN_WEIGHT) {
-        return values[closest];
+        vec4 a = abs(dz);
+        float m = min(min(a.x, a.y), min(a.z, a.w));
+        return a.x == m ? values[0] : (a.y == m ? values[1] : (a.z == m ? values[2] : values[3]));
     }
-    return sum / total;
+    return (w.x * values[0] + w.y * values[1] + w.z * values[2] + w.w * values[3]) / total;
 }
 
 /// Continuous position of a full-res pixel in L's texel grid (texel centers at integers).

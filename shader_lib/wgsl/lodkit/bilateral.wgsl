@@ -58,7 +58,9 @@ fn bilateral_weight(tent: f32, depth_diff: f32, normal_dist: f32, sigma_z: f32, 
 
 /// Eq. 1 over the 2x2 low-res samples (`values`, `depths`, `normals`) for a full-res pixel at
 /// fraction `f` between them with depth `depth` and normal `normal`. Falls back to the sample
-/// closest in depth when the weights sum below BILATERAL_MIN_WEIGHT.
+/// closest in depth (the first of equals) when the weights sum below BILATERAL_MIN_WEIGHT.
+/// Written without loops or dynamic indexing (four lanes of one vec4), and with the squared
+/// normal distance instead of a square root: a software rasterizer runs this per pixel.
 fn bilateral_upsample(
     f: vec2<f32>,
     values: array<vec4<f32>, 4>,
@@ -69,25 +71,25 @@ fn bilateral_upsample(
     sigma_z: f32,
     sigma_n: f32,
 ) -> vec4<f32> {
-    let tent = bilateral_tent(f);
+    // Differences scaled by 1 / sigma (0 for sigma = +inf: no range term).
+    let inv_z = 1.0 / sigma_z;
+    let inv_n = 1.0 / sigma_n;
     let here = foreshortened_normal(normal);
-    var sum = vec4<f32>(0.0);
-    var total = 0.0;
-    var closest = 0u;
-    for (var i = 0u; i < 4u; i++) {
-        // foreshortened_normal_distance, with this pixel's half computed once.
-        let normal_dist = distance(foreshortened_normal(normals[i]), here);
-        let w = bilateral_weight(tent[i], depths[i] - depth, normal_dist, sigma_z, sigma_n);
-        sum += w * values[i];
-        total += w;
-        if (abs(depths[i] - depth) < abs(depths[closest] - depth)) {
-            closest = i;
-        }
-    }
+    let dz = depths - depth;
+    let z = dz * inv_z;
+    let n0 = (foreshortened_normal(normals[0]) - here) * inv_n;
+    let n1 = (foreshortened_normal(normals[1]) - here) * inv_n;
+    let n2 = (foreshortened_normal(normals[2]) - here) * inv_n;
+    let n3 = (foreshortened_normal(normals[3]) - here) * inv_n;
+    let nn = vec4<f32>(dot(n0, n0), dot(n1, n1), dot(n2, n2), dot(n3, n3));
+    let w = bilateral_tent(f) * exp(-0.5 * (z * z + nn));
+    let total = w.x + w.y + w.z + w.w;
     if (total < BILATERAL_MIN_WEIGHT) {
-        return values[closest];
+        let a = abs(dz);
+        let m = min(min(a.x, a.y), min(a.z, a.w));
+        return select(select(select(values[3], values[2], a.z == m), values[1], a.y == m), values[0], a.x == m);
     }
-    return sum / total;
+    return (w.x * values[0] + w.y * values[1] + w.z * values[2] + w.w * values[3]) / total;
 }
 
 /// Continuous position of a full-res pixel in L's texel grid (texel centers at integers).
@@ -129,7 +131,8 @@ fn bilateral_upsample_texels(
 }
 
 /// The full lookup for the full-res pixel at `frag_coord` with `depth` and screen `normal`:
-/// fetches the 2x2 L texels from `low_color` and `low_geometry` and applies eq. 1.
+/// fetches the 2x2 L texels from `low_color` and `low_geometry` and applies eq. 1. Eight texel
+/// loads, the cell computed once.
 fn bilateral_upsample_at(
     low_color: texture_2d<f32>,
     low_geometry: texture_2d<f32>,
@@ -141,13 +144,25 @@ fn bilateral_upsample_at(
     sigma_z: f32,
     sigma_n: f32,
 ) -> vec4<f32> {
-    var colors: array<vec4<f32>, 4>;
-    var geometry: array<vec4<f32>, 4>;
-    for (var i = 0u; i < 4u; i++) {
-        let texel = bilateral_cell_texel(frag_coord, low_viewport, full_size, i);
-        colors[i] = textureLoad(low_color, texel, 0);
-        geometry[i] = textureLoad(low_geometry, texel, 0);
-    }
-    let f = bilateral_cell_fraction(frag_coord, low_viewport, full_size);
+    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
+    let origin = bilateral_cell_origin(p, low_viewport);
+    let f = clamp(p - origin, vec2<f32>(0.0), vec2<f32>(1.0));
+    let last = vec2<u32>(max(low_viewport - 1.0, vec2<f32>(0.0)));
+    let t0 = min(vec2<u32>(origin), last);
+    let t3 = min(vec2<u32>(origin) + 1u, last);
+    let t1 = vec2<u32>(t3.x, t0.y);
+    let t2 = vec2<u32>(t0.x, t3.y);
+    let colors = array<vec4<f32>, 4>(
+        textureLoad(low_color, t0, 0),
+        textureLoad(low_color, t1, 0),
+        textureLoad(low_color, t2, 0),
+        textureLoad(low_color, t3, 0),
+    );
+    let geometry = array<vec4<f32>, 4>(
+        textureLoad(low_geometry, t0, 0),
+        textureLoad(low_geometry, t1, 0),
+        textureLoad(low_geometry, t2, 0),
+        textureLoad(low_geometry, t3, 0),
+    );
     return bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n);
 }
