@@ -111,13 +111,8 @@ fn main() -> Result<(), Box<dyn Error>> {
             .map(|(key, &p)| {
                 let d = scheduler.draw(*key)?;
                 let (mesh, color) = &lods[usize::from(d.lod.min(1))];
-                Ok(LodDrawItem {
-                    mesh,
-                    model: Mat4::from_translation(p) * Mat4::from_scale(Vec3::splat(0.45)),
-                    color: *color,
-                    id: d.id,
-                    tau: d.tau,
-                })
+                let model = Mat4::from_translation(p) * Mat4::from_scale(Vec3::splat(0.45));
+                Ok(LodDrawItem::from_draw(mesh, model, *color, &d))
             })
             .collect::<Result<Vec<_>, Box<dyn Error>>>()?;
         let index = scheduler.buffer_index();

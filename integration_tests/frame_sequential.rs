@@ -4,7 +4,9 @@
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, LodSample, combine_samples};
 use lodkit::frame_sequential::{Drive, ID_QUARANTINE_FRAMES, TransitionScheduler};
-use lodkit::reproject::{in_viewport, new_to_old_matrix, reproject};
+use lodkit::reproject::{
+    in_viewport, new_to_old_matrix, reproject, reproject_base, reproject_refine,
+};
 use lodkit::shaders::SourceLanguage;
 use lodkit::visibility::{
     VisibilityPattern, check_visibility, visibility_texel, visibility_texture, visibility_threshold,
@@ -222,11 +224,13 @@ fn reproject_cases() -> Vec<(Mat4, Vec2, f32)> {
 fn reproject_twins_match_including_reversed_z_sky_and_outside() {
     let gpu = lodkit_test_gpu!();
     let cases = reproject_cases();
+    // The refinement looks for the surface at new depth 0.97 on the same ray, given its old depth.
+    let old_depth = |m: &Mat4, uv: Vec2| reproject(uv, 0.97, m).z;
     let inputs: Vec<u32> = cases
         .iter()
         .flat_map(|(m, uv, d)| {
             let mut w = words(&m.to_cols_array());
-            w.extend(words(&[uv.x, uv.y, *d]));
+            w.extend(words(&[uv.x, uv.y, *d, old_depth(m, *uv)]));
             w
         })
         .collect();
@@ -234,18 +238,26 @@ fn reproject_twins_match_including_reversed_z_sky_and_outside() {
         .iter()
         .map(|(m, uv, d)| reproject(*uv, *d, m))
         .collect();
+    let refined: Vec<Vec3> = cases
+        .iter()
+        .map(|(m, uv, d)| reproject_refine(reproject_base(*uv, m), *d, old_depth(m, *uv), m))
+        .collect();
     let wgsl_body = "let m = mat4x4<f32>(vec4(inp_f(0u), inp_f(1u), inp_f(2u), inp_f(3u)), vec4(inp_f(4u), inp_f(5u), inp_f(6u), inp_f(7u)),
                                   vec4(inp_f(8u), inp_f(9u), inp_f(10u), inp_f(11u)), vec4(inp_f(12u), inp_f(13u), inp_f(14u), inp_f(15u)));
         let r = reproject(vec2(inp_f(16u), inp_f(17u)), inp_f(18u), m);
-        out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_u(3u, u32(in_viewport(r.xy)));";
+        out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_u(3u, u32(in_viewport(r.xy)));
+        let q = reproject_refine(reproject_base(vec2(inp_f(16u), inp_f(17u)), m), inp_f(18u), inp_f(19u), m);
+        out_f(4u, q.x); out_f(5u, q.y); out_f(6u, q.z);";
     let glsl_body = "mat4 m = mat4(vec4(inp_f(0u), inp_f(1u), inp_f(2u), inp_f(3u)), vec4(inp_f(4u), inp_f(5u), inp_f(6u), inp_f(7u)),
                            vec4(inp_f(8u), inp_f(9u), inp_f(10u), inp_f(11u)), vec4(inp_f(12u), inp_f(13u), inp_f(14u), inp_f(15u)));
         vec3 r = lodkit_reproject(vec2(inp_f(16u), inp_f(17u)), inp_f(18u), m);
-        out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_u(3u, uint(lodkit_in_viewport(r.xy)));";
+        out_f(0u, r.x); out_f(1u, r.y); out_f(2u, r.z); out_u(3u, uint(lodkit_in_viewport(r.xy)));
+        vec3 q = lodkit_reproject_refine(lodkit_reproject_base(vec2(inp_f(16u), inp_f(17u)), m), inp_f(18u), inp_f(19u), m);
+        out_f(4u, q.x); out_f(5u, q.y); out_f(6u, q.z);";
     for (language, header, body) in [
         (
             SourceLanguage::Wgsl,
-            "#import lodkit::reproject::{reproject, in_viewport}",
+            "#import lodkit::reproject::{reproject, reproject_base, reproject_refine, in_viewport}",
             wgsl_body,
         ),
         (GLSL, "#include \"lodkit/reproject.glsl\"", glsl_body),
@@ -253,17 +265,22 @@ fn reproject_twins_match_including_reversed_z_sky_and_outside() {
         let probe = Probe {
             header,
             body,
-            inputs: 19,
-            outputs: 4,
+            inputs: 20,
+            outputs: 7,
             texture: None,
             rgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
-        for (i, (g, w)) in got.chunks(4).zip(&want).enumerate() {
+        for (i, (g, (w, q))) in got.chunks(7).zip(want.iter().zip(&refined)).enumerate() {
             let gv = Vec3::from_slice(&floats(&g[..3]));
             assert!(
                 (gv - *w).abs().max_element() <= 1e-4 * w.abs().max_element().max(1.0),
                 "{language:?} case {i}: {gv} vs {w}"
+            );
+            let gq = Vec3::from_slice(&floats(&g[4..7]));
+            assert!(
+                (gq - *q).abs().max_element() <= 1e-3 * q.abs().max_element().max(1.0),
+                "{language:?} case {i}: refined {gq} vs {q}"
             );
             assert_eq!(
                 g[3] == 1,
@@ -272,8 +289,18 @@ fn reproject_twins_match_including_reversed_z_sky_and_outside() {
             );
         }
     }
-    // Hand-derived: a still camera maps every pixel to itself; the sky stays finite; the turned
+    // Hand-derived: refining finds the surface at new depth 0.97 on every ray in front of the
+    // older camera; a still camera maps every pixel to itself; the sky stays finite; the turned
     // camera puts the point outside.
+    for (i, ((m, uv, _), q)) in cases.iter().zip(&refined).enumerate() {
+        let at = reproject(*uv, 0.97, m);
+        if in_viewport(at.truncate()) {
+            assert!(
+                (*q - at).abs().max_element() < 1e-3,
+                "case {i}: {q} vs {at}"
+            );
+        }
+    }
     let still = &cases[0];
     assert!(
         (reproject(still.1, still.2, &still.0) - Vec3::new(0.5, 0.5, 0.95))

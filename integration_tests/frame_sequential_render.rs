@@ -76,21 +76,14 @@ fn combine_matches_the_cpu_rule(depth: DepthConvention, proj: Mat4) {
         assert_eq!(t.incoming, frame == 1, "odd frames draw the incoming LOD");
         let (mesh, color) = lods[t.lod as usize];
         let items = [
-            LodDrawItem {
-                mesh,
-                model: Mat4::from_scale(Vec3::splat(0.9)),
-                color,
-                id: t.id,
-                tau: t.tau,
-            },
-            LodDrawItem {
-                mesh: lods[n.lod as usize].0,
-                model: Mat4::from_translation(Vec3::new(0.4, -0.2, -2.5))
+            LodDrawItem::from_draw(mesh, Mat4::from_scale(Vec3::splat(0.9)), color, &t),
+            LodDrawItem::from_draw(
+                lods[n.lod as usize].0,
+                Mat4::from_translation(Vec3::new(0.4, -0.2, -2.5))
                     * Mat4::from_scale(Vec3::new(2.0, 1.2, 0.3)),
-                color: Vec4::new(0.2, 0.9, 0.2, 1.0),
-                id: n.id,
-                tau: n.tau,
-            },
+                Vec4::new(0.2, 0.9, 0.2, 1.0),
+                &n,
+            ),
         ];
         renderer
             .render(
@@ -227,13 +220,8 @@ fn a_transition_may_begin_on_any_frame_without_the_object_dropping_out() {
     // Renders one frame of `scheduler`'s instance and returns the combined image's coverage.
     let frame = |buffers: &LodBuffers, scheduler: &TransitionScheduler, key, first: bool| {
         let d = scheduler.draw(key).unwrap();
-        let item = LodDrawItem {
-            mesh: &lods[usize::from(d.lod)],
-            model: Mat4::from_rotation_y(0.5),
-            color: colors[usize::from(d.lod)],
-            id: d.id,
-            tau: d.tau,
-        };
+        let lod = usize::from(d.lod);
+        let item = LodDrawItem::from_draw(&lods[lod], Mat4::from_rotation_y(0.5), colors[lod], &d);
         let index = scheduler.buffer_index();
         let vp = proj * view;
         renderer
@@ -311,6 +299,7 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
         color: Vec4::ONE,
         id: 7,
         tau,
+        tau_next: tau,
     };
     let render = |items: &[LodDrawItem]| {
         let clear = wgpu::Color::BLACK;
@@ -320,7 +309,7 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
         (triangles, read_lod_image(gpu, &buffers, 0).unwrap())
     };
     let (alone, image) = render(&[item(&sphere, 1.0)]);
-    for tau in [0.0, -1.0, f32::NAN] {
+    for tau in [0.0, -0.0, f32::NAN] {
         let (both, with_cube) = render(&[item(&sphere, 1.0), item(&cube, tau)]);
         assert_eq!(
             both, alone,

@@ -6,6 +6,7 @@
 #[macro_use]
 mod support;
 mod composition;
+mod display_time;
 mod frame_sequential;
 mod frame_sequential_render;
 mod framebuffer_lod;

@@ -56,6 +56,32 @@ pub fn combine_samples(newer: LodSample, older: LodSample, convention: DepthConv
     }
 }
 
+/// [`combine_samples`] with display-time visibility: when exactly one sample is shown in the
+/// frame being displayed, its color; when both or neither are, [`combine_samples`] (neither: the
+/// fragments are shown rather than a hole).
+///
+/// ```
+/// # use lodkit::combine::*;
+/// # use glam::Vec4;
+/// let s = |c: f32, id, depth| LodSample { color: Vec4::splat(c), id, depth };
+/// let std = DepthConvention::Standard;
+/// assert_eq!(combine_shown(s(1.0, 7, 0.1), false, s(0.0, 0, 0.9), true, std), Vec4::ZERO);
+/// assert_eq!(combine_shown(s(1.0, 7, 0.1), false, s(0.0, 7, 0.9), false, std), Vec4::splat(0.5));
+/// ```
+pub fn combine_shown(
+    newer: LodSample,
+    newer_shown: bool,
+    older: LodSample,
+    older_shown: bool,
+    convention: DepthConvention,
+) -> Vec4 {
+    match (newer_shown, older_shown) {
+        (true, false) => newer.color,
+        (false, true) => older.color,
+        _ => combine_samples(newer, older, convention),
+    }
+}
+
 /// A LOD buffer read back to the CPU.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LodImage {
@@ -69,6 +95,9 @@ pub struct LodImage {
     pub ids: Vec<u32>,
     /// Clip depths.
     pub depths: Vec<f32>,
+    /// Display-time flags (`LOD_BUFFER_SHOWN_NOW`, `LOD_BUFFER_SHOWN_NEXT`); empty: shown in
+    /// both frames.
+    pub flags: Vec<u32>,
 }
 
 impl LodImage {
@@ -79,6 +108,12 @@ impl LodImage {
             id: self.ids[p],
             depth: self.depths[p],
         }
+    }
+
+    /// Whether the texel at pixel index `p` is shown in the frame `flag` names (always for
+    /// n-instances and without flags).
+    pub fn shown(&self, p: usize, flag: u32) -> bool {
+        self.ids[p] == 0 || self.flags.get(p).is_none_or(|f| f & flag != 0)
     }
 }
 
@@ -108,7 +143,8 @@ pub struct CombinedPixel {
 }
 
 /// The combine pass on the CPU: every pixel of `newer` reprojected into `older` through
-/// `new_to_old` and combined with [`combine_samples`], as `passes/combine.wgsl` does. Both images
+/// `new_to_old` and combined with [`combine_shown`] (the newer texel shown if flagged for now, the
+/// older if flagged for next), as `passes/combine.wgsl` does. Both images
 /// must have the same, non-zero size and complete texel arrays; otherwise the result is empty.
 pub fn combine_images(
     newer: &LodImage,
@@ -132,7 +168,8 @@ pub fn combine_images(
                 (p as u32 / newer.width) as f32,
             );
             let uv = (Vec2::new(x, y) + 0.5) / size;
-            let old = crate::reproject::reproject(uv, n.depth, new_to_old);
+            let base = crate::reproject::reproject_base(uv, new_to_old);
+            let old = crate::reproject::reproject_from_base(base, n.depth, new_to_old);
             if !crate::reproject::in_viewport(old.truncate()) {
                 return CombinedPixel {
                     color: n.color,
@@ -140,16 +177,40 @@ pub fn combine_images(
                     on_texel_edge: false,
                 };
             }
-            let f = old.truncate() * size;
-            let frac = f - f.floor();
-            let on_texel_edge = frac.min_element() < 1e-3 || frac.max_element() > 1.0 - 1e-3;
-            let op = f
-                .as_uvec2()
-                .min(glam::UVec2::new(newer.width - 1, newer.height - 1));
+            let last = glam::UVec2::new(newer.width - 1, newer.height - 1);
+            let texel = |uv: Vec2| (uv * size).as_uvec2().min(last);
+            let near_edge = |uv: Vec2| {
+                let f = uv * size;
+                let frac = f - f.floor();
+                frac.min_element() < 1e-3 || frac.max_element() > 1.0 - 1e-3
+            };
+            let first = texel(old.truncate());
+            let first_depth = older.depths[(first.y * newer.width + first.x) as usize];
+            let refined =
+                crate::reproject::reproject_refine(base, n.depth, first_depth, new_to_old);
+            let (op, on_texel_edge) = if crate::reproject::in_viewport(refined.truncate()) {
+                (
+                    texel(refined.truncate()),
+                    near_edge(old.truncate()) || near_edge(refined.truncate()),
+                )
+            } else {
+                (first, near_edge(old.truncate()))
+            };
             let o = older.sample((op.y * newer.width + op.x) as usize);
             n.depth = old.z;
-            let color = combine_samples(n, o, convention);
-            let source = if n.id == 0 && o.id == 0 {
+            use crate::lod_buffer::{LOD_BUFFER_SHOWN_NEXT, LOD_BUFFER_SHOWN_NOW};
+            let (n_shown, o_shown) = (
+                newer.shown(p, LOD_BUFFER_SHOWN_NOW),
+                older.shown((op.y * newer.width + op.x) as usize, LOD_BUFFER_SHOWN_NEXT),
+            );
+            let color = combine_shown(n, n_shown, o, o_shown, convention);
+            let source = if n_shown != o_shown {
+                if n_shown {
+                    PixelSource::Newer
+                } else {
+                    PixelSource::Older
+                }
+            } else if n.id == 0 && o.id == 0 {
                 PixelSource::Newer
             } else if n.id == o.id {
                 PixelSource::Average

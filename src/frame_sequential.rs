@@ -4,7 +4,9 @@
 //! transition between two LODs). A t-instance is drawn with ONE of its two LODs per frame,
 //! alternating with its own phase: the frame its transition begins, and every other frame after,
 //! draw the outgoing LOD, the frames between the incoming, each with its visibility threshold tau
-//! (Fig. 2) and the instance's id. A transition may begin on any frame: its first frame draws the
+//! under the [`Schedule`] (the paper's Fig. 2 or complementary), the threshold the same LOD will
+//! have next frame (display-time visibility: the combine shows each LOD as it is at the frame
+//! displayed) and the instance's id. A transition may begin on any frame: its first frame draws the
 //! outgoing LOD whole (tau = 1 at progress 0), so the object never drops out of the newer buffer. The combine pass merges
 //! this frame's LOD buffer with last frame's. Pure math, no wgpu.
 //!
@@ -27,6 +29,40 @@ pub const ID_QUARANTINE_FRAMES: u64 = 2;
 pub struct InstanceKey {
     index: u32,
     generation: u32,
+}
+
+/// How the two LODs of a t-instance share the visibility texture over a transition.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Schedule {
+    /// The paper's Fig. 2: the incoming LOD appears over the first half while the outgoing stays
+    /// complete, then the outgoing vanishes over the second half. One LOD is always complete,
+    /// so the object's interior never shows what is behind it; at silhouettes, where only one
+    /// LOD covers a pixel, the change happens within one half of the transition.
+    #[default]
+    Paper,
+    /// Complementary: the incoming LOD shows the texels v <= progress, the outgoing the others
+    /// ([`visibility_threshold_complementary`](crate::visibility::visibility_threshold_complementary)).
+    /// The change at silhouettes is spread over the whole transition, like a dither; inside the
+    /// object, pixels whose two LOD samples are both shown or both hidden show their average.
+    Complementary,
+}
+
+impl Schedule {
+    /// Threshold tau of one LOD at `progress`.
+    ///
+    /// ```
+    /// # use lodkit::frame_sequential::Schedule;
+    /// assert_eq!(Schedule::Paper.threshold(0.25, false), 1.0);
+    /// assert_eq!(Schedule::Complementary.threshold(0.25, false), -0.75);
+    /// ```
+    pub fn threshold(self, progress: f32, incoming: bool) -> f32 {
+        match self {
+            Self::Paper => crate::visibility::visibility_threshold(progress, incoming),
+            Self::Complementary => {
+                crate::visibility::visibility_threshold_complementary(progress, incoming)
+            }
+        }
+    }
 }
 
 /// What drives a transition's progress.
@@ -54,7 +90,7 @@ pub enum ScheduleError {
     /// A duration that is not finite and positive.
     #[error("transition duration {0} s must be finite and > 0")]
     BadDuration(f32),
-    /// Every id in `1..=u32::MAX` is live or quarantined.
+    /// Every id in `1..=LOD_BUFFER_MAX_ID` (2^30 - 1) is live or quarantined.
     #[error("out of instance ids")]
     OutOfIds,
 }
@@ -66,8 +102,15 @@ pub struct FrameDraw {
     pub lod: u8,
     /// Instance id to write into the LOD buffer (0 for n-instances).
     pub id: u32,
-    /// Visibility threshold: keep fragments whose visibility texel is <= tau (1 = all).
+    /// Visibility threshold this frame
+    /// ([`visibility_shown`](crate::visibility::visibility_shown): 1 = all, 0 = none, negative =
+    /// the inverted pattern).
     pub tau: f32,
+    /// Visibility threshold of the same LOD in the next frame, when this frame's LOD buffer is
+    /// the older one (display-time visibility), from the progress the next frame is expected to
+    /// have: the last frame's time step for [`Drive::Time`], the last change continued for
+    /// [`Drive::Progress`].
+    pub tau_next: f32,
     /// Transition progress in [0, 1] (0 for n-instances).
     pub progress: f32,
     /// Whether this draw is the incoming LOD of a transition.
@@ -80,6 +123,10 @@ struct Transition {
     to: u8,
     id: u32,
     progress: f32,
+    /// Progress in the frame before.
+    previous: f32,
+    /// The caller's progress for the next frame (cleared by `advance`).
+    next: Option<f32>,
     drive: Drive,
     /// Frame the transition began: its phase.
     start: u64,
@@ -97,6 +144,9 @@ struct Slot {
 #[derive(Clone, Debug)]
 pub struct TransitionScheduler {
     frame: u64,
+    schedule: Schedule,
+    /// The time step of the last `advance`.
+    last_dt: f32,
     slots: Vec<Slot>,
     free_slots: Vec<u32>,
     next_id: u32,
@@ -114,11 +164,31 @@ impl TransitionScheduler {
     pub fn new() -> Self {
         Self {
             frame: 0,
+            schedule: Schedule::Paper,
+            last_dt: 0.0,
             slots: Vec::new(),
             free_slots: Vec::new(),
             next_id: 1,
             free_ids: Default::default(),
         }
+    }
+
+    /// The scheduler with visibility schedule `schedule` (the paper's Fig. 2 by default).
+    pub fn with_schedule(schedule: Schedule) -> Self {
+        Self {
+            schedule,
+            ..Self::new()
+        }
+    }
+
+    /// The visibility schedule.
+    pub fn schedule(&self) -> Schedule {
+        self.schedule
+    }
+
+    /// Changes the visibility schedule (running transitions follow it from this frame on).
+    pub fn set_schedule(&mut self, schedule: Schedule) {
+        self.schedule = schedule;
     }
 
     /// The current frame number (advanced by [`advance`](Self::advance)).
@@ -190,7 +260,7 @@ impl TransitionScheduler {
             self.free_ids.pop_front();
             return Ok(id);
         }
-        if self.next_id == 0 {
+        if self.next_id == 0 || self.next_id > crate::lod_buffer::LOD_BUFFER_MAX_ID {
             return Err(ScheduleError::OutOfIds);
         }
         let id = self.next_id;
@@ -226,6 +296,8 @@ impl TransitionScheduler {
             to,
             id,
             progress: 0.0,
+            previous: 0.0,
+            next: None,
             drive,
             start,
         });
@@ -251,12 +323,28 @@ impl TransitionScheduler {
         Ok(())
     }
 
+    /// Tells the scheduler the progress `key`'s transition will have next frame, when the caller
+    /// knows it (a transition driven by frame count, a scripted one): this frame's LOD is drawn
+    /// with the visibility it will have when it is shown as the older buffer. Without it the
+    /// next progress is predicted (the last time step, or the last change of progress), and the
+    /// first frame of a [`Drive::Progress`] transition predicts no change. Clamped to [0, 1]
+    /// (NaN is ignored); valid until the next [`advance`](Self::advance); no effect on instances
+    /// not in a transition.
+    pub fn set_next_progress(&mut self, key: InstanceKey, next: f32) -> Result<(), ScheduleError> {
+        let slot = self.slot_mut(key)?;
+        if let Some(t) = slot.transition.as_mut().filter(|_| !next.is_nan()) {
+            t.next = Some(next.clamp(0.0, 1.0));
+        }
+        Ok(())
+    }
+
     /// Starts the next frame: flips the parity, moves time-driven transitions on by `dt` seconds,
     /// and ends transitions that reached 1 (the instance becomes an n-instance at the new LOD and
     /// its id goes into quarantine).
     pub fn advance(&mut self, dt: f32) {
         self.frame += 1;
-        let dt = if dt > 0.0 { dt } else { 0.0 };
+        let dt = if dt > 0.0 && dt.is_finite() { dt } else { 0.0 };
+        self.last_dt = dt;
         let frame = self.frame;
         for slot in self.slots.iter_mut().filter(|s| s.live) {
             let Some(t) = slot.transition.as_mut() else {
@@ -268,6 +356,8 @@ impl TransitionScheduler {
                 slot.transition = None;
                 continue;
             }
+            t.previous = t.progress;
+            t.next = None;
             if let Drive::Time { seconds } = t.drive {
                 t.progress = (t.progress + dt / seconds).min(1.0);
             }
@@ -282,15 +372,22 @@ impl TransitionScheduler {
                 lod: slot.lod,
                 id: 0,
                 tau: 1.0,
+                tau_next: 1.0,
                 progress: 0.0,
                 incoming: false,
             },
             Some(t) => {
                 let incoming = (self.frame - t.start) % 2 == 1;
+                let next = match (t.next, t.drive) {
+                    (Some(next), _) => next,
+                    (None, Drive::Time { seconds }) => t.progress + self.last_dt / seconds,
+                    (None, Drive::Progress) => 2.0 * t.progress - t.previous,
+                };
                 FrameDraw {
                     lod: if incoming { t.to } else { t.from },
                     id: t.id,
-                    tau: crate::visibility::visibility_threshold(t.progress, incoming),
+                    tau: self.schedule.threshold(t.progress, incoming),
+                    tau_next: self.schedule.threshold(next.clamp(0.0, 1.0), incoming),
                     progress: t.progress,
                     incoming,
                 }

@@ -46,6 +46,30 @@ pub fn reproject_from_base(base: Vec4, depth: f32, new_to_old: &Mat4) -> Vec3 {
     Vec3::new(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5, p.z)
 }
 
+/// Reprojects the point on the ray of `base`'s pixel whose old clip depth is `old_depth` (read
+/// from the older buffer at the first estimate, the reprojection of `depth`): the older surface
+/// with its own parallax where the newer pixel shows another surface. Where no point of the ray
+/// has that old depth, the reprojection of `depth`.
+///
+/// ```
+/// # use lodkit::reproject::*;
+/// # use glam::{Vec2, Vec3};
+/// let p = glam::camera::rh::proj::directx::perspective(1.0, 1.0, 0.1, 100.0);
+/// let eye = |x| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 0.0, 5.0), Vec3::ZERO, Vec3::Y);
+/// let m = new_to_old_matrix(&eye(0.2), &p, &eye(0.0), &p);
+/// let base = reproject_base(Vec2::new(0.4, 0.5), &m);
+/// // A surface at old depth 0.98 along this pixel's ray: refining from a far first guess finds it.
+/// let want = reproject_from_base(base, 0.98, &m);
+/// let got = reproject_refine(base, 0.999, want.z, &m);
+/// assert!((got - want).abs().max_element() < 1e-4);
+/// ```
+pub fn reproject_refine(base: Vec4, depth: f32, old_depth: f32, new_to_old: &Mat4) -> Vec3 {
+    let c = new_to_old.z_axis;
+    let z = (old_depth * base.w - base.z) / (c.z - old_depth * c.w);
+    let solved = z.abs() <= 3.0e38;
+    reproject_from_base(base, if solved { z } else { depth }, new_to_old)
+}
+
 /// Whether `uv` lies inside the older buffer ([0, 1] on both axes).
 pub fn in_viewport(uv: Vec2) -> bool {
     uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all()

@@ -26,6 +26,47 @@ pub fn visibility_threshold(progress: f32, incoming: bool) -> f32 {
     crate::unpopping::unpopping_alpha(progress, incoming)
 }
 
+/// Threshold of one LOD under the complementary schedule: the incoming LOD shows the texels
+/// v <= progress, the outgoing LOD the others (tau = -(1 - progress), the inverted pattern of
+/// [`visibility_shown`]). Progress is clamped to [0, 1].
+///
+/// ```
+/// # use lodkit::visibility::{visibility_shown, visibility_threshold_complementary as c};
+/// assert_eq!((c(0.25, true), c(0.25, false)), (0.25, -0.75));
+/// // Every texel is shown by exactly one LOD.
+/// for v in [0.1f32, 0.3, 0.9] {
+///     assert_ne!(visibility_shown(v, c(0.25, true)), visibility_shown(v, c(0.25, false)));
+/// }
+/// ```
+pub fn visibility_threshold_complementary(progress: f32, incoming: bool) -> f32 {
+    let p = progress.clamp(0.0, 1.0);
+    if incoming { p } else { -(1.0 - p) }
+}
+
+/// Whether texel value `v` is shown at threshold `tau`: v <= tau for tau >= 0 (the paper's
+/// eq. 1); for tau < 0 the inverted pattern, v > 1 + tau. -0 counts as 0 (nothing shown).
+///
+/// ```
+/// # use lodkit::visibility::visibility_shown;
+/// assert!(visibility_shown(0.3, 0.5) && !visibility_shown(0.7, 0.5));
+/// assert!(!visibility_shown(0.3, -0.5) && visibility_shown(0.7, -0.5));
+/// assert!(!visibility_shown(0.5, -0.0) && visibility_shown(0.5, -1.0));
+/// ```
+pub fn visibility_shown(v: f32, tau: f32) -> bool {
+    if tau < 0.0 { v > 1.0 + tau } else { v <= tau }
+}
+
+/// Display-time visibility flags from texel value `v`: bit 0 shown at `tau_now`, bit 1 at
+/// `tau_next` (the Rust twin of `visibility_flags`, with the texel already looked up).
+///
+/// ```
+/// # use lodkit::visibility::visibility_flags_of;
+/// assert_eq!(visibility_flags_of(0.4, 0.3, 0.5), 0b10);
+/// ```
+pub fn visibility_flags_of(v: f32, tau_now: f32, tau_next: f32) -> u32 {
+    u32::from(visibility_shown(v, tau_now)) | (u32::from(visibility_shown(v, tau_next)) << 1)
+}
+
 /// A square visibility texture: `size` x `size` values in (0, 1), row-major (upload as R32Float
 /// or R8Unorm/R16Unorm).
 #[derive(Clone, Debug, PartialEq)]
@@ -112,8 +153,18 @@ impl VisibilityTexture {
     }
 }
 
-/// Whether a fragment at `object_pos` is kept for threshold `tau` (texel <= tau): the Rust twin
-/// of `check_visibility`, with the texture given as data.
+/// Whether a fragment at `object_pos` is kept for threshold `tau` ([`visibility_shown`]): the
+/// Rust twin of `check_visibility`, with the texture given as data.
 pub fn check_visibility(vis_tex: &VisibilityTexture, object_pos: Vec3, tau: f32) -> bool {
-    vis_tex.lookup(object_pos) <= tau
+    visibility_shown(vis_tex.lookup(object_pos), tau)
+}
+
+/// Display-time flags of a fragment at `object_pos` (the Rust twin of `visibility_flags`).
+pub fn visibility_flags(
+    vis_tex: &VisibilityTexture,
+    object_pos: Vec3,
+    tau_now: f32,
+    tau_next: f32,
+) -> u32 {
+    visibility_flags_of(vis_tex.lookup(object_pos), tau_now, tau_next)
 }

@@ -198,7 +198,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     };
     let scenes = DemoScene::built_in();
     let report = run_on(gpu, &options, &scenes).unwrap();
-    assert_eq!(report.transitions.len(), scenes.len() * 7);
+    assert_eq!(report.transitions.len(), scenes.len() * 8);
     for scene in &scenes {
         let row = |name: &str| {
             report
@@ -221,7 +221,11 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             assert_eq!(r.see_through, 0.0, "{name} in {}", scene.name);
             assert!(r.pop_static < 0.6, "{name} pops: {}", r.pop_static);
         }
-        for name in ["frame-seq-white-noise", "frame-seq-blue-noise"] {
+        for name in [
+            "frame-seq-white-noise",
+            "frame-seq-blue-noise",
+            "frame-seq-complementary",
+        ] {
             let r = row(name);
             assert!(r.see_through < 0.02, "{name}: {}", r.see_through);
             // One LOD per object per frame (the paper's point), never both.

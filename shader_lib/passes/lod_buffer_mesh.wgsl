@@ -2,9 +2,12 @@
 // engine adds to its forward shader (Scherzer & Wimmer 2008, sec. 4.1).
 //
 // The vertex stage passes the object-space position on (before any animation, so the visibility
-// pattern sticks to the object); the fragment stage discards t-instance fragments whose
-// visibility texel exceeds tau (lodkit::visibility) and writes color and id/depth
-// (lodkit::lod_buffer). n-instances use id 0 and tau 1.
+// pattern sticks to the object). The fragment stage keeps every fragment of a t-instance and
+// flags, in the id word, whether it is shown at tau (this frame) and at tau_next (the next frame,
+// when this buffer is the older one) (lodkit::visibility::visibility_flags): the combine pass
+// then shows each LOD with its visibility at the frame displayed, so its share changes every
+// frame, and a sample hidden in its buffer never leaves a hole where the other buffer has none.
+// n-instances use id 0 (always shown).
 //
 // Entry points:
 //   vs_main   @location(0) position, @location(1) normal (object space)
@@ -12,8 +15,8 @@
 // Bindings: group 0: 0 `camera: Camera` (uniform), 1 `vis_tex: texture_2d<f32>`;
 //   group 1: 0 `draw: LodDraw` (uniform, dynamic offset).
 // Shader defs: none.
-#import lodkit::visibility::check_visibility
-#import lodkit::lod_buffer::{LodBufferOutput, lod_buffer_output}
+#import lodkit::visibility::visibility_flags
+#import lodkit::lod_buffer::{LodBufferOutput, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT, lod_buffer_output_flags}
 
 /// Per-view data.
 struct Camera {
@@ -28,11 +31,12 @@ struct LodDraw {
     color: vec4<f32>,
     /// 0 for n-instances.
     instance_id: u32,
-    /// Visibility threshold (1 keeps every fragment).
+    /// Visibility threshold this frame (lodkit::visibility::visibility_shown).
     tau: f32,
     /// Visibility texture repeats per object-space unit.
     vis_scale: f32,
-    _pad: f32,
+    /// Visibility threshold of the same LOD in the next frame.
+    tau_next: f32,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -52,13 +56,14 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
     return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz, position);
 }
 
-/// Visibility test, Lambert shading, LOD buffer output.
+/// Display-time visibility flags, Lambert shading, LOD buffer output.
 @fragment
 fn fs_main(in: VertexOut) -> LodBufferOutput {
-    if (draw.tau < 1.0 && !check_visibility(vis_tex, in.object_pos * draw.vis_scale, draw.tau)) {
-        discard;
+    var flags = LOD_BUFFER_SHOWN_NOW | LOD_BUFFER_SHOWN_NEXT;
+    if (draw.instance_id != 0u) {
+        flags = visibility_flags(vis_tex, in.object_pos * draw.vis_scale, draw.tau, draw.tau_next);
     }
     let lambert = max(dot(normalize(in.normal), normalize(camera.light_dir.xyz)), 0.0);
     let color = vec4<f32>(draw.color.rgb * (0.35 + 0.65 * lambert), 1.0);
-    return lod_buffer_output(color, draw.instance_id, in.position.z);
+    return lod_buffer_output_flags(color, draw.instance_id, in.position.z, flags);
 }

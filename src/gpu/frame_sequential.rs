@@ -288,7 +288,16 @@ pub fn read_lod_image(
             .chunks(4)
             .map(|c| glam::Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
             .collect(),
-        ids: words.iter().step_by(2).copied().collect(),
+        ids: words
+            .iter()
+            .step_by(2)
+            .map(|w| crate::lod_buffer::lod_buffer_id([*w, 0]))
+            .collect(),
+        flags: words
+            .iter()
+            .step_by(2)
+            .map(|w| crate::lod_buffer::lod_buffer_flags([*w, 0]))
+            .collect(),
         depths: words
             .iter()
             .skip(1)

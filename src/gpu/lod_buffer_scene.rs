@@ -12,6 +12,7 @@ use super::resources::{
 use super::scene::{CameraUniform, GpuMesh};
 use super::{GpuContext, GpuError};
 use crate::combine::DepthConvention;
+use crate::frame_sequential::FrameDraw;
 use crate::lod_buffer::ID_DEPTH_FORMAT;
 use crate::visibility::VisibilityTexture;
 
@@ -25,12 +26,12 @@ pub struct LodDrawUniform {
     pub color: [f32; 4],
     /// 0 for n-instances.
     pub instance_id: u32,
-    /// Visibility threshold.
+    /// Visibility threshold this frame.
     pub tau: f32,
     /// Visibility texture repeats per object-space unit.
     pub vis_scale: f32,
-    /// Padding.
-    pub pad: f32,
+    /// Visibility threshold of the same LOD in the next frame.
+    pub tau_next: f32,
 }
 
 /// One draw into a LOD buffer.
@@ -42,10 +43,34 @@ pub struct LodDrawItem<'a> {
     pub model: Mat4,
     /// Base color.
     pub color: Vec4,
-    /// Instance id (0 = n-instance).
+    /// Instance id (0 = n-instance, always shown).
     pub id: u32,
-    /// Visibility threshold (1 = every fragment).
+    /// Visibility threshold this frame ([`visibility_shown`](crate::visibility::visibility_shown):
+    /// 1 shows every fragment, 0 none, negative the inverted pattern).
     pub tau: f32,
+    /// Visibility threshold of the same LOD in the next frame, when this buffer is the older one.
+    pub tau_next: f32,
+}
+
+impl<'a> LodDrawItem<'a> {
+    /// The draw the scheduler asks for: `mesh` is the mesh of LOD `draw.lod`.
+    pub fn from_draw(mesh: &'a GpuMesh, model: Mat4, color: Vec4, draw: &FrameDraw) -> Self {
+        Self {
+            mesh,
+            model,
+            color,
+            id: draw.id,
+            tau: draw.tau,
+            tau_next: draw.tau_next,
+        }
+    }
+
+    /// Whether the draw can show a fragment: n-instances always; a t-instance when tau or
+    /// tau_next is neither 0 nor NaN.
+    pub fn shows_anything(&self) -> bool {
+        let shows = |tau: f32| tau != 0.0 && !tau.is_nan();
+        self.id == 0 || shows(self.tau) || shows(self.tau_next)
+    }
 }
 
 /// Draws [`LodDrawItem`]s into one buffer of a [`LodBuffers`] pair, in standard or reversed Z.
@@ -149,8 +174,10 @@ impl LodBufferRenderer {
 
     /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers`, cleared to
     /// `clear`, counting the pass's fragments with `counter` if given. Returns the triangles
-    /// drawn and the count (0 without a counter). An item whose tau is not above 0 keeps no
-    /// fragment (visibility texels lie strictly between 0 and 1), so it is not submitted.
+    /// drawn and the count (0 without a counter). A t-instance item shown in neither this frame
+    /// nor the next (tau and tau_next 0 or NaN: visibility texels lie strictly between 0 and 1)
+    /// is not submitted. Every fragment of a t-instance is kept and flagged (see
+    /// `passes/lod_buffer_mesh.wgsl`).
     #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
@@ -180,7 +207,7 @@ impl LodBufferRenderer {
                     instance_id: item.id,
                     tau: item.tau,
                     vis_scale: self.vis_scale,
-                    pad: 0.0,
+                    tau_next: item.tau_next,
                 })
                 .collect();
             self.draws.write(gpu, &uniforms)?;
@@ -198,7 +225,11 @@ impl LodBufferRenderer {
                 }
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.camera_group, &[]);
-                for (i, item) in items.iter().enumerate().filter(|(_, item)| item.tau > 0.0) {
+                for (i, item) in items
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, item)| item.shows_anything())
+                {
                     pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                     item.mesh.draw(&mut pass);
                     triangles += u64::from(item.mesh.triangles());

@@ -5,7 +5,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::scene::DemoScene;
 use lodkit::combine::{DepthConvention, PixelSource, combine_images};
-use lodkit::frame_sequential::{Drive, TransitionScheduler};
+use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::counters::FragmentCounter;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
@@ -24,29 +24,37 @@ use lodkit::visibility::{VisibilityPattern, visibility_texture};
 pub enum Technique {
     /// A single-frame technique.
     Single(SingleFrameTechnique),
-    /// Frame-sequential interpolation with a visibility pattern.
-    FrameSequential(VisibilityPattern),
+    /// Frame-sequential interpolation with a visibility pattern and schedule.
+    FrameSequential(VisibilityPattern, Schedule),
 }
 
 impl Technique {
     /// Every technique the harness compares.
-    pub const ALL: [Technique; 7] = [
+    pub const ALL: [Technique; 8] = [
         Technique::Single(SingleFrameTechnique::HardSwitch),
         Technique::Single(SingleFrameTechnique::CrossFade),
         Technique::Single(SingleFrameTechnique::Dither(DitherPattern::Bayer4x4)),
         Technique::Single(SingleFrameTechnique::Dither(DitherPattern::BlueNoise16x16)),
         Technique::Single(SingleFrameTechnique::Unpopping),
-        Technique::FrameSequential(VisibilityPattern::WhiteNoise),
-        Technique::FrameSequential(VisibilityPattern::BlueNoise),
+        Technique::FrameSequential(VisibilityPattern::WhiteNoise, Schedule::Paper),
+        Technique::FrameSequential(VisibilityPattern::BlueNoise, Schedule::Paper),
+        Technique::FrameSequential(VisibilityPattern::BlueNoise, Schedule::Complementary),
     ];
 
     /// Short name for tables and file names.
     pub fn name(self) -> &'static str {
         match self {
             Technique::Single(t) => t.name(),
-            Technique::FrameSequential(VisibilityPattern::WhiteNoise) => "frame-seq-white-noise",
-            Technique::FrameSequential(VisibilityPattern::BlueNoise) => "frame-seq-blue-noise",
-            Technique::FrameSequential(VisibilityPattern::Radial) => "frame-seq-radial",
+            Technique::FrameSequential(p, Schedule::Paper) => match p {
+                VisibilityPattern::WhiteNoise => "frame-seq-white-noise",
+                VisibilityPattern::BlueNoise => "frame-seq-blue-noise",
+                VisibilityPattern::Radial => "frame-seq-radial",
+            },
+            Technique::FrameSequential(p, Schedule::Complementary) => match p {
+                VisibilityPattern::WhiteNoise => "frame-seq-compl-white-noise",
+                VisibilityPattern::BlueNoise => "frame-seq-complementary",
+                VisibilityPattern::Radial => "frame-seq-compl-radial",
+            },
         }
     }
 }
@@ -225,8 +233,8 @@ impl<'a> SceneRenderer<'a> {
                 }
                 Ok(())
             }
-            Technique::FrameSequential(p) => {
-                self.run_frame_sequential(gpu, p, spec, wanted, on_frame, on_sources)
+            Technique::FrameSequential(p, schedule) => {
+                self.run_frame_sequential(gpu, (p, schedule), spec, wanted, on_frame, on_sources)
             }
         }
     }
@@ -297,14 +305,14 @@ impl<'a> SceneRenderer<'a> {
     fn run_frame_sequential(
         &self,
         gpu: &GpuContext,
-        pattern: VisibilityPattern,
+        (pattern, schedule): (VisibilityPattern, Schedule),
         spec: RunSpec,
         wanted: &dyn Fn(usize) -> bool,
         on_frame: &mut dyn FnMut(usize, Frame),
         mut on_sources: Option<&mut dyn FnMut(Vec<PixelSource>)>,
     ) -> Result<(), GpuError> {
         let renderer = &self.lod_buffer[usize::from(pattern == VisibilityPattern::BlueNoise)];
-        let mut scheduler = TransitionScheduler::new();
+        let mut scheduler = TransitionScheduler::with_schedule(schedule);
         let keys: Vec<_> = self
             .scene
             .objects
@@ -333,6 +341,7 @@ impl<'a> SceneRenderer<'a> {
                 }
                 if frame >= LEAD_FRAMES {
                     let _ = scheduler.set_progress(*key, self.progress(frame));
+                    let _ = scheduler.set_next_progress(*key, self.progress(frame + 1));
                 }
             }
             let (view, proj) = self.camera(frame, spec.moving);
@@ -342,13 +351,12 @@ impl<'a> SceneRenderer<'a> {
                 .filter_map(|(i, key)| {
                     let d = scheduler.draw(*key).ok()?;
                     let lod = usize::from(d.lod.min(1));
-                    Some(LodDrawItem {
-                        mesh: &self.meshes[i][lod],
-                        model: self.scene.model(i),
-                        color: self.object_color(i, lod, spec.background),
-                        id: d.id,
-                        tau: d.tau,
-                    })
+                    Some(LodDrawItem::from_draw(
+                        &self.meshes[i][lod],
+                        self.scene.model(i),
+                        self.object_color(i, lod, spec.background),
+                        &d,
+                    ))
                 })
                 .collect();
             let index = scheduler.buffer_index();

@@ -229,6 +229,7 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
                 color: Vec4::new(0.8, 0.2, 0.2, 1.0),
                 id: if k % 3 == 0 { k as u32 + 1 } else { 0 },
                 tau: if k % 3 == 0 { 0.5 } else { 1.0 },
+                tau_next: if k % 3 == 0 { 0.55 } else { 1.0 },
             })
             .collect();
         renderer.render(

@@ -144,7 +144,7 @@ fn transition_run(
     let mut failed = None;
     let mut sources = None;
     let mut on_sources = |s| sources = Some(s);
-    let frame_sequential = matches!(technique, Technique::FrameSequential(_));
+    let frame_sequential = matches!(technique, Technique::FrameSequential(..));
     renderer.run(
         gpu,
         spec,
@@ -264,7 +264,7 @@ pub fn measure_scene(
     let mut references: Option<(bool, [Vec<Vec<u8>>; 2])> = None;
     for technique in Technique::ALL {
         let name = technique.name();
-        let family = matches!(technique, Technique::FrameSequential(_));
+        let family = matches!(technique, Technique::FrameSequential(..));
         if references.as_ref().is_none_or(|(f, _)| *f != family) {
             drop(references.take()); // frees the other family's frames first
             let run = |moving| reference_run(gpu, renderer, technique, moving);

@@ -6,6 +6,8 @@
 // Exports:
 //   lodkit_LodSample { color, id, depth }
 //   lodkit_combine_samples(newer, older) -> vec4
+//   lodkit_combine_shown(newer, newer_shown, older, older_shown) -> vec4   exactly one shown: it;
+//       both or neither: lodkit_combine_samples
 //   lodkit_depth_closer(a, b) -> bool
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z).
@@ -40,6 +42,14 @@ vec4 lodkit_combine_samples(lodkit_LodSample newer, lodkit_LodSample older) {
         return older.color;
     }
     return newer.color;
+}
+
+/// lodkit_combine_samples with display-time visibility.
+vec4 lodkit_combine_shown(lodkit_LodSample newer, bool newer_shown, lodkit_LodSample older, bool older_shown) {
+    if (newer_shown != older_shown) {
+        return newer_shown ? newer.color : older.color;
+    }
+    return lodkit_combine_samples(newer, older);
 }
 
 #endif // LODKIT_COMBINE_GLSL

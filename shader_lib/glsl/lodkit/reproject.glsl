@@ -9,6 +9,8 @@
 //   lodkit_reproject_base(uv, new_to_old) -> vec4   depth-independent part, linear in uv
 //   lodkit_reproject_from_base(base, depth, new_to_old) -> vec3   reproject() given that part
 //   lodkit_in_viewport(uv) -> bool
+//   lodkit_reproject_refine(base, depth, old_depth, new_to_old) -> vec3   the point on the pixel's
+//       ray at old depth old_depth, reprojected (the first estimate where there is none)
 // Shader defs: none.
 #ifndef LODKIT_REPROJECT_GLSL
 #define LODKIT_REPROJECT_GLSL
@@ -36,6 +38,15 @@ vec3 lodkit_reproject(vec2 uv, float depth, mat4 new_to_old) {
 /// Whether `uv` lies inside the older buffer ([0, 1] on both axes).
 bool lodkit_in_viewport(vec2 uv) {
     return all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+}
+
+/// Reprojects the point on this pixel's ray whose old clip depth is `old_depth` (the first
+/// estimate, `depth`, where there is none).
+vec3 lodkit_reproject_refine(vec4 base, float depth, float old_depth, mat4 new_to_old) {
+    vec4 c = new_to_old[2];
+    float z = (old_depth * base.w - base.z) / (c.z - old_depth * c.w);
+    bool solved = abs(z) <= 3.0e38;
+    return lodkit_reproject_from_base(base, solved ? z : depth, new_to_old);
 }
 
 #endif // LODKIT_REPROJECT_GLSL

@@ -13,6 +13,10 @@
 //                                                 vertex stage can compute it and let it interpolate
 //   reproject_from_base(base, depth, new_to_old) -> vec3<f32>   reproject() given that part
 //   in_viewport(uv) -> bool   whether an old uv lies inside the older buffer
+//   reproject_refine(base, depth, old_depth, new_to_old) -> vec3<f32>   the point on the same
+//       pixel's ray whose old depth is old_depth (the older buffer's depth at the first estimate),
+//       reprojected: finds the older surface where a stipple hole or an edge gave the newer
+//       pixel another surface's depth; the first estimate where the ray never has that depth
 // Shader defs: none (LODKIT_REVERSE_Z matters only where depths are compared: lodkit::combine).
 #define_import_path lodkit::reproject
 
@@ -42,4 +46,17 @@ fn reproject(uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>) -> vec3<f32> {
 /// Whether `uv` lies inside the older buffer ([0, 1] on both axes).
 fn in_viewport(uv: vec2<f32>) -> bool {
     return all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0));
+}
+
+/// Reprojects the point on this pixel's ray (`base` = reproject_base) whose old clip depth is
+/// `old_depth`: with `old_depth` read from the older buffer at reproject_from_base(base, depth),
+/// a second fetch there finds the older surface itself, with its own parallax, where the newer
+/// pixel shows another surface (a stipple hole, an edge). Where no point of the ray has that old
+/// depth, the reprojection of `depth` itself.
+fn reproject_refine(base: vec4<f32>, depth: f32, old_depth: f32, new_to_old: mat4x4<f32>) -> vec3<f32> {
+    // old.z / old.w = old_depth along base + z * column 2, solved for z.
+    let c = new_to_old[2];
+    let z = (old_depth * base.w - base.z) / (c.z - old_depth * c.w);
+    let solved = abs(z) <= 3.0e38;
+    return reproject_from_base(base, select(depth, z, solved), new_to_old);
 }

@@ -13,6 +13,13 @@
 //                                                      outgoing 1 -> 0 over the second
 //   visibility_texel(size, object_pos) -> vec2<u32>   texel looked up (repeat addressing, nearest)
 //   check_visibility(vis_tex, object_pos, tau) -> bool   true = keep the fragment
+//   visibility_shown(v, tau) -> bool   texel v shown at tau: v <= tau; for tau < 0 the inverted
+//                                      pattern, v > 1 + tau (-0 counts as 0)
+//   visibility_threshold_complementary(progress, incoming) -> f32   the complementary schedule:
+//       incoming progress (v <= p), outgoing -(1 - progress) (v > p)
+//   visibility_flags_of(v, tau_now, tau_next) -> u32   the flags from a looked-up texel value
+//   visibility_flags(vis_tex, object_pos, tau_now, tau_next) -> u32   display-time visibility of
+//       a fragment: bit 0 shown at tau_now (the frame rendered), bit 1 at tau_next (the next frame)
 // The texture repeats once per object-space unit: scale object_pos to change the pattern's size.
 // Shader defs: none.
 #define_import_path lodkit::visibility
@@ -37,9 +44,44 @@ fn visibility_texel(size: vec2<u32>, object_pos: vec3<f32>) -> vec2<u32> {
     return min(vec2<u32>(uv * vec2<f32>(size)), size - vec2<u32>(1u));
 }
 
+/// Whether texel value `v` is shown at threshold `tau`: v <= tau for tau >= 0 (eq. 1); for
+/// tau < 0 the inverted pattern, v > 1 + tau, which the complementary schedule gives the outgoing
+/// LOD. -0 counts as 0 (nothing shown), so both ends of a schedule are exact.
+fn visibility_shown(v: f32, tau: f32) -> bool {
+    if (tau < 0.0) {
+        return v > 1.0 + tau;
+    }
+    return v <= tau;
+}
+
+/// Visibility threshold of one LOD under the complementary schedule: the incoming LOD shows the
+/// texels v <= progress, the outgoing LOD the others (tau = -(1 - progress), the inverted
+/// pattern). Spreads the change at silhouettes over the whole transition; no LOD is complete
+/// in between (see docs/frame-sequential.md).
+fn visibility_threshold_complementary(progress: f32, incoming: bool) -> f32 {
+    let p = clamp(progress, 0.0, 1.0);
+    if (incoming) {
+        return p;
+    }
+    return -(1.0 - p);
+}
+
+/// Display-time flags from texel value `v`: bit 0 shown at `tau_now`, bit 1 at `tau_next`.
+fn visibility_flags_of(v: f32, tau_now: f32, tau_next: f32) -> u32 {
+    return u32(visibility_shown(v, tau_now)) | (u32(visibility_shown(v, tau_next)) << 1u);
+}
+
 /// Whether to keep a fragment at object-space position `object_pos` for threshold `tau`: keeps
-/// it where the texel (repeat addressing, nearest) is at most tau.
+/// it where the texel (repeat addressing, nearest) is shown at tau (visibility_shown).
 fn check_visibility(vis_tex: texture_2d<f32>, object_pos: vec3<f32>, tau: f32) -> bool {
     let texel = visibility_texel(textureDimensions(vis_tex, 0), object_pos);
-    return textureLoad(vis_tex, texel, 0).r <= tau;
+    return visibility_shown(textureLoad(vis_tex, texel, 0).r, tau);
+}
+
+/// Display-time visibility flags of a fragment: bit 0 set when it is shown at `tau_now` (the
+/// frame being rendered), bit 1 at `tau_next` (the next frame, when this LOD buffer is the older
+/// one). Write them with lodkit::lod_buffer::lod_buffer_output_flags.
+fn visibility_flags(vis_tex: texture_2d<f32>, object_pos: vec3<f32>, tau_now: f32, tau_next: f32) -> u32 {
+    let texel = visibility_texel(textureDimensions(vis_tex, 0), object_pos);
+    return visibility_flags_of(textureLoad(vis_tex, texel, 0).r, tau_now, tau_next);
 }

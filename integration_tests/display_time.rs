@@ -1,0 +1,350 @@
+//! Display-time visibility of frame-sequential LOD: the flag functions of `lodkit::visibility`,
+//! `lodkit::lod_buffer` and `lodkit::combine` on the GPU (WGSL and GLSL twins) against their Rust
+//! twins, and whole transitions through the LOD pass and the combine pass, where the share of
+//! each LOD must follow its schedule on every frame.
+
+use glam::{Mat4, Vec3, Vec4};
+use lodkit::combine::{DepthConvention, LodSample, combine_shown};
+use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
+use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::readback::read_texture_rgba8;
+use lodkit::gpu::scene::{GpuMesh, Mesh};
+use lodkit::lod_buffer::{
+    LOD_BUFFER_MAX_ID, LOD_BUFFER_SHOWN_NEXT, LOD_BUFFER_SHOWN_NOW, lod_buffer_flags,
+    lod_buffer_id, lod_buffer_id_depth_flags, lod_buffer_shown,
+};
+use lodkit::reproject::new_to_old_matrix;
+use lodkit::shaders::SourceLanguage;
+use lodkit::visibility::{
+    VisibilityPattern, check_visibility, visibility_flags, visibility_texture,
+    visibility_threshold_complementary,
+};
+
+use crate::harness::{Probe, floats, run_with, say, words};
+
+const GLSL: SourceLanguage = SourceLanguage::Glsl(naga::ShaderStage::Compute);
+
+#[test]
+fn visibility_flags_twins_match_with_a_real_texture() {
+    let gpu = lodkit_test_gpu!();
+    let tex = visibility_texture(VisibilityPattern::BlueNoise, 64, 5);
+    // (position, tau_now, tau_next, progress): both signs of tau, -0, the ends of a schedule.
+    let points: Vec<Vec3> = lodkit::noise::white_noise(3 * 60, 4)
+        .chunks(3)
+        .map(|c| Vec3::new(c[0] * 4.0 - 2.0, c[1] * 4.0 - 2.0, c[2] * 4.0 - 2.0))
+        .collect();
+    let taus = [
+        (0.3f32, 0.35f32),
+        (-0.6, -0.55),
+        (1.0, -0.0),
+        (-1.0, 0.0),
+        (0.5, -0.5),
+    ];
+    let cases: Vec<(Vec3, f32, f32, f32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (a, b) = taus[i % taus.len()];
+            (*p, a, b, (i as f32 * 0.07) % 1.2 - 0.1)
+        })
+        .collect();
+    let inputs: Vec<u32> = cases
+        .iter()
+        .flat_map(|(p, a, b, q)| words(&[p.x, p.y, p.z, *a, *b, *q]))
+        .collect();
+    let want: Vec<u32> = cases
+        .iter()
+        .flat_map(|(p, a, b, q)| {
+            [
+                visibility_flags(&tex, *p, *a, *b),
+                u32::from(check_visibility(&tex, *p, *a)),
+                visibility_threshold_complementary(*q, true).to_bits(),
+                visibility_threshold_complementary(*q, false).to_bits(),
+            ]
+        })
+        .collect();
+    let wgsl = "let p = vec3(inp_f(0u), inp_f(1u), inp_f(2u));
+        out_u(0u, visibility_flags(probe_tex, p, inp_f(3u), inp_f(4u)));
+        out_u(1u, u32(check_visibility(probe_tex, p, inp_f(3u))));
+        out_f(2u, visibility_threshold_complementary(inp_f(5u), true));
+        out_f(3u, visibility_threshold_complementary(inp_f(5u), false));";
+    let glsl = "vec3 p = vec3(inp_f(0u), inp_f(1u), inp_f(2u));
+        out_u(0u, lodkit_visibility_flags(sampler2D(probe_tex, probe_sampler), p, inp_f(3u), inp_f(4u)));
+        out_u(1u, uint(lodkit_check_visibility(sampler2D(probe_tex, probe_sampler), p, inp_f(3u))));
+        out_f(2u, lodkit_visibility_threshold_complementary(inp_f(5u), true));
+        out_f(3u, lodkit_visibility_threshold_complementary(inp_f(5u), false));";
+    for (language, header, body) in [
+        (
+            SourceLanguage::Wgsl,
+            "#import lodkit::visibility::{visibility_flags, check_visibility, visibility_threshold_complementary}",
+            wgsl,
+        ),
+        (GLSL, "#include \"lodkit/visibility.glsl\"", glsl),
+    ] {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 6,
+            outputs: 4,
+            texture: Some((64, &tex.texels)),
+            rgba: &[],
+        };
+        let got = run_with(gpu, &probe, &inputs, language, &[]);
+        assert_eq!(got, want, "{language:?} visibility flags");
+    }
+    // Hand-derived: every flag combination occurs, and the complementary thresholds split the
+    // texels between the two LODs.
+    let seen = want.chunks(4).fold(0u32, |m, w| m | (1 << w[0]));
+    assert_eq!(seen, 0b1111, "flags 0..=3 all occur: {seen:b}");
+    for v in [0.01f32, 0.3, 0.5, 0.99] {
+        for p in [0.0f32, 0.25, 0.5, 1.0] {
+            let shown = |incoming| {
+                lodkit::visibility::visibility_shown(
+                    v,
+                    visibility_threshold_complementary(p, incoming),
+                )
+            };
+            assert_ne!(shown(true), shown(false), "v {v} at progress {p}");
+        }
+    }
+}
+
+#[test]
+fn lod_buffer_flags_and_combine_shown_twins_match() {
+    let gpu = lodkit_test_gpu!();
+    let sample = |c: f32, id, depth| LodSample {
+        color: Vec4::new(c, 1.0 - c, 0.25, 1.0),
+        id,
+        depth,
+    };
+    // (id, flags, newer, newer shown, older, older shown)
+    let cases = [
+        (
+            7u32,
+            1u32,
+            sample(0.9, 7, 0.5),
+            true,
+            sample(0.1, 7, 0.2),
+            false,
+        ),
+        (7, 2, sample(0.9, 7, 0.5), false, sample(0.1, 7, 0.2), true),
+        (0, 0, sample(0.9, 7, 0.5), false, sample(0.1, 7, 0.2), false),
+        (
+            LOD_BUFFER_MAX_ID,
+            3,
+            sample(0.9, 5, 0.6),
+            true,
+            sample(0.1, 0, 0.3),
+            true,
+        ),
+        (
+            LOD_BUFFER_MAX_ID + 9,
+            0,
+            sample(0.9, 0, 0.6),
+            true,
+            sample(0.1, 9, 0.3),
+            false,
+        ),
+        (
+            1 << 20,
+            2,
+            sample(0.9, 9, 0.2),
+            false,
+            sample(0.1, 0, 0.3),
+            true,
+        ),
+    ];
+    let inputs: Vec<u32> = cases
+        .iter()
+        .flat_map(|(id, flags, n, ns, o, os)| {
+            let mut w = vec![*id, *flags];
+            w.extend(words(&n.color.to_array()));
+            w.extend([n.id, n.depth.to_bits(), u32::from(*ns)]);
+            w.extend(words(&o.color.to_array()));
+            w.extend([o.id, o.depth.to_bits(), u32::from(*os)]);
+            w
+        })
+        .collect();
+    let want: Vec<u32> = cases
+        .iter()
+        .flat_map(|(id, flags, n, ns, o, os)| {
+            let t = lod_buffer_id_depth_flags(*id, 0.25, *flags);
+            let mut w = vec![
+                t[0],
+                lod_buffer_id(t),
+                lod_buffer_flags(t),
+                u32::from(lod_buffer_shown(t, LOD_BUFFER_SHOWN_NOW)),
+                u32::from(lod_buffer_shown(t, LOD_BUFFER_SHOWN_NEXT)),
+            ];
+            w.extend(words(
+                &combine_shown(*n, *ns, *o, *os, DepthConvention::Standard).to_array(),
+            ));
+            w
+        })
+        .collect();
+    let wgsl = "let t = lod_buffer_output_flags(vec4(0.0), inp_u(0u), 0.25, inp_u(1u)).id_depth;
+        out_u(0u, t.x); out_u(1u, lod_buffer_id(t)); out_u(2u, lod_buffer_flags(t));
+        out_u(3u, u32(lod_buffer_shown(t, LOD_BUFFER_SHOWN_NOW)));
+        out_u(4u, u32(lod_buffer_shown(t, LOD_BUFFER_SHOWN_NEXT)));
+        let n = LodSample(vec4(inp_f(2u), inp_f(3u), inp_f(4u), inp_f(5u)), inp_u(6u), inp_f(7u));
+        let o = LodSample(vec4(inp_f(9u), inp_f(10u), inp_f(11u), inp_f(12u)), inp_u(13u), inp_f(14u));
+        let c = combine_shown(n, inp_u(8u) != 0u, o, inp_u(15u) != 0u);
+        out_f(5u, c.x); out_f(6u, c.y); out_f(7u, c.z); out_f(8u, c.w);";
+    let glsl = "uvec2 t = lodkit_lod_buffer_output_flags(vec4(0.0), inp_u(0u), 0.25, inp_u(1u)).id_depth;
+        out_u(0u, t.x); out_u(1u, lodkit_lod_buffer_id(t)); out_u(2u, lodkit_lod_buffer_flags(t));
+        out_u(3u, uint(lodkit_lod_buffer_shown(t, LODKIT_LOD_BUFFER_SHOWN_NOW)));
+        out_u(4u, uint(lodkit_lod_buffer_shown(t, LODKIT_LOD_BUFFER_SHOWN_NEXT)));
+        lodkit_LodSample n = lodkit_LodSample(vec4(inp_f(2u), inp_f(3u), inp_f(4u), inp_f(5u)), inp_u(6u), inp_f(7u));
+        lodkit_LodSample o = lodkit_LodSample(vec4(inp_f(9u), inp_f(10u), inp_f(11u), inp_f(12u)), inp_u(13u), inp_f(14u));
+        vec4 c = lodkit_combine_shown(n, inp_u(8u) != 0u, o, inp_u(15u) != 0u);
+        out_f(5u, c.x); out_f(6u, c.y); out_f(7u, c.z); out_f(8u, c.w);";
+    for (language, header, body) in [
+        (
+            SourceLanguage::Wgsl,
+            "#import lodkit::lod_buffer::{lod_buffer_output_flags, lod_buffer_id, lod_buffer_flags, lod_buffer_shown, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT}\n#import lodkit::combine::{LodSample, combine_shown}",
+            wgsl,
+        ),
+        (
+            GLSL,
+            "#include \"lodkit/lod_buffer.glsl\"\n#include \"lodkit/combine.glsl\"",
+            glsl,
+        ),
+    ] {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 16,
+            outputs: 9,
+            texture: None,
+            rgba: &[],
+        };
+        let got = run_with(gpu, &probe, &inputs, language, &[]);
+        assert_eq!(got, want, "{language:?} lod buffer flags and combine_shown");
+    }
+    // Hand-derived: ids up to 2^30 - 1 survive, the flags sit above them, id 0 is always shown,
+    // and a shown sample wins over a hidden one whatever the depths.
+    let w: Vec<&[u32]> = want.chunks(9).collect();
+    assert_eq!((w[3][1], w[3][2]), (LOD_BUFFER_MAX_ID, 3));
+    assert_eq!(w[4][1], 8, "an id past 2^30 - 1 keeps its low 30 bits");
+    assert_eq!((w[5][1], w[5][2], w[5][3], w[5][4]), (1 << 20, 2, 0, 1));
+    assert_eq!((w[2][3], w[2][4]), (1, 1), "id 0 is shown in both frames");
+    let color = |i: usize| Vec4::from_slice(&floats(&w[i][5..9]));
+    assert_eq!(color(0), cases[0].2.color, "only the newer is shown");
+    assert_eq!(color(1), cases[1].4.color, "only the older is shown");
+    assert_eq!(
+        color(2),
+        0.5 * (cases[2].2.color + cases[2].4.color),
+        "neither shown: the paper's rule (same id: average)"
+    );
+}
+
+/// Blue share b / (r + b) of the object's pixels (LOD 0 pure red, LOD 1 pure blue, so lighting
+/// cancels) and the number of object pixels.
+fn blue_share(pixels: &[u8]) -> (f32, usize) {
+    let object: Vec<(f32, f32)> = pixels
+        .chunks(4)
+        .map(|p| (f32::from(p[0]), f32::from(p[2])))
+        .filter(|(r, b)| r + b > 12.0)
+        .collect();
+    let share = object.iter().map(|(r, b)| b / (r + b)).sum::<f32>() / object.len().max(1) as f32;
+    (share, object.len())
+}
+
+#[test]
+fn each_lod_is_shown_as_it_is_at_the_frame_displayed() {
+    const W: u32 = 64;
+    const FRAMES: u32 = 12;
+    let gpu = lodkit_test_gpu!();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 2);
+    let renderer = LodBufferRenderer::new(gpu, format, &vis, 1.0).unwrap();
+    let combine = CombinePass::new(gpu, format, false).unwrap();
+    // Both LODs are the same sphere, so both cover the same pixels with the same texels: the
+    // blue (incoming) share of the object is exactly the schedule's, progress p in both.
+    let sphere = GpuMesh::new(gpu, &Mesh::sphere(24, 32)).unwrap();
+    let colors = [Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 0.0, 1.0, 1.0)];
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, 1.0, 0.1, 50.0);
+    let view = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target =
+        lodkit::gpu::resources::texture_2d(gpu, (W, W), format, usage, "combined").unwrap();
+    let target_view = target.create_view(&Default::default());
+    let mut rows = Vec::new();
+    for schedule in [Schedule::Paper, Schedule::Complementary] {
+        for start in [3u64, 4] {
+            let buffers = LodBuffers::new(gpu, W, W, format).unwrap();
+            let mut s = TransitionScheduler::with_schedule(schedule);
+            let key = s.insert(0);
+            let (mut shares, mut coverage) = (Vec::new(), Vec::new());
+            for f in 0..start + u64::from(FRAMES) + 2 {
+                if f > 0 {
+                    s.advance(1.0 / 60.0);
+                }
+                if f == start {
+                    s.begin_transition(key, 1, Drive::Progress).unwrap();
+                }
+                if f >= start {
+                    let p = |f: u64| ((f - start) as f32 / FRAMES as f32).min(1.0);
+                    s.set_progress(key, p(f)).unwrap();
+                    // One start knows the next frame's progress, the other lets it be predicted.
+                    if start == 3 {
+                        s.set_next_progress(key, p(f + 1)).unwrap();
+                    }
+                }
+                let d = s.draw(key).unwrap();
+                let item =
+                    LodDrawItem::from_draw(&sphere, Mat4::IDENTITY, colors[usize::from(d.lod)], &d);
+                let index = s.buffer_index();
+                let clear = wgpu::Color::BLACK;
+                renderer
+                    .render(gpu, &buffers, index, proj * view, &[item], clear, None)
+                    .unwrap();
+                let m = if f == 0 {
+                    CombinePass::NO_HISTORY
+                } else {
+                    new_to_old_matrix(&view, &proj, &view, &proj)
+                };
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                combine
+                    .encode(gpu, &mut encoder, &buffers, index, m, &target_view)
+                    .unwrap();
+                gpu.queue.submit([encoder.finish()]);
+                let (share, covered) = blue_share(&read_texture_rgba8(gpu, &target).unwrap());
+                shares.push(share);
+                coverage.push(covered);
+            }
+            let first = coverage[0];
+            assert!(first > 1000, "the sphere covers {first} pixels");
+            let frames = &shares[start as usize..=(start + u64::from(FRAMES)) as usize];
+            for (k, pair) in frames.windows(2).enumerate() {
+                assert!(
+                    pair[1] > pair[0] + 0.02,
+                    "{schedule:?}, start {start}: the incoming share must grow on every frame, \
+                     frame {} -> {}: {frames:?}",
+                    k,
+                    k + 1
+                );
+            }
+            for (k, share) in frames.iter().enumerate() {
+                let p = k as f32 / FRAMES as f32;
+                assert!(
+                    (share - p).abs() < 0.05,
+                    "{schedule:?}, start {start}: frame {k} shows {share:.3} of the incoming LOD, \
+                     its progress is {p:.3}: {frames:?}"
+                );
+            }
+            assert!(
+                coverage.iter().all(|&c| c == first),
+                "{schedule:?}, start {start}: the object's coverage changed (see-through or a \
+                 hole): {coverage:?}"
+            );
+            let shown: Vec<String> = frames.iter().map(|s| format!("{s:.3}")).collect();
+            rows.push(format!("{schedule:?}, start {start}: {}", shown.join(" ")));
+        }
+    }
+    say(&format!(
+        "incoming share per frame of a {FRAMES}-frame transition:\n{}",
+        rows.join("\n")
+    ));
+}
