@@ -1,7 +1,7 @@
 //! Display-time visibility of frame-sequential LOD: the flag functions of `lodkit::visibility`,
-//! `lodkit::lod_buffer` and `lodkit::combine` on the GPU (WGSL and GLSL twins) against their Rust
-//! twins, and whole transitions through the LOD pass and the combine pass, where the share of
-//! each LOD must follow its schedule on every frame.
+//! `lodkit::lod_buffer` and `lodkit::combine` and the whole per-pixel `combine_at` on the GPU
+//! (WGSL and GLSL twins) against their Rust twins, and whole transitions through the LOD pass and
+//! the combine pass, where the share of each LOD must follow its schedule on every frame.
 
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, LodSample, combine_shown};
@@ -89,6 +89,7 @@ fn visibility_flags_twins_match_with_a_real_texture() {
             outputs: 4,
             texture: Some((64, &tex.texels)),
             rgba: &[],
+            urgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
         assert_eq!(got, want, "{language:?} visibility flags");
@@ -218,6 +219,7 @@ fn lod_buffer_flags_and_combine_shown_twins_match() {
             outputs: 9,
             texture: None,
             rgba: &[],
+            urgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
         assert_eq!(got, want, "{language:?} lod buffer flags and combine_shown");
@@ -237,6 +239,119 @@ fn lod_buffer_flags_and_combine_shown_twins_match() {
         0.5 * (cases[2].2.color + cases[2].4.color),
         "neither shown: the paper's rule (same id: average)"
     );
+}
+
+#[test]
+fn combine_at_twins_match_on_two_lod_images() {
+    use lodkit::combine::{LodImage, combine_images};
+    let gpu = lodkit_test_gpu!();
+    let (w, h) = (12u32, 10u32);
+    let n = (w * h) as usize;
+    let noise = lodkit::noise::white_noise(6 * n, 11);
+    // Two buffers of a t-instance (id 5, flags of every kind), n-instances and sky, with depths
+    // spread over the far part of the range where reprojection moves texels most.
+    let image = |k: usize| {
+        let r = |i: usize, j: usize| noise[(k * 3 + j) * n + i];
+        LodImage {
+            width: w,
+            height: h,
+            colors: (0..n)
+                .map(|i| Vec4::new(r(i, 0), r(i, 1), 1.0 - r(i, 0), 1.0))
+                .collect(),
+            ids: (0..n)
+                .map(|i| [0, 5, 5, 9][(r(i, 1) * 4.0) as usize % 4])
+                .collect(),
+            depths: (0..n)
+                .map(|i| {
+                    if r(i, 2) > 0.9 {
+                        1.0
+                    } else {
+                        0.9 + 0.09 * r(i, 2)
+                    }
+                })
+                .collect(),
+            flags: (0..n).map(|i| (r(i, 2) * 37.0) as u32 % 4).collect(),
+        }
+    };
+    let (newer, older) = (image(0), image(1));
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, w as f32 / h as f32, 0.1, 50.0);
+    let eye =
+        |x: f32| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 0.2, 3.0), Vec3::ZERO, Vec3::Y);
+    let m = new_to_old_matrix(&eye(0.15), &proj, &eye(0.0), &proj);
+    let want = combine_images(&newer, &older, &m, DepthConvention::Standard);
+    let inputs: Vec<u32> = (0..n as u32)
+        .flat_map(|p| {
+            let mut words = words(&m.to_cols_array());
+            words.extend([p % w, p / w]);
+            words
+        })
+        .collect();
+    let colors = |i: &LodImage| i.colors.clone();
+    let texels = |i: &LodImage| -> Vec<[u32; 4]> {
+        (0..n)
+            .map(|p| {
+                let t = i.texel(p);
+                [t[0], t[1], 0, 0]
+            })
+            .collect()
+    };
+    let (nc, oc) = (colors(&newer), colors(&older));
+    let (nt, ot) = (texels(&newer), texels(&older));
+    let matrix = "mat4x4<f32>(vec4(inp_f(0u), inp_f(1u), inp_f(2u), inp_f(3u)), vec4(inp_f(4u), inp_f(5u), inp_f(6u), inp_f(7u)), vec4(inp_f(8u), inp_f(9u), inp_f(10u), inp_f(11u)), vec4(inp_f(12u), inp_f(13u), inp_f(14u), inp_f(15u)))";
+    let wgsl = format!(
+        "let c = combine_at(probe_rgba0, probe_urgba0, probe_rgba1, probe_urgba1, vec2(inp_u(16u), inp_u(17u)), {matrix});
+        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);"
+    );
+    let glsl = format!(
+        "vec4 c = lodkit_combine_at(sampler2D(probe_rgba0, probe_sampler), usampler2D(probe_urgba0, probe_sampler), sampler2D(probe_rgba1, probe_sampler), usampler2D(probe_urgba1, probe_sampler), uvec2(inp_u(16u), inp_u(17u)), {});
+        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);",
+        matrix.replace("mat4x4<f32>", "mat4")
+    );
+    for (language, header, body) in [
+        (
+            SourceLanguage::Wgsl,
+            "#import lodkit::combine::combine_at",
+            wgsl.as_str(),
+        ),
+        (GLSL, "#include \"lodkit/combine.glsl\"", glsl.as_str()),
+    ] {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 18,
+            outputs: 4,
+            texture: None,
+            rgba: &[(w, h, &nc), (w, h, &oc)],
+            urgba: &[(w, h, &nt), (w, h, &ot)],
+        };
+        let got = floats(&run_with(gpu, &probe, &inputs, language, &[]));
+        let mut compared = 0;
+        for (p, (g, want)) in got.chunks(4).zip(&want).enumerate() {
+            if want.on_texel_edge {
+                continue;
+            }
+            compared += 1;
+            let g = Vec4::from_slice(g);
+            assert!(
+                (g - want.color).abs().max_element() < 1e-5,
+                "{language:?} pixel {p}: {g} vs {} ({:?})",
+                want.color,
+                want.source
+            );
+        }
+        assert!(
+            compared * 10 > n * 9,
+            "{language:?}: only {compared} pixels compared"
+        );
+    }
+    // The images exercise every rule.
+    use lodkit::combine::PixelSource::*;
+    for source in [Newer, Older, Average, OutsideOlder] {
+        assert!(
+            want.iter().any(|p| p.source == source),
+            "no pixel combined as {source:?}"
+        );
+    }
 }
 
 /// Blue share b / (r + b) of the object's pixels (LOD 0 pure red, LOD 1 pure blue, so lighting

@@ -63,6 +63,7 @@ pub(crate) const COMBINE_PROBE: Probe<'static> = Probe {
     outputs: 4,
     texture: None,
     rgba: &[],
+    urgba: &[],
 };
 
 const COMBINE_WGSL: &str = "let newer = LodSample(vec4<f32>(inp_f(0u), inp_f(1u), inp_f(2u), inp_f(3u)), inp_u(4u), inp_f(5u));
@@ -103,6 +104,7 @@ fn combine_samples_twins_match_on_hand_derived_cases() {
                 outputs: 4,
                 texture: None,
                 rgba: &[],
+                urgba: &[],
             };
             let got = floats(&run_with(gpu, &probe, &inputs, language, defs));
             assert_eq!(got, want, "{language:?} {convention:?}");
@@ -269,6 +271,7 @@ fn reproject_twins_match_including_reversed_z_sky_and_outside() {
             outputs: 7,
             texture: None,
             rgba: &[],
+            urgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
         for (i, (g, (w, q))) in got.chunks(7).zip(want.iter().zip(&refined)).enumerate() {
@@ -382,6 +385,7 @@ fn visibility_twins_match_with_a_real_texture() {
             outputs: 4,
             texture: Some((64, &tex.texels)),
             rgba: &[],
+            urgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
         assert_eq!(got, want, "{language:?} visibility");

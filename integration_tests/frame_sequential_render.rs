@@ -323,3 +323,142 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
     let (both, _) = render(&[item(&sphere, 1.0), item(&cube, 0.01)]);
     assert_eq!(both, alone + 12, "a cube at tau 0.01 is drawn");
 }
+
+#[test]
+fn the_combine_over_the_t_instances_rectangles_equals_the_full_combine() {
+    use lodkit::combine::screen_rect;
+    let gpu = lodkit_test_gpu!();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 3);
+    let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.5).unwrap();
+    let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
+    let combine = CombinePass::new(gpu, format, false).unwrap();
+    let sphere_mesh = Mesh::sphere(16, 24);
+    let bounds = sphere_mesh.bounds().unwrap();
+    let sphere = GpuMesh::new(gpu, &sphere_mesh).unwrap();
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.1, 50.0);
+    let eye =
+        |x: f32| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 0.5, 6.0), Vec3::ZERO, Vec3::Y);
+    let views = [eye(0.0), eye(0.2)];
+    // Three spheres: the left one in transition, the others n-instances.
+    let mut s = TransitionScheduler::new();
+    let keys: Vec<_> = (0..3).map(|_| s.insert(0)).collect();
+    s.begin_transition(keys[0], 1, Drive::Progress).unwrap();
+    let model = |i: usize| {
+        Mat4::from_translation(Vec3::new(i as f32 * 1.8 - 1.8, 0.0, 0.0))
+            * Mat4::from_scale(Vec3::splat(0.7))
+    };
+    let colors = [Vec4::new(1.0, 0.2, 0.1, 1.0), Vec4::new(0.1, 0.3, 1.0, 1.0)];
+    for (frame, view) in views.iter().enumerate() {
+        if frame > 0 {
+            s.advance(1.0 / 60.0);
+        }
+        s.set_progress(keys[0], 0.3 + 0.1 * frame as f32).unwrap();
+        let items: Vec<LodDrawItem> = keys
+            .iter()
+            .enumerate()
+            .map(|(i, k)| {
+                let d = s.draw(*k).unwrap();
+                LodDrawItem::from_draw(&sphere, model(i), colors[usize::from(d.lod)], &d)
+            })
+            .collect();
+        let clear = wgpu::Color::BLACK;
+        renderer
+            .render(
+                gpu,
+                &buffers,
+                s.buffer_index(),
+                proj * *view,
+                &items,
+                clear,
+                None,
+            )
+            .unwrap();
+    }
+    let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
+    let rect = screen_rect(
+        bounds,
+        model(0),
+        &[proj * views[1], proj * views[0]],
+        (W, H),
+        2,
+    )
+    .unwrap();
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+        | wgpu::TextureUsages::COPY_SRC
+        | wgpu::TextureUsages::COPY_DST;
+    let texture =
+        |label| lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, label).unwrap();
+    let (full, regions, none) = (texture("full"), texture("regions"), texture("none"));
+    let newer = s.buffer_index();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+    combine
+        .encode(gpu, &mut encoder, &buffers, newer, m, &view(&full))
+        .unwrap();
+    gpu.queue.submit([encoder.finish()]);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let combined = combine
+        .encode_regions(
+            gpu,
+            &mut encoder,
+            &buffers,
+            newer,
+            m,
+            &view(&regions),
+            &[rect, rect],
+        )
+        .unwrap();
+    let skipped = combine
+        .encode_regions(gpu, &mut encoder, &buffers, newer, m, &view(&none), &[])
+        .unwrap();
+    gpu.queue.submit([encoder.finish()]);
+    let read = |t: &wgpu::Texture| read_texture_rgba8(gpu, t).unwrap();
+    assert_eq!(
+        combined,
+        rect.area(),
+        "overlapping rectangles are combined once"
+    );
+    assert_eq!(skipped, 0);
+    assert!(
+        rect.area() * 3 < u64::from(W * H),
+        "the rectangle {rect:?} is a small part"
+    );
+    assert_eq!(
+        read(&regions),
+        read(&full),
+        "the rectangle holds every pixel the combine changes"
+    );
+    assert_eq!(
+        read(&none),
+        read(buffers.color(newer)),
+        "no region: the newer buffer as it is"
+    );
+    assert_ne!(
+        read(&full),
+        read(buffers.color(newer)),
+        "the combine does change the frame"
+    );
+    // A target the pass cannot copy into is refused, not a validation panic.
+    let plain = lodkit::gpu::resources::texture_2d(
+        gpu,
+        (W, H),
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT,
+        "plain",
+    )
+    .unwrap();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let err = combine
+        .encode_regions(
+            gpu,
+            &mut encoder,
+            &buffers,
+            newer,
+            m,
+            &view(&plain),
+            &[rect],
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("COPY_DST"), "{err}");
+}

@@ -169,6 +169,7 @@ fn bilateral_upsample_twins_match_on_hand_built_neighbourhoods() {
             outputs: 4,
             texture: None,
             rgba: &[],
+            urgba: &[],
         };
         let got = floats(&run_with(gpu, &probe, &inputs(&cases), language, &[]));
         assert_close(
@@ -552,6 +553,7 @@ fn bilateral_upsample_at_twins_match_on_real_textures() {
             outputs: 4,
             texture: None,
             rgba: &textures,
+            urgba: &[],
         };
         let got = floats(&run_with(gpu, &probe, &inputs, language, &[]));
         assert_close(

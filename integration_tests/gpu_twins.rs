@@ -56,6 +56,7 @@ fn normal_probe(expr: &str) -> Probe<'static> {
         outputs: 1,
         texture: None,
         rgba: &[],
+        urgba: &[],
     }
 }
 
@@ -98,6 +99,7 @@ fn foreshortened_normal_distance_glsl_matches_rust_twin() {
         outputs: 1,
         texture: None,
         rgba: &[],
+        urgba: &[],
     };
     let got = floats(&run_glsl(gpu, &probe, &normal_inputs(&pairs)));
     let want: Vec<f32> = pairs
@@ -141,6 +143,7 @@ fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
         outputs: 6,
         texture: None,
         rgba: &[],
+        urgba: &[],
     };
     let glsl = Probe {
         header: "#include \"lodkit/fullscreen.glsl\"",
@@ -151,6 +154,7 @@ fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
         outputs: 6,
         texture: None,
         rgba: &[],
+        urgba: &[],
     };
     let want = fullscreen_want();
     assert_eq!(

@@ -49,6 +49,9 @@ pub struct Probe<'a> {
     /// Rgba32Float textures (width, height, texels) bound as `probe_rgba0`, `probe_rgba1`, ...
     /// (GLSL: `texture2D`s to combine with `probe_sampler`).
     pub rgba: &'a [(u32, u32, &'a [glam::Vec4])],
+    /// Rgba32Uint textures (width, height, texels) bound as `probe_urgba0`, ... (WGSL
+    /// `texture_2d<u32>`; GLSL `utexture2D`s to combine with `probe_sampler`).
+    pub urgba: &'a [(u32, u32, &'a [[u32; 4]])],
 }
 
 /// The WGSL probe shader (naga_oil: the header `#import`s lodkit).
@@ -62,6 +65,12 @@ pub fn wgsl_probe(p: &Probe) -> String {
         texture.push_str(&format!(
             "\n@group(0) @binding({}) var probe_rgba{k}: texture_2d<f32>;",
             4 + k
+        ));
+    }
+    for k in 0..p.urgba.len() {
+        texture.push_str(&format!(
+            "\n@group(0) @binding({}) var probe_urgba{k}: texture_2d<u32>;",
+            8 + k
         ));
     }
     format!(
@@ -99,7 +108,13 @@ pub fn glsl_probe(p: &Probe) -> String {
             4 + k
         ));
     }
-    if p.texture.is_some() || !p.rgba.is_empty() {
+    for k in 0..p.urgba.len() {
+        texture.push_str(&format!(
+            "layout(set = 0, binding = {}) uniform utexture2D probe_urgba{k};\n",
+            8 + k
+        ));
+    }
+    if p.texture.is_some() || !p.rgba.is_empty() || !p.urgba.is_empty() {
         texture.push_str("layout(set = 0, binding = 3) uniform sampler probe_sampler;\n");
     }
     format!(
@@ -230,40 +245,49 @@ fn run(
             .expect("probe texture");
         texture.create_view(&Default::default())
     });
-    let rgba_views: Vec<wgpu::TextureView> = probe
-        .rgba
-        .iter()
-        .map(|(w, h, texels)| {
-            use wgpu::util::DeviceExt;
-            let flat: Vec<f32> = texels.iter().flat_map(|v| v.to_array()).collect();
-            device
-                .create_texture_with_data(
-                    &gpu.queue,
-                    &wgpu::TextureDescriptor {
-                        label: Some("probe rgba"),
-                        size: wgpu::Extent3d {
-                            width: *w,
-                            height: *h,
-                            depth_or_array_layers: 1,
-                        },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: wgpu::TextureFormat::Rgba32Float,
-                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                        view_formats: &[],
+    let texture = |(w, h): (u32, u32), format, bytes: &[u8]| {
+        use wgpu::util::DeviceExt;
+        device
+            .create_texture_with_data(
+                &gpu.queue,
+                &wgpu::TextureDescriptor {
+                    label: Some("probe rgba"),
+                    size: wgpu::Extent3d {
+                        width: w,
+                        height: h,
+                        depth_or_array_layers: 1,
                     },
-                    wgpu::util::TextureDataOrder::LayerMajor,
-                    bytemuck::cast_slice(&flat),
-                )
-                .create_view(&Default::default())
-        })
-        .collect();
-    for (k, v) in rgba_views.iter().enumerate() {
-        entries.push(wgpu::BindGroupEntry {
-            binding: 4 + k as u32,
-            resource: wgpu::BindingResource::TextureView(v),
-        });
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                },
+                wgpu::util::TextureDataOrder::LayerMajor,
+                bytes,
+            )
+            .create_view(&Default::default())
+    };
+    let float_views = probe.rgba.iter().map(|(w, h, texels)| {
+        let flat: Vec<f32> = texels.iter().flat_map(|v| v.to_array()).collect();
+        let format = wgpu::TextureFormat::Rgba32Float;
+        texture((*w, *h), format, bytemuck::cast_slice(&flat))
+    });
+    let uint_views = probe.urgba.iter().map(|(w, h, texels)| {
+        let format = wgpu::TextureFormat::Rgba32Uint;
+        texture((*w, *h), format, bytemuck::cast_slice(texels))
+    });
+    // Float textures from binding 4, unsigned ones from binding 8.
+    let views: [(u32, Vec<wgpu::TextureView>); 2] =
+        [(4, float_views.collect()), (8, uint_views.collect())];
+    for (first, list) in &views {
+        for (k, v) in list.iter().enumerate() {
+            entries.push(wgpu::BindGroupEntry {
+                binding: first + k as u32,
+                resource: wgpu::BindingResource::TextureView(v),
+            });
+        }
     }
     if let Some(view) = &view {
         entries.push(wgpu::BindGroupEntry {

@@ -88,6 +88,7 @@ pub(crate) const SCREEN_DOOR_PROBE: Probe<'static> = Probe {
     outputs: 4,
     texture: None,
     rgba: &[],
+    urgba: &[],
 };
 
 const SCREEN_DOOR_WGSL: &str = "let t = inp_f(0u); let y = f32(inp_u(1u)) + 0.5;
@@ -118,6 +119,7 @@ fn screen_door_twins_are_complementary_on_the_gpu() {
         outputs: 4,
         texture: None,
         rgba: &[],
+        urgba: &[],
     };
     for (pattern, defs) in [
         (DitherPattern::Bayer4x4, &[][..]),
@@ -164,6 +166,7 @@ fn unpopping_twins_match_on_the_gpu() {
         outputs: 4,
         texture: None,
     rgba: &[],
+    urgba: &[],
     };
     let glsl = Probe {
         header: "#include \"lodkit/unpopping.glsl\"",
@@ -174,6 +177,7 @@ fn unpopping_twins_match_on_the_gpu() {
         outputs: 4,
         texture: None,
     rgba: &[],
+    urgba: &[],
     };
     let want: Vec<u32> = ts
         .iter()

@@ -1,7 +1,7 @@
 //! The combination rule of two LOD buffers (Scherzer & Wimmer 2008, sec. 3.4): Rust twins of
 //! `lodkit::combine`.
 
-use glam::Vec4;
+use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 
 /// One texel of a LOD buffer (mirror of WGSL `LodSample`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,6 +110,12 @@ impl LodImage {
         }
     }
 
+    /// The id/depth texel at pixel index `p` as the shader reads it (id word with the flags).
+    pub fn texel(&self, p: usize) -> [u32; 2] {
+        let flags = self.flags.get(p).copied().unwrap_or(3);
+        crate::lod_buffer::lod_buffer_id_depth_flags(self.ids[p], self.depths[p], flags)
+    }
+
     /// Whether the texel at pixel index `p` is shown in the frame `flag` names (always for
     /// n-instances and without flags).
     pub fn shown(&self, p: usize, flag: u32) -> bool {
@@ -142,88 +148,307 @@ pub struct CombinedPixel {
     pub on_texel_edge: bool,
 }
 
-/// The combine pass on the CPU: every pixel of `newer` reprojected into `older` through
-/// `new_to_old` and combined with [`combine_shown`] (the newer texel shown if flagged for now, the
-/// older if flagged for next), as `passes/combine.wgsl` does. Both images
-/// must have the same, non-zero size and complete texel arrays; otherwise the result is empty.
+/// The texel of a `size` texture at texture-space `uv` (clamped to the texture).
+pub fn combine_texel(uv: Vec2, size: UVec2) -> UVec2 {
+    let inside = uv.clamp(Vec2::ZERO, Vec2::ONE);
+    (inside * size.as_vec2())
+        .as_uvec2()
+        .min(size.saturating_sub(UVec2::ONE))
+}
+
+/// Texture-space center of pixel `pixel` of a `size` target.
+pub fn combine_uv(pixel: UVec2, size: UVec2) -> Vec2 {
+    (pixel.as_vec2() + 0.5) / size.as_vec2()
+}
+
+/// The older buffer's texel the combine reads for the newer pixel `pixel` with clip depth
+/// `newer_depth`: where the point of the pixel's ray at the older depth `first_depth` (found at
+/// the first estimate) reprojects, or the first estimate where there is none.
+pub fn combine_older_texel(
+    pixel: UVec2,
+    size: UVec2,
+    newer_depth: f32,
+    first_depth: f32,
+    new_to_old: &Mat4,
+) -> UVec2 {
+    use crate::reproject::{in_viewport, reproject_base, reproject_from_base, reproject_refine};
+    let base = reproject_base(combine_uv(pixel, size), new_to_old);
+    let first = reproject_from_base(base, newer_depth, new_to_old);
+    let refined = reproject_refine(base, newer_depth, first_depth, new_to_old);
+    if in_viewport(refined.truncate()) {
+        combine_texel(refined.truncate(), size)
+    } else {
+        combine_texel(first.truncate(), size)
+    }
+}
+
+/// The combined color from the fetched texels: the newer color and id/depth texel, `old` = the
+/// newer pixel reprojected with its depth, the older color and id/depth texel at
+/// [`combine_older_texel`]. Outside the older view the newer color, else [`combine_shown`].
+pub fn combine_texels(
+    newer_color: Vec4,
+    newer_texel: [u32; 2],
+    old: Vec3,
+    older_color: Vec4,
+    older_texel: [u32; 2],
+    convention: DepthConvention,
+) -> Vec4 {
+    use crate::lod_buffer::*;
+    if !crate::reproject::in_viewport(old.truncate()) {
+        return newer_color;
+    }
+    let newer = LodSample {
+        color: newer_color,
+        id: lod_buffer_id(newer_texel),
+        depth: old.z,
+    };
+    let older = LodSample {
+        color: older_color,
+        id: lod_buffer_id(older_texel),
+        depth: lod_buffer_depth(older_texel),
+    };
+    let newer_shown = lod_buffer_shown(newer_texel, LOD_BUFFER_SHOWN_NOW);
+    let older_shown = lod_buffer_shown(older_texel, LOD_BUFFER_SHOWN_NEXT);
+    combine_shown(newer, newer_shown, older, older_shown, convention)
+}
+
+/// The whole per-pixel combine at `pixel` (the Rust twin of `combine_at`, with the buffers read
+/// back as [`LodImage`]s of the same size; `pixel` must lie inside them).
+pub fn combine_at(
+    newer: &LodImage,
+    older: &LodImage,
+    pixel: UVec2,
+    new_to_old: &Mat4,
+    convention: DepthConvention,
+) -> Vec4 {
+    combine_pixel(newer, older, pixel, new_to_old, convention).color
+}
+
+/// [`combine_at`] with the rule it applied and whether a GPU may read another texel.
+fn combine_pixel(
+    newer: &LodImage,
+    older: &LodImage,
+    pixel: UVec2,
+    new_to_old: &Mat4,
+    convention: DepthConvention,
+) -> CombinedPixel {
+    use crate::lod_buffer::{LOD_BUFFER_SHOWN_NEXT, LOD_BUFFER_SHOWN_NOW};
+    let size = UVec2::new(newer.width, newer.height);
+    let index = |t: UVec2| (t.y * newer.width + t.x) as usize;
+    let p = index(pixel);
+    let newer_texel = newer.texel(p);
+    let depth = newer.depths[p];
+    let old = crate::reproject::reproject(combine_uv(pixel, size), depth, new_to_old);
+    if !crate::reproject::in_viewport(old.truncate()) {
+        return CombinedPixel {
+            color: newer.colors[p],
+            source: PixelSource::OutsideOlder,
+            on_texel_edge: false,
+        };
+    }
+    let first = combine_texel(old.truncate(), size);
+    let first_depth = older.depths[index(first)];
+    let texel = combine_older_texel(pixel, size, depth, first_depth, new_to_old);
+    let o = index(texel);
+    let color = combine_texels(
+        newer.colors[p],
+        newer_texel,
+        old,
+        older.colors[o],
+        older.texel(o),
+        convention,
+    );
+    // A reprojected position within 1e-3 texel of a texel edge may round the other way on a GPU.
+    let near_edge = |uv: Vec2| {
+        let f = uv * size.as_vec2();
+        let frac = f - f.floor();
+        frac.min_element() < 1e-3 || frac.max_element() > 1.0 - 1e-3
+    };
+    let base = crate::reproject::reproject_base(combine_uv(pixel, size), new_to_old);
+    let refined = crate::reproject::reproject_refine(base, depth, first_depth, new_to_old);
+    let on_texel_edge = near_edge(old.truncate()) || near_edge(refined.truncate());
+    let (n, o) = (newer.sample(p), older.sample(o));
+    let (n_shown, o_shown) = (
+        newer.shown(p, LOD_BUFFER_SHOWN_NOW),
+        older.shown(index(texel), LOD_BUFFER_SHOWN_NEXT),
+    );
+    let source = if n_shown != o_shown {
+        if n_shown {
+            PixelSource::Newer
+        } else {
+            PixelSource::Older
+        }
+    } else if n.id == 0 && o.id == 0 {
+        PixelSource::Newer
+    } else if n.id == o.id {
+        PixelSource::Average
+    } else if depth_closer(o.depth, old.z, convention) {
+        PixelSource::Older
+    } else {
+        PixelSource::Newer
+    };
+    CombinedPixel {
+        color,
+        source,
+        on_texel_edge,
+    }
+}
+
+/// The combine pass on the CPU: [`combine_at`] at every pixel, with the rule applied. Both
+/// images must have the same, non-zero size and complete texel arrays; otherwise the result is
+/// empty.
 pub fn combine_images(
     newer: &LodImage,
     older: &LodImage,
-    new_to_old: &glam::Mat4,
+    new_to_old: &Mat4,
     convention: DepthConvention,
 ) -> Vec<CombinedPixel> {
-    use glam::Vec2;
     let n = (newer.width * newer.height) as usize;
-    let complete = |i: &LodImage| i.colors.len() == n && i.ids.len() == n && i.depths.len() == n;
+    let complete = |i: &LodImage| {
+        i.colors.len() == n
+            && i.ids.len() == n
+            && i.depths.len() == n
+            && (i.flags.is_empty() || i.flags.len() == n)
+    };
     let same_size = (newer.width, newer.height) == (older.width, older.height);
     if n == 0 || !same_size || !complete(newer) || !complete(older) {
         return Vec::new();
     }
-    let size = Vec2::new(newer.width as f32, newer.height as f32);
-    (0..newer.colors.len())
+    (0..n as u32)
         .map(|p| {
-            let mut n = newer.sample(p);
-            let (x, y) = (
-                (p as u32 % newer.width) as f32,
-                (p as u32 / newer.width) as f32,
-            );
-            let uv = (Vec2::new(x, y) + 0.5) / size;
-            let base = crate::reproject::reproject_base(uv, new_to_old);
-            let old = crate::reproject::reproject_from_base(base, n.depth, new_to_old);
-            if !crate::reproject::in_viewport(old.truncate()) {
-                return CombinedPixel {
-                    color: n.color,
-                    source: PixelSource::OutsideOlder,
-                    on_texel_edge: false,
-                };
-            }
-            let last = glam::UVec2::new(newer.width - 1, newer.height - 1);
-            let texel = |uv: Vec2| (uv * size).as_uvec2().min(last);
-            let near_edge = |uv: Vec2| {
-                let f = uv * size;
-                let frac = f - f.floor();
-                frac.min_element() < 1e-3 || frac.max_element() > 1.0 - 1e-3
-            };
-            let first = texel(old.truncate());
-            let first_depth = older.depths[(first.y * newer.width + first.x) as usize];
-            let refined =
-                crate::reproject::reproject_refine(base, n.depth, first_depth, new_to_old);
-            let (op, on_texel_edge) = if crate::reproject::in_viewport(refined.truncate()) {
-                (
-                    texel(refined.truncate()),
-                    near_edge(old.truncate()) || near_edge(refined.truncate()),
-                )
-            } else {
-                (first, near_edge(old.truncate()))
-            };
-            let o = older.sample((op.y * newer.width + op.x) as usize);
-            n.depth = old.z;
-            use crate::lod_buffer::{LOD_BUFFER_SHOWN_NEXT, LOD_BUFFER_SHOWN_NOW};
-            let (n_shown, o_shown) = (
-                newer.shown(p, LOD_BUFFER_SHOWN_NOW),
-                older.shown((op.y * newer.width + op.x) as usize, LOD_BUFFER_SHOWN_NEXT),
-            );
-            let color = combine_shown(n, n_shown, o, o_shown, convention);
-            let source = if n_shown != o_shown {
-                if n_shown {
-                    PixelSource::Newer
-                } else {
-                    PixelSource::Older
-                }
-            } else if n.id == 0 && o.id == 0 {
-                PixelSource::Newer
-            } else if n.id == o.id {
-                PixelSource::Average
-            } else if depth_closer(o.depth, n.depth, convention) {
-                PixelSource::Older
-            } else {
-                PixelSource::Newer
-            };
-            CombinedPixel {
-                color,
-                source,
-                on_texel_edge,
-            }
+            let pixel = UVec2::new(p % newer.width, p / newer.width);
+            combine_pixel(newer, older, pixel, new_to_old, convention)
         })
         .collect()
+}
+
+/// A rectangle of pixels (top-left origin), where the combine pass has work to do.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ScreenRect {
+    /// Left column.
+    pub x: u32,
+    /// Top row.
+    pub y: u32,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
+
+impl ScreenRect {
+    /// Pixels covered.
+    pub fn area(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+
+    /// The smallest rectangle holding both.
+    pub fn union(&self, other: &ScreenRect) -> ScreenRect {
+        let x = self.x.min(other.x);
+        let y = self.y.min(other.y);
+        let right = (self.x + self.width).max(other.x + other.width);
+        let bottom = (self.y + self.height).max(other.y + other.height);
+        ScreenRect {
+            x,
+            y,
+            width: right - x,
+            height: bottom - y,
+        }
+    }
+
+    /// Whether the two share a pixel.
+    pub fn overlaps(&self, other: &ScreenRect) -> bool {
+        self.x < other.x + other.width
+            && other.x < self.x + self.width
+            && self.y < other.y + other.height
+            && other.y < self.y + self.height
+    }
+}
+
+/// The screen rectangle of a t-instance for the combine pass: the box `bounds` (object-space
+/// min and max, the union of both LODs' boxes) under `model` and each of `view_projs` (this
+/// frame's and the previous frame's view-projection: where the newer and the older buffer hold
+/// it), in a `size` target, dilated by `dilate` pixels and clipped to the target. `None` when it
+/// is off screen; the whole target when a corner is behind a camera.
+///
+/// ```
+/// # use lodkit::combine::{ScreenRect, screen_rect};
+/// # use glam::{Mat4, Vec3};
+/// let vp = glam::camera::rh::proj::directx::perspective(1.0, 1.0, 0.1, 10.0)
+///     * glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y);
+/// let r = screen_rect((Vec3::splat(-0.5), Vec3::splat(0.5)), Mat4::IDENTITY, &[vp], (100, 100), 1)
+///     .unwrap();
+/// assert!(r.x > 30 && r.x + r.width < 70 && r.width == r.height);
+/// let away = Mat4::from_translation(Vec3::new(100.0, 0.0, 0.0));
+/// assert_eq!(screen_rect((Vec3::splat(-0.5), Vec3::splat(0.5)), away, &[vp], (100, 100), 1), None);
+/// ```
+pub fn screen_rect(
+    bounds: (glam::Vec3, glam::Vec3),
+    model: glam::Mat4,
+    view_projs: &[glam::Mat4],
+    size: (u32, u32),
+    dilate: u32,
+) -> Option<ScreenRect> {
+    use glam::{Vec2, Vec3};
+    let (lo, hi) = bounds;
+    let (w, h) = (size.0.max(1), size.1.max(1));
+    let whole = ScreenRect {
+        x: 0,
+        y: 0,
+        width: w,
+        height: h,
+    };
+    let (mut min, mut max) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+    for vp in view_projs {
+        let m = *vp * model;
+        for i in 0..8 {
+            let corner = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let clip = m * corner.extend(1.0);
+            if !clip.is_finite() || clip.w <= 0.0 {
+                return Some(whole);
+            }
+            let ndc = clip.truncate().truncate() / clip.w;
+            let pixel = Vec2::new(
+                (ndc.x * 0.5 + 0.5) * w as f32,
+                (0.5 - ndc.y * 0.5) * h as f32,
+            );
+            min = min.min(pixel);
+            max = max.max(pixel);
+        }
+    }
+    let d = dilate as f32;
+    let (x0, y0) = ((min.x - d).floor().max(0.0), (min.y - d).floor().max(0.0));
+    let (x1, y1) = (
+        (max.x + d).ceil().min(w as f32),
+        (max.y + d).ceil().min(h as f32),
+    );
+    (x0 < x1 && y0 < y1 && !view_projs.is_empty()).then_some(ScreenRect {
+        x: x0 as u32,
+        y: y0 as u32,
+        width: (x1 - x0) as u32,
+        height: (y1 - y0) as u32,
+    })
+}
+
+/// Merges overlapping rectangles into their unions until none overlap, so no pixel is
+/// combined twice.
+///
+/// ```
+/// # use lodkit::combine::{ScreenRect, merge_rects};
+/// let r = |x, y| ScreenRect { x, y, width: 10, height: 10 };
+/// assert_eq!(merge_rects(&[r(0, 0), r(5, 5), r(40, 40)]).len(), 2);
+/// ```
+pub fn merge_rects(rects: &[ScreenRect]) -> Vec<ScreenRect> {
+    let mut out: Vec<ScreenRect> = Vec::new();
+    for r in rects.iter().filter(|r| r.area() > 0) {
+        let mut merged = *r;
+        while let Some(i) = out.iter().position(|o| o.overlaps(&merged)) {
+            merged = merged.union(&out.swap_remove(i));
+        }
+        out.push(merged);
+    }
+    out
 }

@@ -7,12 +7,13 @@
 
 use glam::Mat4;
 
-use super::error::{check_color_format, texture_matches};
+use super::error::{check_color_format, has_usage, texture_matches};
 use super::resources::{
-    TextureSet, begin_color_pass, begin_targets_pass, fullscreen_pipeline, new_set, resize_set,
-    texture_2d, textures_and_uniform, uniform_buffer,
+    TextureSet, begin_color_pass, begin_load_pass, begin_targets_pass, fullscreen_pipeline,
+    new_set, resize_set, texture_2d, textures_and_uniform, uniform_buffer,
 };
 use super::{GpuContext, GpuError};
+use crate::combine::{ScreenRect, merge_rects};
 use crate::lod_buffer::ID_DEPTH_FORMAT;
 
 /// Depth format of the pair's shared depth buffer.
@@ -215,6 +216,102 @@ impl CombinePass {
         new_to_old: Mat4,
         target: &wgpu::TextureView,
     ) -> Result<(), GpuError> {
+        self.record(gpu, encoder, buffers, newer, new_to_old, target, None)
+    }
+
+    /// The combine where it has work to do: copies buffer `newer`'s color into `target` (which
+    /// needs `COPY_DST` besides what [`encode`](Self::encode) needs), then runs the combine only
+    /// inside `regions`, the screen rectangles of the t-instances
+    /// ([`screen_rect`](crate::combine::screen_rect), merged with
+    /// [`merge_rects`](crate::combine::merge_rects); overlapping rectangles are merged here
+    /// too). With no region the frame is the copy: no combine, no read of the older buffer.
+    /// Returns the pixels combined. An engine that can show the newer buffer's color directly
+    /// skips the copy as well (see docs/frame-sequential.md).
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_regions(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        buffers: &LodBuffers,
+        newer: usize,
+        new_to_old: Mat4,
+        target: &wgpu::TextureView,
+        regions: &[ScreenRect],
+    ) -> Result<u64, GpuError> {
+        const CALL: &str = "CombinePass::encode_regions";
+        let usage = target.texture().usage();
+        let copy = wgpu::TextureUsages::COPY_DST;
+        has_usage(CALL, "target", usage, usage.contains(copy), "COPY_DST")?;
+        let (found, expected) = (buffers.color_format(), self.target_format);
+        if found.remove_srgb_suffix() != expected.remove_srgb_suffix() {
+            return Err(GpuError::Mismatch {
+                call: CALL,
+                parameter: "buffers",
+                found: format!("{found:?} color"),
+                expected: format!(
+                    "{expected:?}, the target's format (the rest of the frame is a copy)"
+                ),
+            });
+        }
+        let (w, h) = buffers.size();
+        let clipped: Vec<ScreenRect> = regions
+            .iter()
+            .filter_map(|r| {
+                let (x1, y1) = (
+                    r.x.saturating_add(r.width).min(w),
+                    r.y.saturating_add(r.height).min(h),
+                );
+                (r.x < x1 && r.y < y1).then(|| ScreenRect {
+                    x: r.x,
+                    y: r.y,
+                    width: x1 - r.x,
+                    height: y1 - r.y,
+                })
+            })
+            .collect();
+        let merged = merge_rects(&clipped);
+        texture_matches(
+            CALL,
+            "target",
+            target.texture(),
+            buffers.size(),
+            self.target_format,
+            "the pass (built for its format, drawing the LOD buffers' size)",
+        )?;
+        gpu.guarded(CALL, || {
+            encoder.copy_texture_to_texture(
+                buffers.color(newer).as_image_copy(),
+                target.texture().as_image_copy(),
+                target.texture().size(),
+            );
+            Ok(())
+        })?;
+        if !merged.is_empty() {
+            self.record(
+                gpu,
+                encoder,
+                buffers,
+                newer,
+                new_to_old,
+                target,
+                Some(&merged),
+            )?;
+        }
+        Ok(merged.iter().map(ScreenRect::area).sum())
+    }
+
+    /// Records the combine over the whole target, or inside `regions` over what is there.
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        buffers: &LodBuffers,
+        newer: usize,
+        new_to_old: Mat4,
+        target: &wgpu::TextureView,
+        regions: Option<&[ScreenRect]>,
+    ) -> Result<(), GpuError> {
         const CALL: &str = "CombinePass::encode";
         texture_matches(
             CALL,
@@ -244,10 +341,22 @@ impl CombinePass {
                 Some(&self.params),
                 "lodkit combine",
             )?;
-            let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit combine");
+            let label = "lodkit combine";
+            let mut pass = match regions {
+                None => begin_color_pass(encoder, target, wgpu::Color::BLACK, label),
+                Some(_) => begin_load_pass(encoder, target, label),
+            };
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
-            pass.draw(0..3, 0..1);
+            match regions {
+                None => pass.draw(0..3, 0..1),
+                Some(rects) => {
+                    for r in rects {
+                        pass.set_scissor_rect(r.x, r.y, r.width, r.height);
+                        pass.draw(0..3, 0..1);
+                    }
+                }
+            }
             Ok(())
         })
     }

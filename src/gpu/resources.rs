@@ -244,6 +244,24 @@ pub fn begin_color_pass<'e>(
     clear: wgpu::Color,
     label: &str,
 ) -> wgpu::RenderPass<'e> {
+    color_pass(encoder, target, wgpu::LoadOp::Clear(clear), label)
+}
+
+/// A render pass into one color target that keeps its contents, without depth.
+pub fn begin_load_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    target: &wgpu::TextureView,
+    label: &str,
+) -> wgpu::RenderPass<'e> {
+    color_pass(encoder, target, wgpu::LoadOp::Load, label)
+}
+
+fn color_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    target: &wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+    label: &str,
+) -> wgpu::RenderPass<'e> {
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -251,7 +269,7 @@ pub fn begin_color_pass<'e>(
             depth_slice: None,
             resolve_target: None,
             ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(clear),
+                load,
                 store: wgpu::StoreOp::Store,
             },
         })],

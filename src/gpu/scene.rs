@@ -89,6 +89,13 @@ impl Mesh {
         m
     }
 
+    /// Object-space bounding box (min, max) of the vertices; `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut points = self.vertices.iter().map(|v| Vec3::new(v[0], v[1], v[2]));
+        let first = points.next()?;
+        Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+
     /// Number of triangles.
     pub fn triangles(&self) -> usize {
         self.indices.len() / 3

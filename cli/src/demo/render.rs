@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::scene::DemoScene;
-use lodkit::combine::{DepthConvention, PixelSource, combine_images};
+use lodkit::combine::{DepthConvention, PixelSource, ScreenRect, combine_images, screen_rect};
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::counters::FragmentCounter;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
@@ -103,6 +103,8 @@ pub struct SceneRenderer<'a> {
     size: (u32, u32),
     frames: usize,
     meshes: Vec<[GpuMesh; 2]>,
+    /// Object-space box of both LODs of each object.
+    bounds: Vec<Option<(Vec3, Vec3)>>,
     single: [MeshRenderer; 2],
     target: RenderTarget,
     lod_buffer: [LodBufferRenderer; 2],
@@ -144,13 +146,27 @@ impl<'a> SceneRenderer<'a> {
                 ])
             })
             .collect::<Result<_, GpuError>>()?;
+        let bounds = scene
+            .objects
+            .iter()
+            .map(|o| {
+                let (fine, coarse) = (o.fine.mesh().bounds(), o.coarse.mesh().bounds());
+                match (fine, coarse) {
+                    (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
+                    (a, b) => a.or(b),
+                }
+            })
+            .collect();
         let vis = |p| visibility_texture(p, 64, 1);
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST;
         Ok(Self {
             scene,
             size,
             frames: frames.max(2),
             meshes,
+            bounds,
             single: [
                 MeshRenderer::new(gpu, false)?,
                 MeshRenderer::new(gpu, true)?,
@@ -372,10 +388,29 @@ impl<'a> SceneRenderer<'a> {
             let m = previous.map_or(CombinePass::NO_HISTORY, |old| {
                 new_to_old_matrix(&view, &proj, &old, &proj)
             });
+            // The combine runs over the screen rectangles of the t-instances, where this frame's
+            // and the previous frame's views see them; the rest of the frame is a copy.
+            let views = [proj * view, proj * previous.unwrap_or(view)];
+            let regions: Vec<ScreenRect> = keys
+                .iter()
+                .enumerate()
+                .filter(|(_, key)| scheduler.in_transition(**key))
+                .filter_map(|(i, _)| {
+                    let bounds = self.bounds[i]?;
+                    screen_rect(bounds, self.scene.model(i), &views, self.size, 2)
+                })
+                .collect();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let target = self.combined.create_view(&Default::default());
-            self.combine
-                .encode(gpu, &mut encoder, &self.buffers, index, m, &target)?;
+            let combined = self.combine.encode_regions(
+                gpu,
+                &mut encoder,
+                &self.buffers,
+                index,
+                m,
+                &target,
+                &regions,
+            )?;
             gpu.queue.submit([encoder.finish()]);
             if let Some(f) = on_sources.as_mut().filter(|_| frame == middle) {
                 let newer = read_lod_image(gpu, &self.buffers, index)?;
@@ -384,10 +419,9 @@ impl<'a> SceneRenderer<'a> {
                 f(sources.iter().map(|p| p.source).collect());
             }
             if wanted(frame) {
-                // The combine pass shades every pixel once more.
-                let combine = u64::from(self.size.0) * u64::from(self.size.1);
+                // The combine pass shades each pixel of its rectangles once more.
                 let pixels = read_texture_rgba8(gpu, &self.combined)?;
-                let fragments = fragments + combine;
+                let fragments = fragments + combined;
                 on_frame(
                     frame,
                     Frame {

@@ -186,6 +186,7 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                 "vs hard switch",
                 "fragments",
                 "vs hard switch",
+                "frames without a t-instance, vs hard switch",
             ],
             rows: rows
                 .map(|t| {
@@ -195,6 +196,7 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                         format!("{:.3}x", t.triangles_vs_hard),
                         t.fragments.map_or("n/a".to_owned(), |f| f.to_string()),
                         times(t.fragments_vs_hard),
+                        times(t.idle_fragments_vs_hard),
                     ]
                 })
                 .collect(),
@@ -512,19 +514,20 @@ pub fn summary(report: &DemoReport) -> String {
     for scene in &report.scenes {
         let _ = writeln!(
             s,
-            "\n{scene:<24} {:>8} {:>8} {:>12} {:>10} {:>10}",
-            "pop", "pop mov", "see-through", "tris", "frags"
+            "\n{scene:<24} {:>8} {:>8} {:>12} {:>10} {:>10} {:>10}",
+            "pop", "pop mov", "see-through", "tris", "frags", "idle"
         );
         for t in report.transitions.iter().filter(|t| &t.scene == scene) {
             let _ = writeln!(
                 s,
-                "  {:<22} {:>8.3} {:>8.3} {:>12} {:>9.3}x {:>10}",
+                "  {:<22} {:>8.3} {:>8.3} {:>12} {:>9.3}x {:>10} {:>10}",
                 t.technique,
                 t.pop_static,
                 t.pop_moving,
                 pct(t.see_through),
                 t.triangles_vs_hard,
-                times(t.fragments_vs_hard)
+                times(t.fragments_vs_hard),
+                times(t.idle_fragments_vs_hard)
             );
         }
     }

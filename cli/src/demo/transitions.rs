@@ -31,11 +31,17 @@ pub struct TransitionMetrics {
     /// Counted fragments over the transition, relative to a hard switch (None when the
     /// adapter's counter is not a count).
     pub fragments_vs_hard: Option<f64>,
+    /// Counted fragments on the frames before and after the transition (no t-instance on
+    /// screen), relative to a hard switch's on the same frames (None when the adapter's counter
+    /// is not a count).
+    pub idle_fragments_vs_hard: Option<f64>,
     /// Triangles submitted over the transition.
     pub triangles: u64,
-    /// Counted fragments over the transition (frame-sequential: plus one per pixel for the
-    /// combine pass); None when the adapter's counter is not a count.
+    /// Counted fragments over the transition (frame-sequential: plus one per pixel of the
+    /// combine pass's rectangles); None when the adapter's counter is not a count.
     pub fragments: Option<u64>,
+    /// Counted fragments on the frames with no t-instance.
+    pub idle_fragments: Option<u64>,
     /// Per-frame change attributable to the transition, static camera (mean |delta| per channel,
     /// 0..1), from frame 1 on.
     pub change_static: Vec<f32>,
@@ -109,6 +115,7 @@ struct TransitionRun {
     change: Vec<f32>,
     triangles: u64,
     fragments: u64,
+    idle_fragments: u64,
     strip: image::RgbaImage,
     sources: Option<Vec<PixelSource>>,
 }
@@ -137,6 +144,7 @@ fn transition_run(
         change: Vec::new(),
         triangles: 0,
         fragments: 0,
+        idle_fragments: 0,
         strip: image::RgbaImage::new(size.0 * 7, size.1),
         sources: None,
     };
@@ -161,6 +169,8 @@ fn transition_run(
             if span.contains(&f) {
                 run.triangles += frame.triangles;
                 run.fragments += frame.fragments;
+            } else {
+                run.idle_fragments += frame.fragments;
             }
             if let Some(slot) = strip_at.iter().position(|&s| s == f) {
                 match to_image(size, frame.pixels.clone()) {
@@ -274,7 +284,7 @@ pub fn measure_scene(
             return Err(DemoError::Internal("no reference run".to_owned()));
         };
         let mut changes = Vec::new();
-        let mut cost = (0, 0);
+        let mut cost = (0, 0, 0);
         for (moving, reference) in [false, true].into_iter().zip(reference) {
             let run = transition_run(gpu, renderer, technique, moving, reference, size)?;
             let camera = if moving { "moving" } else { "static" };
@@ -287,7 +297,7 @@ pub fn measure_scene(
                 super::save(&img, &out.join(format!("sources/{scene}-{name}.png")))?;
             }
             if !moving {
-                cost = (run.triangles, run.fragments);
+                cost = (run.triangles, run.fragments, run.idle_fragments);
             }
             changes.push(run.change);
         }
@@ -303,8 +313,10 @@ pub fn measure_scene(
             see_through: share,
             triangles_vs_hard: 0.0,
             fragments_vs_hard: None,
+            idle_fragments_vs_hard: None,
             triangles: cost.0,
             fragments: counts.then_some(cost.1),
+            idle_fragments: counts.then_some(cost.2),
             change_static: static_change,
             change_moving: moving_change,
         });
@@ -313,11 +325,13 @@ pub fn measure_scene(
     let hard = rows
         .iter()
         .find(|r| r.technique == "hard-switch")
-        .map(|r| (r.triangles.max(1), r.fragments.map(|f| f.max(1))));
-    if let Some((t, f)) = hard {
+        .map(|r| (r.triangles.max(1), r.fragments, r.idle_fragments));
+    let ratio = |a: Option<u64>, b: Option<u64>| a.zip(b).map(|(a, b)| a as f64 / b.max(1) as f64);
+    if let Some((t, f, idle)) = hard {
         for r in &mut rows {
             r.triangles_vs_hard = r.triangles as f64 / t as f64;
-            r.fragments_vs_hard = r.fragments.zip(f).map(|(a, b)| a as f64 / b as f64);
+            r.fragments_vs_hard = ratio(r.fragments, f);
+            r.idle_fragments_vs_hard = ratio(r.idle_fragments, idle);
         }
     }
     Ok(rows)

@@ -8,11 +8,20 @@
 //   lodkit_combine_samples(newer, older) -> vec4
 //   lodkit_combine_shown(newer, newer_shown, older, older_shown) -> vec4   exactly one shown: it;
 //       both or neither: lodkit_combine_samples
+//   lodkit_combine_texel(uv, size) -> uvec2, lodkit_combine_uv(pixel, size) -> vec2
+//   lodkit_combine_older_texel(pixel, size, newer_depth, first_depth, new_to_old) -> uvec2
+//   lodkit_combine_texels(newer_color, newer_texel, old, older_color, older_texel) -> vec4
+//   lodkit_combine_at(newer_color, newer_id_depth, older_color, older_id_depth, pixel, new_to_old)
+//       -> vec4   the whole per-pixel combine (a macro: takes sampler2D / usampler2D, or
+//       sampler2D(texture, sampler) / usampler2D(texture, sampler) in Vulkan GLSL; pixel a uvec2)
 //   lodkit_depth_closer(a, b) -> bool
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z).
 #ifndef LODKIT_COMBINE_GLSL
 #define LODKIT_COMBINE_GLSL
+
+#include "lodkit/lod_buffer.glsl"
+#include "lodkit/reproject.glsl"
 
 /// One texel of a LOD buffer: color, instance id (0 = n-instance), clip depth.
 struct lodkit_LodSample {
@@ -51,5 +60,56 @@ vec4 lodkit_combine_shown(lodkit_LodSample newer, bool newer_shown, lodkit_LodSa
     }
     return lodkit_combine_samples(newer, older);
 }
+
+/// The texel of a `size` texture at texture-space `uv` (clamped to the texture).
+uvec2 lodkit_combine_texel(vec2 uv, uvec2 size) {
+    vec2 inside = clamp(uv, vec2(0.0), vec2(1.0));
+    return min(uvec2(inside * vec2(size)), size - uvec2(1u));
+}
+
+/// Texture-space center of pixel `pixel` of a `size` target.
+vec2 lodkit_combine_uv(uvec2 pixel, uvec2 size) {
+    return (vec2(pixel) + 0.5) / vec2(size);
+}
+
+/// The older buffer's texel for the newer pixel: the reprojection refined at the older depth.
+uvec2 lodkit_combine_older_texel(uvec2 pixel, uvec2 size, float newer_depth, float first_depth, mat4 new_to_old) {
+    vec4 base = lodkit_reproject_base(lodkit_combine_uv(pixel, size), new_to_old);
+    vec3 first = lodkit_reproject_from_base(base, newer_depth, new_to_old);
+    vec3 refined = lodkit_reproject_refine(base, newer_depth, first_depth, new_to_old);
+    return lodkit_in_viewport(refined.xy) ? lodkit_combine_texel(refined.xy, size) : lodkit_combine_texel(first.xy, size);
+}
+
+/// The combined color from the fetched texels.
+vec4 lodkit_combine_texels(vec4 newer_color, uvec2 newer_texel, vec3 old, vec4 older_color, uvec2 older_texel) {
+    if (!lodkit_in_viewport(old.xy)) {
+        return newer_color;
+    }
+    lodkit_LodSample newer = lodkit_LodSample(newer_color, lodkit_lod_buffer_id(newer_texel), old.z);
+    lodkit_LodSample older = lodkit_LodSample(older_color, lodkit_lod_buffer_id(older_texel), lodkit_lod_buffer_depth(older_texel));
+    bool newer_shown = lodkit_lod_buffer_shown(newer_texel, LODKIT_LOD_BUFFER_SHOWN_NOW);
+    bool older_shown = lodkit_lod_buffer_shown(older_texel, LODKIT_LOD_BUFFER_SHOWN_NEXT);
+    return lodkit_combine_shown(newer, newer_shown, older, older_shown);
+}
+
+/// The size of the buffers.
+#define LODKIT_COMBINE_SIZE_(nc) uvec2(textureSize((nc), 0))
+/// The newer id/depth texel at the pixel.
+#define LODKIT_COMBINE_NEWER_(nid, px) texelFetch((nid), ivec2(px), 0).xy
+/// The newer clip depth at the pixel.
+#define LODKIT_COMBINE_DEPTH_(nid, px) lodkit_lod_buffer_depth(LODKIT_COMBINE_NEWER_(nid, px))
+/// The newer pixel reprojected with its own depth.
+#define LODKIT_COMBINE_OLD_(nc, nid, px, m) \
+    lodkit_reproject(lodkit_combine_uv((px), LODKIT_COMBINE_SIZE_(nc)), LODKIT_COMBINE_DEPTH_(nid, px), (m))
+/// The older texel read (refined at the older depth of the first estimate).
+#define LODKIT_COMBINE_OLDER_(nc, nid, oid, px, m) \
+    lodkit_combine_older_texel((px), LODKIT_COMBINE_SIZE_(nc), LODKIT_COMBINE_DEPTH_(nid, px), \
+        lodkit_lod_buffer_depth(texelFetch((oid), ivec2(lodkit_combine_texel(LODKIT_COMBINE_OLD_(nc, nid, px, m).xy, LODKIT_COMBINE_SIZE_(nc))), 0).xy), (m))
+
+/// The whole per-pixel combine at `px` (uvec2), for a full-screen pass the engine already has.
+#define lodkit_combine_at(nc, nid, oc, oid, px, m) \
+    lodkit_combine_texels(texelFetch((nc), ivec2(px), 0), LODKIT_COMBINE_NEWER_(nid, px), LODKIT_COMBINE_OLD_(nc, nid, px, m), \
+        texelFetch((oc), ivec2(LODKIT_COMBINE_OLDER_(nc, nid, oid, px, m)), 0), \
+        texelFetch((oid), ivec2(LODKIT_COMBINE_OLDER_(nc, nid, oid, px, m)), 0).xy)
 
 #endif // LODKIT_COMBINE_GLSL
