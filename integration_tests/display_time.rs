@@ -12,7 +12,7 @@ use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::lod_buffer::{
     LOD_BUFFER_MAX_ID, LOD_BUFFER_SHOWN_NEXT, LOD_BUFFER_SHOWN_NOW, lod_buffer_flags,
-    lod_buffer_id, lod_buffer_id_depth_flags, lod_buffer_shown,
+    lod_buffer_id, lod_buffer_shown, lod_buffer_word,
 };
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::shaders::SourceLanguage;
@@ -170,9 +170,9 @@ fn lod_buffer_flags_and_combine_shown_twins_match() {
     let want: Vec<u32> = cases
         .iter()
         .flat_map(|(id, flags, n, ns, o, os)| {
-            let t = lod_buffer_id_depth_flags(*id, 0.25, *flags);
+            let t = lod_buffer_word(*id, *flags);
             let mut w = vec![
-                t[0],
+                t,
                 lod_buffer_id(t),
                 lod_buffer_flags(t),
                 u32::from(lod_buffer_shown(t, LOD_BUFFER_SHOWN_NOW)),
@@ -184,16 +184,16 @@ fn lod_buffer_flags_and_combine_shown_twins_match() {
             w
         })
         .collect();
-    let wgsl = "let t = lod_buffer_output_flags(vec4(0.0), inp_u(0u), 0.25, inp_u(1u)).id_depth;
-        out_u(0u, t.x); out_u(1u, lod_buffer_id(t)); out_u(2u, lod_buffer_flags(t));
+    let wgsl = "let t = lod_buffer_output_flags(vec4(0.0), inp_u(0u), inp_u(1u)).id;
+        out_u(0u, t); out_u(1u, lod_buffer_id(t)); out_u(2u, lod_buffer_flags(t));
         out_u(3u, u32(lod_buffer_shown(t, LOD_BUFFER_SHOWN_NOW)));
         out_u(4u, u32(lod_buffer_shown(t, LOD_BUFFER_SHOWN_NEXT)));
         let n = LodSample(vec4(inp_f(2u), inp_f(3u), inp_f(4u), inp_f(5u)), inp_u(6u), inp_f(7u));
         let o = LodSample(vec4(inp_f(9u), inp_f(10u), inp_f(11u), inp_f(12u)), inp_u(13u), inp_f(14u));
         let c = combine_shown(n, inp_u(8u) != 0u, o, inp_u(15u) != 0u);
         out_f(5u, c.x); out_f(6u, c.y); out_f(7u, c.z); out_f(8u, c.w);";
-    let glsl = "uvec2 t = lodkit_lod_buffer_output_flags(vec4(0.0), inp_u(0u), 0.25, inp_u(1u)).id_depth;
-        out_u(0u, t.x); out_u(1u, lodkit_lod_buffer_id(t)); out_u(2u, lodkit_lod_buffer_flags(t));
+    let glsl = "uint t = lodkit_lod_buffer_output_flags(vec4(0.0), inp_u(0u), inp_u(1u)).id;
+        out_u(0u, t); out_u(1u, lodkit_lod_buffer_id(t)); out_u(2u, lodkit_lod_buffer_flags(t));
         out_u(3u, uint(lodkit_lod_buffer_shown(t, LODKIT_LOD_BUFFER_SHOWN_NOW)));
         out_u(4u, uint(lodkit_lod_buffer_shown(t, LODKIT_LOD_BUFFER_SHOWN_NEXT)));
         lodkit_LodSample n = lodkit_LodSample(vec4(inp_f(2u), inp_f(3u), inp_f(4u), inp_f(5u)), inp_u(6u), inp_f(7u));
@@ -287,23 +287,18 @@ fn combine_at_twins_match_on_two_lod_images() {
         })
         .collect();
     let colors = |i: &LodImage| i.colors.clone();
-    let texels = |i: &LodImage| -> Vec<[u32; 4]> {
-        (0..n)
-            .map(|p| {
-                let t = i.texel(p);
-                [t[0], t[1], 0, 0]
-            })
-            .collect()
-    };
+    let depths = |i: &LodImage| -> Vec<Vec4> { i.depths.iter().map(|d| Vec4::splat(*d)).collect() };
+    let words = |i: &LodImage| -> Vec<[u32; 4]> { (0..n).map(|p| [i.word(p), 0, 0, 0]).collect() };
     let (nc, oc) = (colors(&newer), colors(&older));
-    let (nt, ot) = (texels(&newer), texels(&older));
+    let (nd, od) = (depths(&newer), depths(&older));
+    let (nw, ow) = (words(&newer), words(&older));
     let matrix = "mat4x4<f32>(vec4(inp_f(0u), inp_f(1u), inp_f(2u), inp_f(3u)), vec4(inp_f(4u), inp_f(5u), inp_f(6u), inp_f(7u)), vec4(inp_f(8u), inp_f(9u), inp_f(10u), inp_f(11u)), vec4(inp_f(12u), inp_f(13u), inp_f(14u), inp_f(15u)))";
     let wgsl = format!(
-        "let c = combine_at(probe_rgba0, probe_urgba0, probe_rgba1, probe_urgba1, vec2(inp_u(16u), inp_u(17u)), {matrix});
+        "let c = combine_at(probe_rgba0, probe_urgba0, probe_rgba2, probe_rgba1, probe_urgba1, probe_rgba3, vec2(inp_u(16u), inp_u(17u)), {matrix});
         out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);"
     );
     let glsl = format!(
-        "vec4 c = lodkit_combine_at(sampler2D(probe_rgba0, probe_sampler), usampler2D(probe_urgba0, probe_sampler), sampler2D(probe_rgba1, probe_sampler), usampler2D(probe_urgba1, probe_sampler), uvec2(inp_u(16u), inp_u(17u)), {});
+        "vec4 c = lodkit_combine_at(sampler2D(probe_rgba0, probe_sampler), usampler2D(probe_urgba0, probe_sampler), sampler2D(probe_rgba2, probe_sampler), sampler2D(probe_rgba1, probe_sampler), usampler2D(probe_urgba1, probe_sampler), sampler2D(probe_rgba3, probe_sampler), uvec2(inp_u(16u), inp_u(17u)), {});
         out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);",
         matrix.replace("mat4x4<f32>", "mat4")
     );
@@ -321,8 +316,8 @@ fn combine_at_twins_match_on_two_lod_images() {
             inputs: 18,
             outputs: 4,
             texture: None,
-            rgba: &[(w, h, &nc), (w, h, &oc)],
-            urgba: &[(w, h, &nt), (w, h, &ot)],
+            rgba: &[(w, h, &nc), (w, h, &oc), (w, h, &nd), (w, h, &od)],
+            urgba: &[(w, h, &nw), (w, h, &ow)],
         };
         let got = floats(&run_with(gpu, &probe, &inputs, language, &[]));
         let mut compared = 0;

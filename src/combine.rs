@@ -110,10 +110,10 @@ impl LodImage {
         }
     }
 
-    /// The id/depth texel at pixel index `p` as the shader reads it (id word with the flags).
-    pub fn texel(&self, p: usize) -> [u32; 2] {
+    /// The id word at pixel index `p` as the shader reads it (id with the flags).
+    pub fn word(&self, p: usize) -> u32 {
         let flags = self.flags.get(p).copied().unwrap_or(3);
-        crate::lod_buffer::lod_buffer_id_depth_flags(self.ids[p], self.depths[p], flags)
+        crate::lod_buffer::lod_buffer_word(self.ids[p], flags)
     }
 
     /// Whether the texel at pixel index `p` is shown in the frame `flag` names (always for
@@ -182,15 +182,16 @@ pub fn combine_older_texel(
     }
 }
 
-/// The combined color from the fetched texels: the newer color and id/depth texel, `old` = the
-/// newer pixel reprojected with its depth, the older color and id/depth texel at
+/// The combined color from the fetched texels: the newer color and id word, `old` = the newer
+/// pixel reprojected with its depth, the older color, id word and depth at
 /// [`combine_older_texel`]. Outside the older view the newer color, else [`combine_shown`].
 pub fn combine_texels(
     newer_color: Vec4,
-    newer_texel: [u32; 2],
+    newer_word: u32,
     old: Vec3,
     older_color: Vec4,
-    older_texel: [u32; 2],
+    older_word: u32,
+    older_depth: f32,
     convention: DepthConvention,
 ) -> Vec4 {
     use crate::lod_buffer::*;
@@ -199,16 +200,16 @@ pub fn combine_texels(
     }
     let newer = LodSample {
         color: newer_color,
-        id: lod_buffer_id(newer_texel),
+        id: lod_buffer_id(newer_word),
         depth: old.z,
     };
     let older = LodSample {
         color: older_color,
-        id: lod_buffer_id(older_texel),
-        depth: lod_buffer_depth(older_texel),
+        id: lod_buffer_id(older_word),
+        depth: older_depth,
     };
-    let newer_shown = lod_buffer_shown(newer_texel, LOD_BUFFER_SHOWN_NOW);
-    let older_shown = lod_buffer_shown(older_texel, LOD_BUFFER_SHOWN_NEXT);
+    let newer_shown = lod_buffer_shown(newer_word, LOD_BUFFER_SHOWN_NOW);
+    let older_shown = lod_buffer_shown(older_word, LOD_BUFFER_SHOWN_NEXT);
     combine_shown(newer, newer_shown, older, older_shown, convention)
 }
 
@@ -236,7 +237,6 @@ fn combine_pixel(
     let size = UVec2::new(newer.width, newer.height);
     let index = |t: UVec2| (t.y * newer.width + t.x) as usize;
     let p = index(pixel);
-    let newer_texel = newer.texel(p);
     let depth = newer.depths[p];
     let old = crate::reproject::reproject(combine_uv(pixel, size), depth, new_to_old);
     if !crate::reproject::in_viewport(old.truncate()) {
@@ -252,10 +252,11 @@ fn combine_pixel(
     let o = index(texel);
     let color = combine_texels(
         newer.colors[p],
-        newer_texel,
+        newer.word(p),
         old,
         older.colors[o],
-        older.texel(o),
+        older.word(o),
+        older.depths[o],
         convention,
     );
     // A reprojected position within 1e-3 texel of a texel edge may round the other way on a GPU.

@@ -1,7 +1,7 @@
 // passes/combine — the frame-sequential combination pass (Scherzer & Wimmer 2008, sec. 3.4):
 // merges the LOD buffer rendered this frame with the one from the frame before, reprojected.
 //
-// For each pixel, lodkit::combine::combine_at: read the newer color and id/depth; reproject
+// For each pixel, lodkit::combine::combine_at: read the newer color, id word and depth; reproject
 // (uv, depth) into the older buffer, then once more at the older buffer's depth there (the older
 // surface's own parallax); outside the older view -> newer color; else combine_shown, the newer
 // sample shown if its LOD_BUFFER_SHOWN_NOW flag is set, the older one if its
@@ -12,8 +12,9 @@
 // Entry points:
 //   vs_main   fullscreen triangle, draw(0..3)
 //   fs_main   @location(0) combined color
-// Bindings (group 0): 0 newer_color texture_2d<f32>, 1 newer_id_depth texture_2d<u32>,
-//   2 older_color texture_2d<f32>, 3 older_id_depth texture_2d<u32>, 4 params: CombineParams.
+// Bindings (group 0): 0 newer_color texture_2d<f32>, 1 newer_id texture_2d<u32>, 2 newer_depth
+//   texture_2d<f32> (the depth attachment), 3 older_color, 4 older_id, 5 older_depth, 6 params:
+//   CombineParams.
 // Shader defs: LODKIT_REVERSE_Z (bool, default off) — passed on to lodkit::combine.
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 #import lodkit::combine::combine_at
@@ -25,10 +26,12 @@ struct CombineParams {
 }
 
 @group(0) @binding(0) var newer_color: texture_2d<f32>;
-@group(0) @binding(1) var newer_id_depth: texture_2d<u32>;
-@group(0) @binding(2) var older_color: texture_2d<f32>;
-@group(0) @binding(3) var older_id_depth: texture_2d<u32>;
-@group(0) @binding(4) var<uniform> params: CombineParams;
+@group(0) @binding(1) var newer_id: texture_2d<u32>;
+@group(0) @binding(2) var newer_depth: texture_2d<f32>;
+@group(0) @binding(3) var older_color: texture_2d<f32>;
+@group(0) @binding(4) var older_id: texture_2d<u32>;
+@group(0) @binding(5) var older_depth: texture_2d<f32>;
+@group(0) @binding(6) var<uniform> params: CombineParams;
 
 /// Fullscreen triangle.
 @vertex
@@ -40,5 +43,5 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 @fragment
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(v.position.xy);
-    return combine_at(newer_color, newer_id_depth, older_color, older_id_depth, pixel, params.new_to_old);
+    return combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel, params.new_to_old);
 }

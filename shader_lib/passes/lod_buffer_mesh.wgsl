@@ -11,7 +11,8 @@
 //
 // Entry points:
 //   vs_main   @location(0) position, @location(1) normal (object space)
-//   fs_main   LodBufferOutput (location 0 color, location 1 rg32uint id/depth)
+//   fs_main   LodBufferOutput (location 0 color, location 1 r32uint id word; the depth
+//             attachment keeps the depth)
 // Bindings: group 0: 0 `camera: Camera` (uniform), 1 `vis_tex: texture_2d<f32>`;
 //   group 1: 0 `draw: LodDraw` (uniform, dynamic offset).
 // Shader defs: none.
@@ -65,5 +66,5 @@ fn fs_main(in: VertexOut) -> LodBufferOutput {
     }
     let lambert = max(dot(normalize(in.normal), normalize(camera.light_dir.xyz)), 0.0);
     let color = vec4<f32>(draw.color.rgb * (0.35 + 0.65 * lambert), 1.0);
-    return lod_buffer_output_flags(color, draw.instance_id, in.position.z, flags);
+    return lod_buffer_output_flags(color, draw.instance_id, flags);
 }

@@ -1,7 +1,8 @@
 //! wgpu glue for frame-sequential LOD: the LOD buffer pair (ping-pong) and the combine pass.
 //!
 //! Each frame the engine renders its scene into LOD buffer `scheduler.buffer_index()` (color at
-//! location 0, id/depth at location 1, see `lodkit::lod_buffer`), then calls
+//! location 0, the id word at location 1, the buffer's own depth attachment, see
+//! `lodkit::lod_buffer`), then calls
 //! [`CombinePass::encode`] with the matrix from [`new_to_old_matrix`](crate::reproject::new_to_old_matrix)
 //! to write the final image into its own target.
 
@@ -9,24 +10,26 @@ use glam::Mat4;
 
 use super::error::{check_color_format, has_usage, texture_matches};
 use super::resources::{
-    TextureSet, begin_color_pass, begin_load_pass, begin_targets_pass, fullscreen_pipeline,
-    new_set, resize_set, texture_2d, textures_and_uniform, uniform_buffer,
+    TextureSet, begin_color_pass, begin_load_pass, begin_targets_pass, fullscreen_pipeline_with,
+    new_set, resize_set, texture_2d, texture_entry, textures_and_uniform, uniform_buffer,
+    uniform_entry,
 };
 use super::{GpuContext, GpuError};
 use crate::combine::{ScreenRect, merge_rects};
-use crate::lod_buffer::ID_DEPTH_FORMAT;
+use crate::lod_buffer::ID_FORMAT;
 
-/// Depth format of the pair's shared depth buffer.
+/// Depth format of each LOD buffer's depth attachment (the combine pass reads it).
 pub const LOD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
-/// Two LOD buffers (color + id/depth each) and a depth buffer to render them with.
+/// Two LOD buffers, each a color target, an id target and the depth attachment it is rendered
+/// with (read by the combine pass as the fragments' clip depth).
 #[derive(Debug)]
 pub struct LodBuffers {
     color_format: wgpu::TextureFormat,
     size: (u32, u32),
     colors: [wgpu::Texture; 2],
-    id_depths: [wgpu::Texture; 2],
-    depth: wgpu::Texture,
+    ids: [wgpu::Texture; 2],
+    depths: [wgpu::Texture; 2],
 }
 
 impl TextureSet for LodBuffers {
@@ -48,15 +51,14 @@ impl TextureSet for LodBuffers {
                 texture(color_format, usage, "lod buffer color 0")?,
                 texture(color_format, usage, "lod buffer color 1")?,
             ],
-            id_depths: [
-                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 0")?,
-                texture(ID_DEPTH_FORMAT, usage, "lod buffer id/depth 1")?,
+            ids: [
+                texture(ID_FORMAT, usage, "lod buffer id 0")?,
+                texture(ID_FORMAT, usage, "lod buffer id 1")?,
             ],
-            depth: texture(
-                LOD_DEPTH_FORMAT,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-                "lod buffer depth",
-            )?,
+            depths: [
+                texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 0")?,
+                texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 1")?,
+            ],
         })
     }
 
@@ -71,8 +73,8 @@ impl TextureSet for LodBuffers {
     fn textures(&self) -> Vec<&wgpu::Texture> {
         self.colors
             .iter()
-            .chain(&self.id_depths)
-            .chain([&self.depth])
+            .chain(&self.ids)
+            .chain(&self.depths)
             .collect()
     }
 }
@@ -110,18 +112,18 @@ impl LodBuffers {
         &self.colors[index % 2]
     }
 
-    /// Id/depth texture of buffer `index`.
-    pub fn id_depth(&self, index: usize) -> &wgpu::Texture {
-        &self.id_depths[index % 2]
+    /// Id texture (`ID_FORMAT`, the id words) of buffer `index`.
+    pub fn id(&self, index: usize) -> &wgpu::Texture {
+        &self.ids[index % 2]
     }
 
-    /// The shared depth texture used while rendering either buffer.
-    pub fn depth(&self) -> &wgpu::Texture {
-        &self.depth
+    /// Depth attachment of buffer `index` (`LOD_DEPTH_FORMAT`).
+    pub fn depth(&self, index: usize) -> &wgpu::Texture {
+        &self.depths[index % 2]
     }
 
-    /// Begins a render pass into buffer `index` that clears color to `clear`, id to 0 and the
-    /// stored depth and the depth buffer to `far_depth` (1 for standard Z, 0 for reversed).
+    /// Begins a render pass into buffer `index` that clears color to `clear`, the id to 0 and
+    /// the depth attachment to `far_depth` (1 for standard Z, 0 for reversed).
     /// `occlusion_query_set` is passed on to the pass (see
     /// [`FragmentCounter`](super::counters::FragmentCounter)).
     pub fn begin_pass<'e>(
@@ -133,17 +135,11 @@ impl LodBuffers {
         occlusion_query_set: Option<&wgpu::QuerySet>,
     ) -> wgpu::RenderPass<'e> {
         let color = self.colors[index % 2].create_view(&Default::default());
-        let id_depth = self.id_depths[index % 2].create_view(&Default::default());
-        let depth = self.depth.create_view(&Default::default());
-        let id_clear = wgpu::Color {
-            r: 0.0,
-            g: f64::from(far_depth.to_bits()),
-            b: 0.0,
-            a: 0.0,
-        };
+        let id = self.ids[index % 2].create_view(&Default::default());
+        let depth = self.depths[index % 2].create_view(&Default::default());
         begin_targets_pass(
             encoder,
-            &[(&color, clear), (&id_depth, id_clear)],
+            &[(&color, clear), (&id, wgpu::Color::TRANSPARENT)],
             &depth,
             far_depth,
             occlusion_query_set,
@@ -194,8 +190,39 @@ impl CombinePass {
         gpu.guarded(CALL, || {
             let module = gpu.pass_module("combine", defs)?;
             let size = std::mem::size_of::<CombineParams>();
+            // Color, id and depth of each buffer; the depth attachments bind as unfilterable
+            // float textures.
+            let float = wgpu::TextureSampleType::Float { filterable: false };
+            let uint = wgpu::TextureSampleType::Uint;
+            let mut entries: Vec<wgpu::BindGroupLayoutEntry> =
+                [float, uint, float, float, uint, float]
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, t)| texture_entry(i as u32, t))
+                    .collect();
+            entries.push(uniform_entry(6, false));
+            let group = gpu
+                .device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some("lodkit combine"),
+                    entries: &entries,
+                });
+            let layout = gpu
+                .device
+                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some("lodkit combine"),
+                    bind_group_layouts: &[Some(&group)],
+                    immediate_size: 0,
+                });
+            let label = "lodkit combine";
             Ok(Self {
-                pipeline: fullscreen_pipeline(gpu, &module, target_format, "lodkit combine")?,
+                pipeline: fullscreen_pipeline_with(
+                    gpu,
+                    &module,
+                    target_format,
+                    Some(&layout),
+                    label,
+                )?,
                 params: uniform_buffer(gpu, size, "combine params")?,
                 target_format,
             })
@@ -329,9 +356,11 @@ impl CombinePass {
                 .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
             let textures = [
                 buffers.color(newer),
-                buffers.id_depth(newer),
+                buffers.id(newer),
+                buffers.depth(newer),
                 buffers.color(newer + 1),
-                buffers.id_depth(newer + 1),
+                buffers.id(newer + 1),
+                buffers.depth(newer + 1),
             ];
             let layout = self.pipeline.get_bind_group_layout(0);
             let bind_group = textures_and_uniform(
@@ -379,16 +408,21 @@ pub fn read_lod_image(
                 .into(),
         });
     }
-    let (colors, id_depth) = gpu.guarded("read_lod_image", || {
+    let (colors, ids, depths) = gpu.guarded("read_lod_image", || {
+        use super::readback::{read_depth32, read_texture, read_texture_rgba8};
         Ok((
-            super::readback::read_texture_rgba8(gpu, buffers.color(index))?,
-            super::readback::read_texture(gpu, buffers.id_depth(index), 8)?,
+            read_texture_rgba8(gpu, buffers.color(index))?,
+            read_texture(gpu, buffers.id(index), 4)?,
+            read_depth32(gpu, buffers.depth(index))?,
         ))
     })?;
-    let words: Vec<u32> = id_depth
-        .chunks(4)
-        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
+    let words = |bytes: Vec<u8>| -> Vec<u32> {
+        bytes
+            .chunks(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect()
+    };
+    let ids = words(ids);
     let (width, height) = buffers.size();
     Ok(crate::combine::LodImage {
         width,
@@ -397,21 +431,14 @@ pub fn read_lod_image(
             .chunks(4)
             .map(|c| glam::Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) / 255.0)
             .collect(),
-        ids: words
+        ids: ids
             .iter()
-            .step_by(2)
-            .map(|w| crate::lod_buffer::lod_buffer_id([*w, 0]))
+            .map(|w| crate::lod_buffer::lod_buffer_id(*w))
             .collect(),
-        flags: words
+        flags: ids
             .iter()
-            .step_by(2)
-            .map(|w| crate::lod_buffer::lod_buffer_flags([*w, 0]))
+            .map(|w| crate::lod_buffer::lod_buffer_flags(*w))
             .collect(),
-        depths: words
-            .iter()
-            .skip(1)
-            .step_by(2)
-            .map(|w| f32::from_bits(*w))
-            .collect(),
+        depths,
     })
 }

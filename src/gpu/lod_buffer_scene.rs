@@ -13,7 +13,7 @@ use super::scene::{CameraUniform, GpuMesh};
 use super::{GpuContext, GpuError};
 use crate::combine::DepthConvention;
 use crate::frame_sequential::FrameDraw;
-use crate::lod_buffer::ID_DEPTH_FORMAT;
+use crate::lod_buffer::ID_FORMAT;
 use crate::visibility::VisibilityTexture;
 
 /// Rust mirror of `LodDraw` in `passes/lod_buffer_mesh.wgsl`.
@@ -132,7 +132,7 @@ impl LodBufferRenderer {
                 gpu,
                 &module,
                 &layout,
-                &[Some(color_format.into()), Some(ID_DEPTH_FORMAT.into())],
+                &[Some(color_format.into()), Some(ID_FORMAT.into())],
                 depth_write_state(LOD_DEPTH_FORMAT, depth_compare(depth)),
                 "lod_buffer_mesh",
             )?;

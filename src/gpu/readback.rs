@@ -153,3 +153,85 @@ pub fn read_buffer(
         map_read(gpu, &staging)
     })
 }
+
+/// Reads a `Depth32Float` texture (`COPY_SRC`, and `TEXTURE_BINDING` where the device cannot
+/// copy depth to a buffer, as on OpenGL ES) as clip depths, rows top to bottom.
+pub fn read_depth32(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>, GpuError> {
+    const CALL: &str = "readback::read_depth32";
+    let format = texture.format();
+    if format != wgpu::TextureFormat::Depth32Float {
+        return Err(GpuError::UnsupportedFormat {
+            call: CALL,
+            parameter: "texture",
+            format,
+            reason: "read_depth32 reads Depth32Float".into(),
+        });
+    }
+    let copies = wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES;
+    let bytes = if gpu
+        .adapter
+        .get_downlevel_capabilities()
+        .flags
+        .contains(copies)
+    {
+        read_texture(gpu, texture, 4)?
+    } else {
+        let usage = texture.usage();
+        let bound = usage.contains(wgpu::TextureUsages::TEXTURE_BINDING);
+        has_usage(CALL, "texture usage", usage, bound, "TEXTURE_BINDING")?;
+        let copy = gpu.guarded(CALL, || depth_to_r32uint(gpu, texture))?;
+        read_texture(gpu, &copy, 4)?
+    };
+    Ok(bytes
+        .chunks(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect())
+}
+
+/// Draws a depth texture's bits into an `R32Uint` texture of its size (for devices that cannot copy
+/// depth to a buffer).
+fn depth_to_r32uint(gpu: &GpuContext, depth: &wgpu::Texture) -> Result<wgpu::Texture, GpuError> {
+    const SOURCE: &str = "@group(0) @binding(0) var depth: texture_2d<f32>;
+@vertex fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let p = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(p * 2.0 - 1.0, 0.0, 1.0);
+}
+@fragment fn fs_main(@builtin(position) p: vec4<f32>) -> @location(0) vec4<u32> {
+    return vec4<u32>(bitcast<u32>(textureLoad(depth, vec2<u32>(p.xy), 0).x), 0u, 0u, 1u);
+}";
+    let device = &gpu.device;
+    let size = (depth.width(), depth.height());
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    // R32Uint holds the depth's bits and renders on every backend (R32Float does not on GL ES).
+    let format = wgpu::TextureFormat::R32Uint;
+    let target = super::resources::texture_2d(gpu, size, format, usage, "depth copy")?;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("lodkit depth copy"),
+        source: wgpu::ShaderSource::Wgsl(SOURCE.into()),
+    });
+    let float = wgpu::TextureSampleType::Float { filterable: false };
+    let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("lodkit depth copy"),
+        entries: &[super::resources::texture_entry(0, float)],
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("lodkit depth copy"),
+        bind_group_layouts: &[Some(&group_layout)],
+        immediate_size: 0,
+    });
+    let pipeline =
+        super::resources::fullscreen_pipeline_with(gpu, &module, format, Some(&layout), "depth")?;
+    let group =
+        super::resources::textures_and_uniform(gpu, &group_layout, &[depth], None, "depth")?;
+    let view = target.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let clear = wgpu::Color::BLACK;
+        let mut pass = super::resources::begin_color_pass(&mut encoder, &view, clear, "depth copy");
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    Ok(target)
+}

@@ -288,12 +288,24 @@ pub fn fullscreen_pipeline(
     format: wgpu::TextureFormat,
     label: &str,
 ) -> Result<wgpu::RenderPipeline, GpuError> {
+    fullscreen_pipeline_with(gpu, module, format, None, label)
+}
+
+/// [`fullscreen_pipeline`] with an explicit pipeline `layout` (`None`: derived from the shader),
+/// e.g. to bind a depth attachment as an unfilterable float texture.
+pub fn fullscreen_pipeline_with(
+    gpu: &GpuContext,
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+    layout: Option<&wgpu::PipelineLayout>,
+    label: &str,
+) -> Result<wgpu::RenderPipeline, GpuError> {
     gpu.guarded("resources::fullscreen_pipeline", || {
         Ok(gpu
             .device
             .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
-                layout: None,
+                layout,
                 vertex: wgpu::VertexState {
                     module,
                     entry_point: Some("vs_main"),
@@ -313,6 +325,23 @@ pub fn fullscreen_pipeline(
                 cache: None,
             }))
     })
+}
+
+/// A fragment-stage texture binding of `sample_type`, 2D, not multisampled.
+pub fn texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
 }
 
 /// A render pipeline for [`Mesh`](super::scene::Mesh) geometry: `vs_main` / `fs_main` of

@@ -114,6 +114,10 @@ pub struct SceneRenderer<'a> {
     counter: FragmentCounter,
 }
 
+/// Visibility texture repeats per object-space unit: at the demo's sizes a texel covers about
+/// two pixels of an object in transition.
+const VIS_SCALE: f32 = 0.5;
+
 const CLEAR: Vec4 = Vec4::new(0.03, 0.03, 0.06, 1.0);
 const LIGHT: Vec3 = Vec3::new(0.4, 0.8, 0.6);
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -173,8 +177,13 @@ impl<'a> SceneRenderer<'a> {
             ],
             target: RenderTarget::new(gpu, size.0, size.1)?,
             lod_buffer: [
-                LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::WhiteNoise), 0.25)?,
-                LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), 0.25)?,
+                LodBufferRenderer::new(
+                    gpu,
+                    FORMAT,
+                    &vis(VisibilityPattern::WhiteNoise),
+                    VIS_SCALE,
+                )?,
+                LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), VIS_SCALE)?,
             ],
             buffers: LodBuffers::new(gpu, size.0, size.1, FORMAT)?,
             combine: CombinePass::new(gpu, FORMAT, false)?,

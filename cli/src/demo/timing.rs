@@ -11,16 +11,17 @@ use serde::Serialize;
 
 use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
-use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::frame_sequential::{CombinePass, LOD_DEPTH_FORMAT, LodBuffers};
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::EdgeScene;
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::{
-    begin_color_pass, fullscreen_pipeline, texture_2d, textures_and_uniform, uniform_buffer,
+    begin_color_pass, fullscreen_pipeline, fullscreen_pipeline_with, texture_2d, texture_entry,
+    textures_and_uniform, uniform_buffer,
 };
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::gpu::{GpuContext, GpuError};
-use lodkit::lod_buffer::ID_DEPTH_FORMAT;
+use lodkit::lod_buffer::ID_FORMAT;
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
@@ -140,16 +141,20 @@ pub fn plain_pass(
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-const COPY4: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+/// Color, id word and depth of both buffers, read at the pixel and summed.
+const COPY6: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 @group(0) @binding(0) var a: texture_2d<f32>;
 @group(0) @binding(1) var b: texture_2d<u32>;
 @group(0) @binding(2) var c: texture_2d<f32>;
-@group(0) @binding(3) var d: texture_2d<u32>;
+@group(0) @binding(3) var d: texture_2d<f32>;
+@group(0) @binding(4) var e: texture_2d<u32>;
+@group(0) @binding(5) var f: texture_2d<f32>;
 @vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
 @fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let p = vec2<u32>(v.position.xy);
-    let ids = textureLoad(b, p, 0).xy ^ textureLoad(d, p, 0).xy;
-    return textureLoad(a, p, 0) + textureLoad(c, p, 0) + vec4<f32>(f32(ids.x & 1u), f32(ids.y & 1u), 0.0, 0.0);
+    let ids = textureLoad(b, p, 0).x ^ textureLoad(e, p, 0).x;
+    let depth = textureLoad(c, p, 0).x + textureLoad(f, p, 0).x;
+    return textureLoad(a, p, 0) + textureLoad(d, p, 0) + vec4<f32>(f32(ids & 1u), depth, 0.0, 0.0);
 }
 ";
 
@@ -252,35 +257,60 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     let target_view = target.create_view(&Default::default());
     let combine = CombinePass::new(gpu, FORMAT, false)?;
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
-    let copy4 = plain_pass(gpu, COPY4, "copy4.wgsl")?;
-    let textures = [
-        buffers.color(1),
-        buffers.id_depth(1),
-        buffers.color(0),
-        buffers.id_depth(0),
-    ];
-    let layout = copy4.get_bind_group_layout(0);
-    let group = textures_and_uniform(gpu, &layout, &textures, None, "copy4")?;
+    let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+        source: COPY6,
+        file_path: "copy6.wgsl",
+        ..Default::default()
+    })?;
+    let module = gpu.shader_module("copy6.wgsl", &composed)?;
+    // The depth attachments bind as unfilterable float textures, as in the combine pass.
+    let float = wgpu::TextureSampleType::Float { filterable: false };
+    let uint = wgpu::TextureSampleType::Uint;
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = [float, uint, float, float, uint, float]
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| texture_entry(i as u32, t))
+        .collect();
+    let layout = gpu
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("copy6"),
+            entries: &entries,
+        });
+    let pipeline_layout = gpu
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("copy6"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+    let copy6 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "copy6")?;
+    let textures = [1, 0].map(|i| [buffers.color(i), buffers.id(i), buffers.depth(i)]);
+    let group = textures_and_uniform(gpu, &layout, textures.as_flattened(), None, "copy6")?;
     let run_combine = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         combine.encode(gpu, &mut encoder, &buffers, 1, m, &target_view)?;
         gpu.queue.submit([encoder.finish()]);
         gpu.wait_idle()
     };
-    let run_copy = || draw_fullscreen(gpu, &copy4, &group, &target_view);
+    let run_copy = || draw_fullscreen(gpu, &copy6, &group, &target_view);
     let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs)?;
-    // Both read one color and one id/depth texel of each buffer.
-    let reads = Reads::NONE.plus(2, 1, FORMAT).plus(2, 1, ID_DEPTH_FORMAT);
+    // The copy reads color, id and depth of each buffer; the combine also the older depth at
+    // its first estimate.
+    let copy = Reads::NONE
+        .plus(2, 1, FORMAT)
+        .plus(2, 1, ID_FORMAT)
+        .plus(2, 1, LOD_DEPTH_FORMAT);
     Ok(PassRatio {
         pass: "combine (frame-sequential)".to_owned(),
-        baseline: "plain copy of the same 4 textures".to_owned(),
+        baseline: "plain copy of the same 6 textures".to_owned(),
         size: (size, size),
         pass_ms,
         baseline_ms,
         ratio,
         pairs,
-        pass_reads: reads,
-        baseline_reads: reads,
+        pass_reads: copy.plus(1, 1, LOD_DEPTH_FORMAT),
+        baseline_reads: copy,
     })
 }
 

@@ -10,10 +10,12 @@
 //       both or neither: lodkit_combine_samples
 //   lodkit_combine_texel(uv, size) -> uvec2, lodkit_combine_uv(pixel, size) -> vec2
 //   lodkit_combine_older_texel(pixel, size, newer_depth, first_depth, new_to_old) -> uvec2
-//   lodkit_combine_texels(newer_color, newer_texel, old, older_color, older_texel) -> vec4
-//   lodkit_combine_at(newer_color, newer_id_depth, older_color, older_id_depth, pixel, new_to_old)
-//       -> vec4   the whole per-pixel combine (a macro: takes sampler2D / usampler2D, or
-//       sampler2D(texture, sampler) / usampler2D(texture, sampler) in Vulkan GLSL; pixel a uvec2)
+//   lodkit_combine_texels(newer_color, newer_word, old, older_color, older_word, older_depth)
+//       -> vec4
+//   lodkit_combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth,
+//       pixel, new_to_old) -> vec4   the whole per-pixel combine (a macro: takes sampler2D /
+//       usampler2D, or sampler2D(texture, sampler) / usampler2D(texture, sampler) in Vulkan
+//       GLSL, the depths as sampler2D of the depth attachments; pixel a uvec2)
 //   lodkit_depth_closer(a, b) -> bool
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z).
@@ -81,35 +83,34 @@ uvec2 lodkit_combine_older_texel(uvec2 pixel, uvec2 size, float newer_depth, flo
 }
 
 /// The combined color from the fetched texels.
-vec4 lodkit_combine_texels(vec4 newer_color, uvec2 newer_texel, vec3 old, vec4 older_color, uvec2 older_texel) {
+vec4 lodkit_combine_texels(vec4 newer_color, uint newer_word, vec3 old, vec4 older_color, uint older_word, float older_depth) {
     if (!lodkit_in_viewport(old.xy)) {
         return newer_color;
     }
-    lodkit_LodSample newer = lodkit_LodSample(newer_color, lodkit_lod_buffer_id(newer_texel), old.z);
-    lodkit_LodSample older = lodkit_LodSample(older_color, lodkit_lod_buffer_id(older_texel), lodkit_lod_buffer_depth(older_texel));
-    bool newer_shown = lodkit_lod_buffer_shown(newer_texel, LODKIT_LOD_BUFFER_SHOWN_NOW);
-    bool older_shown = lodkit_lod_buffer_shown(older_texel, LODKIT_LOD_BUFFER_SHOWN_NEXT);
+    lodkit_LodSample newer = lodkit_LodSample(newer_color, lodkit_lod_buffer_id(newer_word), old.z);
+    lodkit_LodSample older = lodkit_LodSample(older_color, lodkit_lod_buffer_id(older_word), older_depth);
+    bool newer_shown = lodkit_lod_buffer_shown(newer_word, LODKIT_LOD_BUFFER_SHOWN_NOW);
+    bool older_shown = lodkit_lod_buffer_shown(older_word, LODKIT_LOD_BUFFER_SHOWN_NEXT);
     return lodkit_combine_shown(newer, newer_shown, older, older_shown);
 }
 
 /// The size of the buffers.
 #define LODKIT_COMBINE_SIZE_(nc) uvec2(textureSize((nc), 0))
-/// The newer id/depth texel at the pixel.
-#define LODKIT_COMBINE_NEWER_(nid, px) texelFetch((nid), ivec2(px), 0).xy
 /// The newer clip depth at the pixel.
-#define LODKIT_COMBINE_DEPTH_(nid, px) lodkit_lod_buffer_depth(LODKIT_COMBINE_NEWER_(nid, px))
+#define LODKIT_COMBINE_DEPTH_(nd, px) texelFetch((nd), ivec2(px), 0).x
 /// The newer pixel reprojected with its own depth.
-#define LODKIT_COMBINE_OLD_(nc, nid, px, m) \
-    lodkit_reproject(lodkit_combine_uv((px), LODKIT_COMBINE_SIZE_(nc)), LODKIT_COMBINE_DEPTH_(nid, px), (m))
+#define LODKIT_COMBINE_OLD_(nc, nd, px, m) \
+    lodkit_reproject(lodkit_combine_uv((px), LODKIT_COMBINE_SIZE_(nc)), LODKIT_COMBINE_DEPTH_(nd, px), (m))
 /// The older texel read (refined at the older depth of the first estimate).
-#define LODKIT_COMBINE_OLDER_(nc, nid, oid, px, m) \
-    lodkit_combine_older_texel((px), LODKIT_COMBINE_SIZE_(nc), LODKIT_COMBINE_DEPTH_(nid, px), \
-        lodkit_lod_buffer_depth(texelFetch((oid), ivec2(lodkit_combine_texel(LODKIT_COMBINE_OLD_(nc, nid, px, m).xy, LODKIT_COMBINE_SIZE_(nc))), 0).xy), (m))
+#define LODKIT_COMBINE_OLDER_(nc, nd, od, px, m) \
+    ivec2(lodkit_combine_older_texel((px), LODKIT_COMBINE_SIZE_(nc), LODKIT_COMBINE_DEPTH_(nd, px), \
+        texelFetch((od), ivec2(lodkit_combine_texel(LODKIT_COMBINE_OLD_(nc, nd, px, m).xy, LODKIT_COMBINE_SIZE_(nc))), 0).x, (m)))
 
 /// The whole per-pixel combine at `px` (uvec2), for a full-screen pass the engine already has.
-#define lodkit_combine_at(nc, nid, oc, oid, px, m) \
-    lodkit_combine_texels(texelFetch((nc), ivec2(px), 0), LODKIT_COMBINE_NEWER_(nid, px), LODKIT_COMBINE_OLD_(nc, nid, px, m), \
-        texelFetch((oc), ivec2(LODKIT_COMBINE_OLDER_(nc, nid, oid, px, m)), 0), \
-        texelFetch((oid), ivec2(LODKIT_COMBINE_OLDER_(nc, nid, oid, px, m)), 0).xy)
+#define lodkit_combine_at(nc, nid, nd, oc, oid, od, px, m) \
+    lodkit_combine_texels(texelFetch((nc), ivec2(px), 0), texelFetch((nid), ivec2(px), 0).x, LODKIT_COMBINE_OLD_(nc, nd, px, m), \
+        texelFetch((oc), LODKIT_COMBINE_OLDER_(nc, nd, od, px, m), 0), \
+        texelFetch((oid), LODKIT_COMBINE_OLDER_(nc, nd, od, px, m), 0).x, \
+        texelFetch((od), LODKIT_COMBINE_OLDER_(nc, nd, od, px, m), 0).x)
 
 #endif // LODKIT_COMBINE_GLSL

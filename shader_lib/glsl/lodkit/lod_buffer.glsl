@@ -2,20 +2,20 @@
 // (Scherzer & Wimmer 2008, sec. 3.2, 3.5).
 //
 // GLSL twin of shader_lib/wgsl/lodkit/lod_buffer.wgsl; same semantics, `lodkit_` prefix.
-// Location 0 color, location 1 rg32ui = (id word, floatBitsToUint(depth)); 12 bytes per pixel
-// per LOD buffer with an rgba8 color. The id word: instance id in bits 0..29, display-time flags
-// in bits 30 (shown now) and 31 (shown next frame).
+// Location 0 color, location 1 r32ui, the id word (instance id in bits 0..29, display-time flags
+// in bits 30 (shown now) and 31 (shown next frame)); each LOD buffer's own depth attachment keeps
+// the depth. 8 bytes per pixel per LOD buffer beyond the depth attachment with an rgba8 color.
 //
 // Exports:
-//   lodkit_LodBufferOutput { color, id_depth }
+//   lodkit_LodBufferOutput { color, id }
 //   LODKIT_LOD_BUFFER_ID_MASK, LODKIT_LOD_BUFFER_SHOWN_NOW, LODKIT_LOD_BUFFER_SHOWN_NEXT: uint
+//   lodkit_lod_buffer_output_flags(color, instance_id, flags) -> lodkit_LodBufferOutput
 //   lodkit_lod_buffer_output(color, instance_id, depth) -> lodkit_LodBufferOutput   shown in both
-//   lodkit_lod_buffer_output_flags(color, instance_id, depth, flags) -> lodkit_LodBufferOutput
-//   lodkit_lod_buffer_depth(id_depth) -> float, lodkit_lod_buffer_id(id_depth) -> uint,
-//   lodkit_lod_buffer_flags(id_depth) -> uint
-//   lodkit_lod_buffer_shown(id_depth, flag) -> bool   n-instance, or the flag is set
+//       frames (depth is kept by the depth attachment; the parameter is not stored)
+//   lodkit_lod_buffer_id(word) -> uint, lodkit_lod_buffer_flags(word) -> uint
+//   lodkit_lod_buffer_shown(word, flag) -> bool   n-instance, or the flag is set
 // Usage: lodkit_LodBufferOutput o = lodkit_lod_buffer_output(c, id, gl_FragCoord.z);
-//        out_color = o.color; out_id_depth = o.id_depth;
+//        out_color = o.color; out_id = o.id;
 // Shader defs: none.
 #ifndef LODKIT_LOD_BUFFER_GLSL
 #define LODKIT_LOD_BUFFER_GLSL
@@ -23,10 +23,9 @@
 /// Fragment output of a LOD buffer pass.
 struct lodkit_LodBufferOutput {
     vec4 color;
-    uvec2 id_depth;
+    uint id;
 };
 
-/// Packs `color`, `instance_id` (0 = n-instance) and clip `depth`.
 /// Bits of the id word that hold the instance id (ids exact up to 2^30 - 1).
 const uint LODKIT_LOD_BUFFER_ID_MASK = 0x3fffffffu;
 /// Flag: shown in the frame the buffer is rendered for.
@@ -34,35 +33,29 @@ const uint LODKIT_LOD_BUFFER_SHOWN_NOW = 1u;
 /// Flag: shown in the next frame, when the buffer is the older one.
 const uint LODKIT_LOD_BUFFER_SHOWN_NEXT = 2u;
 
-/// Packs color, instance id, clip depth and display-time flags.
-lodkit_LodBufferOutput lodkit_lod_buffer_output_flags(vec4 color, uint instance_id, float depth, uint flags) {
-    uint word = (instance_id & LODKIT_LOD_BUFFER_ID_MASK) | ((flags & 3u) << 30u);
-    return lodkit_LodBufferOutput(color, uvec2(word, floatBitsToUint(depth)));
+/// Packs color, instance id and display-time flags.
+lodkit_LodBufferOutput lodkit_lod_buffer_output_flags(vec4 color, uint instance_id, uint flags) {
+    return lodkit_LodBufferOutput(color, (instance_id & LODKIT_LOD_BUFFER_ID_MASK) | ((flags & 3u) << 30u));
 }
 
-/// Packs color, instance id (0 = n-instance) and clip depth, shown in both frames.
+/// Packs color and instance id (0 = n-instance), shown in both frames; depth is not stored.
 lodkit_LodBufferOutput lodkit_lod_buffer_output(vec4 color, uint instance_id, float depth) {
-    return lodkit_lod_buffer_output_flags(color, instance_id, depth, LODKIT_LOD_BUFFER_SHOWN_NOW | LODKIT_LOD_BUFFER_SHOWN_NEXT);
+    return lodkit_lod_buffer_output_flags(color, instance_id, LODKIT_LOD_BUFFER_SHOWN_NOW | LODKIT_LOD_BUFFER_SHOWN_NEXT);
 }
 
-/// Instance id of a texel of the id/depth target.
-uint lodkit_lod_buffer_id(uvec2 id_depth) {
-    return id_depth.x & LODKIT_LOD_BUFFER_ID_MASK;
+/// Instance id of an id word.
+uint lodkit_lod_buffer_id(uint word) {
+    return word & LODKIT_LOD_BUFFER_ID_MASK;
 }
 
-/// Display-time flags of a texel.
-uint lodkit_lod_buffer_flags(uvec2 id_depth) {
-    return id_depth.x >> 30u;
+/// Display-time flags of an id word.
+uint lodkit_lod_buffer_flags(uint word) {
+    return word >> 30u;
 }
 
 /// Whether a texel is shown in the frame `flag` names (always for n-instances).
-bool lodkit_lod_buffer_shown(uvec2 id_depth, uint flag) {
-    return lodkit_lod_buffer_id(id_depth) == 0u || (lodkit_lod_buffer_flags(id_depth) & flag) != 0u;
-}
-
-/// Clip depth of a texel of the id/depth target.
-float lodkit_lod_buffer_depth(uvec2 id_depth) {
-    return uintBitsToFloat(id_depth.y);
+bool lodkit_lod_buffer_shown(uint word, uint flag) {
+    return lodkit_lod_buffer_id(word) == 0u || (lodkit_lod_buffer_flags(word) & flag) != 0u;
 }
 
 #endif // LODKIT_LOD_BUFFER_GLSL

@@ -17,16 +17,19 @@
 //   combine_older_texel(pixel, size, newer_depth, first_depth, new_to_old) -> vec2<u32>   where
 //       the older buffer is read: the reprojection refined at the older depth first_depth found
 //       at the first estimate (lodkit::reproject::reproject_refine)
-//   combine_texels(newer_color, newer_texel, old, older_color, older_texel) -> vec4<f32>   the
-//       combined color from the fetched texels (old = reproject(uv, newer depth))
-//   combine_at(newer_color, newer_id_depth, older_color, older_id_depth, pixel, new_to_old)
-//       -> vec4<f32>   the whole per-pixel combine (passes/combine.wgsl), to fold into a
-//       full-screen pass an engine already has (tonemapping, TAA): no pass of its own
+//   combine_texels(newer_color, newer_word, old, older_color, older_word, older_depth)
+//       -> vec4<f32>   the combined color from the fetched texels (old = reproject(uv, newer
+//       depth); words: lodkit::lod_buffer id words)
+//   combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel,
+//       new_to_old) -> vec4<f32>   the whole per-pixel combine (passes/combine.wgsl), to fold
+//       into a full-screen pass an engine already has (tonemapping, TAA): no pass of its own.
+//       The depths are the LOD buffers' depth attachments bound as texture_2d<f32>
+//       (unfilterable float; a depth view of Depth32Float).
 //   depth_closer(a, b) -> bool   a strictly closer than b under the depth convention
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z); off: 0 near.
 #define_import_path lodkit::combine
-#import lodkit::lod_buffer::{lod_buffer_id, lod_buffer_depth, lod_buffer_shown, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT}
+#import lodkit::lod_buffer::{lod_buffer_id, lod_buffer_shown, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT}
 #import lodkit::reproject::{reproject, reproject_base, reproject_from_base, reproject_refine, in_viewport}
 
 /// One texel of a LOD buffer: color, instance id (0 = n-instance), clip depth.
@@ -91,42 +94,50 @@ fn combine_older_texel(pixel: vec2<u32>, size: vec2<u32>, newer_depth: f32, firs
     return select(combine_texel(first.xy, size), combine_texel(refined.xy, size), in_viewport(refined.xy));
 }
 
-/// The combined color from the texels the combine reads: the newer color and id/depth texel at
-/// the pixel, `old` = reproject(uv, newer depth, new_to_old), the older color and id/depth texel
-/// at combine_older_texel. Outside the older view the newer color; else combine_shown, the newer
+/// The combined color from the texels the combine reads: the newer color and id word at the
+/// pixel, `old` = reproject(uv, newer depth, new_to_old), the older color, id word and depth at
+/// combine_older_texel. Outside the older view the newer color; else combine_shown, the newer
 /// sample shown if flagged for now, the older if flagged for next.
-fn combine_texels(newer_color: vec4<f32>, newer_texel: vec2<u32>, old: vec3<f32>, older_color: vec4<f32>, older_texel: vec2<u32>) -> vec4<f32> {
+fn combine_texels(newer_color: vec4<f32>, newer_word: u32, old: vec3<f32>, older_color: vec4<f32>, older_word: u32, older_depth: f32) -> vec4<f32> {
     if (!in_viewport(old.xy)) {
         return newer_color;
     }
-    let newer = LodSample(newer_color, lod_buffer_id(newer_texel), old.z);
-    let older = LodSample(older_color, lod_buffer_id(older_texel), lod_buffer_depth(older_texel));
-    let newer_shown = lod_buffer_shown(newer_texel, LOD_BUFFER_SHOWN_NOW);
-    let older_shown = lod_buffer_shown(older_texel, LOD_BUFFER_SHOWN_NEXT);
+    let newer = LodSample(newer_color, lod_buffer_id(newer_word), old.z);
+    let older = LodSample(older_color, lod_buffer_id(older_word), older_depth);
+    let newer_shown = lod_buffer_shown(newer_word, LOD_BUFFER_SHOWN_NOW);
+    let older_shown = lod_buffer_shown(older_word, LOD_BUFFER_SHOWN_NEXT);
     return combine_shown(newer, newer_shown, older, older_shown);
 }
 
 /// The whole per-pixel combine of frame-sequential LOD at `pixel` (what passes/combine.wgsl
 /// draws), for an engine to call in a full-screen pass it already runs (tonemapping, TAA) and
-/// save the pass: five texel loads (three outside the t-instances' pixels would do, see
-/// docs/frame-sequential.md).
+/// save the pass. Six texel loads: the newer color, id and depth, the older depth at the first
+/// estimate, the older color and id (plus the older depth there) at the refined texel.
 fn combine_at(
     newer_color: texture_2d<f32>,
-    newer_id_depth: texture_2d<u32>,
+    newer_id: texture_2d<u32>,
+    newer_depth: texture_2d<f32>,
     older_color: texture_2d<f32>,
-    older_id_depth: texture_2d<u32>,
+    older_id: texture_2d<u32>,
+    older_depth: texture_2d<f32>,
     pixel: vec2<u32>,
     new_to_old: mat4x4<f32>,
 ) -> vec4<f32> {
     let size = textureDimensions(newer_color, 0);
-    let newer_texel = textureLoad(newer_id_depth, pixel, 0).xy;
     let color = textureLoad(newer_color, pixel, 0);
-    let depth = lod_buffer_depth(newer_texel);
+    let depth = textureLoad(newer_depth, pixel, 0).x;
     let old = reproject(combine_uv(pixel, size), depth, new_to_old);
     if (!in_viewport(old.xy)) {
         return color;
     }
-    let first_depth = lod_buffer_depth(textureLoad(older_id_depth, combine_texel(old.xy, size), 0).xy);
+    let first_depth = textureLoad(older_depth, combine_texel(old.xy, size), 0).x;
     let older = combine_older_texel(pixel, size, depth, first_depth, new_to_old);
-    return combine_texels(color, newer_texel, old, textureLoad(older_color, older, 0), textureLoad(older_id_depth, older, 0).xy);
+    return combine_texels(
+        color,
+        textureLoad(newer_id, pixel, 0).x,
+        old,
+        textureLoad(older_color, older, 0),
+        textureLoad(older_id, older, 0).x,
+        textureLoad(older_depth, older, 0).x,
+    );
 }
