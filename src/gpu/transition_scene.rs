@@ -181,7 +181,8 @@ impl TransitionScene {
 /// The draws of one object in transition from `outgoing` to `incoming` (mesh and color each) at
 /// progress `t`, drawn with `technique`, in the order to draw them. Blended items (cross-fade,
 /// unpopping) belong after the scene's opaque objects; a dithering technique needs a renderer
-/// with its [`SingleFrameTechnique::dither_pattern`].
+/// with its [`SingleFrameTechnique::dither_pattern`]. Outside the transition (t <= 0 or NaN,
+/// t >= 1) only the visible LOD is drawn, opaque.
 pub fn transition_items<'a>(
     technique: SingleFrameTechnique,
     t: f32,
@@ -202,6 +203,15 @@ pub fn transition_items<'a>(
             dither_alpha,
         }
     };
+    // Before and after the transition only one LOD is visible: draw only that one.
+    if technique != SingleFrameTechnique::HardSwitch && !(t > 0.0 && t < 1.0) {
+        let role = if t >= 1.0 {
+            LodRole::Incoming
+        } else {
+            LodRole::Outgoing
+        };
+        return vec![item(role, LodRenderState::OPAQUE, None)];
+    }
     match technique {
         SingleFrameTechnique::HardSwitch => {
             let role = if t < 0.5 {
