@@ -9,8 +9,9 @@
 //! 2. `draw(key)` gives each instance this frame's LOD, id and visibility threshold tau; the
 //!    scene goes into LOD buffer `buffer_index()` (your forward pass writes color, id and depth;
 //!    `LodBufferRenderer` is lodkit's reference for it);
-//! 3. `CombinePass` merges that buffer with last frame's, reprojected through the camera motion
-//!    (`new_to_old_matrix`), into the frame's target.
+//! 3. `CombinePass::encode_regions` merges that buffer with last frame's, reprojected through
+//!    the camera motion (`new_to_old_matrix`), into the frame's target, only inside the screen
+//!    rectangles of the instances in transition; the rest of the frame is a copy.
 //!
 //! `cargo run --example frame_sequential -- [--out DIR]`
 //! Writes DIR/frame_sequential.png (default DIR: lodkit-out): frames of the camera pulling back
@@ -19,6 +20,7 @@
 use std::error::Error;
 
 use glam::{Mat4, Vec3, Vec4};
+use lodkit::combine::screen_rect;
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
@@ -37,6 +39,11 @@ const FRAMES: usize = 90;
 /// Columns of the strip: frames spread evenly over the run.
 const COLUMNS: usize = 6;
 
+/// Object to world of the instance at `p`.
+fn model(p: Vec3) -> Mat4 {
+    Mat4::from_translation(p) * Mat4::from_scale(Vec3::splat(0.45))
+}
+
 fn main() -> Result<(), Box<dyn Error>> {
     let out = std::env::args()
         .skip_while(|a| a != "--out")
@@ -51,7 +58,9 @@ fn main() -> Result<(), Box<dyn Error>> {
     let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 1);
     let renderer = LodBufferRenderer::new(&gpu, FORMAT, &vis, 0.25)?;
     let combine = CombinePass::new(&gpu, FORMAT, false)?;
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+        | wgpu::TextureUsages::COPY_SRC
+        | wgpu::TextureUsages::COPY_DST;
     let target = texture_2d(&gpu, SIZE, FORMAT, usage, "frame")?;
     let target_view = target.create_view(&Default::default());
     let lods = [
@@ -111,8 +120,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             .map(|(key, &p)| {
                 let d = scheduler.draw(*key)?;
                 let (mesh, color) = &lods[usize::from(d.lod.min(1))];
-                let model = Mat4::from_translation(p) * Mat4::from_scale(Vec3::splat(0.45));
-                Ok(LodDrawItem::from_draw(mesh, model, *color, &d))
+                Ok(LodDrawItem::from_draw(mesh, model(p), *color, &d))
             })
             .collect::<Result<Vec<_>, Box<dyn Error>>>()?;
         let index = scheduler.buffer_index();
@@ -124,18 +132,29 @@ fn main() -> Result<(), Box<dyn Error>> {
         };
         renderer.render(&gpu, &buffers, index, proj * view, &items, clear, None)?;
 
-        // 3. Combine with last frame's buffer, reprojected through the camera motion.
+        // 3. Combine with last frame's buffer, reprojected through the camera motion, where the
+        //    t-instances are in this frame's and last frame's view (both LODs fit the unit box).
         let new_to_old = previous_view.map_or(CombinePass::NO_HISTORY, |old| {
             new_to_old_matrix(&view, &proj, &old, &proj)
         });
+        let views = [proj * view, proj * previous_view.unwrap_or(view)];
+        let unit_box = (Vec3::splat(-1.0), Vec3::splat(1.0));
+        let regions: Vec<_> = keys
+            .iter()
+            .zip(&positions)
+            .filter(|(key, _)| scheduler.in_transition(**key))
+            .filter_map(|(_, &p)| screen_rect(unit_box, model(p), &views, SIZE, 2))
+            .collect();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        combine.encode(
+        let (newer, out) = (index, &target_view);
+        combine.encode_regions(
             &gpu,
             &mut encoder,
             &buffers,
-            index,
+            newer,
             new_to_old,
-            &target_view,
+            out,
+            &regions,
         )?;
         gpu.queue.submit([encoder.finish()]);
         previous_view = Some(view);

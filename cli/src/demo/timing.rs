@@ -208,8 +208,8 @@ fn draw_fullscreen(
     gpu.wait_idle()
 }
 
-/// The combine pass against a plain pass reading the same four textures (two colors, two
-/// id/depth) at `size` x `size`, on two LOD buffers of a grid of spheres and boxes with a third
+/// The combine pass against a plain pass reading the same six textures (color, id and depth of
+/// each buffer) at `size` x `size`, on two LOD buffers of a grid of spheres and boxes with a third
 /// of them in transition and the camera moved between the frames.
 pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<PassRatio, GpuError> {
     let buffers = LodBuffers::new(gpu, size, size, FORMAT)?;
