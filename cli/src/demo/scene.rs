@@ -101,6 +101,11 @@ pub enum Shape {
     },
     /// Cube from -1 to 1.
     Cube,
+    /// Box from -half to half (each half-size in (0, 100]).
+    Box {
+        /// Half-sizes along x, y, z.
+        half: [f32; 3],
+    },
     /// Tree-like cluster: a trunk and `puffs` spheres of `rings` rings (puffs 1..=32).
     Tree {
         /// Canopy spheres.
@@ -116,6 +121,11 @@ impl Shape {
         match self {
             Shape::Sphere { rings, segments } => Mesh::sphere(rings, segments),
             Shape::Cube => Mesh::cube(),
+            Shape::Box { half } => {
+                let mut m = Mesh::default();
+                m.append(&Mesh::cube(), Mat4::from_scale(Vec3::from(half)));
+                m
+            }
             Shape::Tree { puffs, rings } => {
                 let mut m = Mesh::default();
                 let trunk = Mat4::from_translation(Vec3::new(0.0, -0.6, 0.0))
@@ -148,7 +158,7 @@ impl Shape {
         let sphere = |rings: u32, segments: u32| 2 * u64::from(rings) * u64::from(segments);
         match self {
             Shape::Sphere { rings, segments } => sphere(rings.max(2), segments.max(3)),
-            Shape::Cube => 12,
+            Shape::Cube | Shape::Box { .. } => 12,
             Shape::Tree { puffs, rings } => {
                 12 + u64::from(puffs) * sphere(rings.max(2), rings.saturating_mul(2).max(3))
             }
@@ -168,6 +178,9 @@ impl Shape {
             }
             Shape::Tree { rings, .. } if !(2..=64).contains(&rings) => {
                 Err(format!("Tree rings = {rings} is outside 2..=64"))
+            }
+            Shape::Box { half } if !half.iter().all(|h| *h > 0.0 && *h <= 100.0) => {
+                Err(format!("Box half = {half:?} must lie in (0, 100]"))
             }
             _ => Ok(()),
         }
@@ -322,9 +335,9 @@ impl DemoScene {
         Mat4::from_translation(o.position.into()) * Mat4::from_scale(o.scale.into())
     }
 
-    /// The built-in scenes: `simple` and `trees`.
+    /// The built-in scenes: `simple`, `trees` and `field`.
     pub fn built_in() -> Vec<DemoScene> {
-        vec![Self::simple(), Self::trees()]
+        vec![Self::simple(), Self::trees(), Self::field()]
     }
 
     /// A SIMPLE-like scene (Scherzer & Wimmer 2008, Fig. 9): a grid of red spheres (LOD 0)
@@ -395,6 +408,76 @@ impl DemoScene {
                 eye: [0.0, 1.2, 6.0],
                 target: [0.0, 0.0, -1.0],
                 moving_eye: [1.6, 1.5, 5.0],
+                fov_y: 0.8,
+            },
+            objects,
+        }
+    }
+}
+
+impl DemoScene {
+    /// The case engines have: a field of trees at many distances, of which a few objects are in
+    /// transition at a time and cover a small part of the screen. Their LOD chains are the ones
+    /// single-frame blends find hard: a near and a far tree, a sphere whose box LOD intersects it
+    /// (corners outside, faces inside), and a flat sign whose two LODs are coplanar.
+    pub fn field() -> DemoScene {
+        let tree = |x: f32, z: f32, transition: bool| DemoObject {
+            fine: Shape::Tree { puffs: 7, rings: 8 },
+            coarse: Shape::Tree { puffs: 1, rings: 4 },
+            fine_color: [0.15, 0.6, 0.2],
+            coarse_color: [0.1, 0.45, 0.35],
+            position: [x, 0.0, z],
+            scale: [0.8; 3],
+            transition,
+        };
+        let mut objects: Vec<DemoObject> = (0..30)
+            .map(|i| {
+                let (col, row) = ((i % 6) as f32, (i / 6) as f32);
+                // Staggered rows from 3 to 19 units in front of the camera.
+                let x = col * 2.4 - 6.0 + 0.9 * (row % 2.0);
+                tree(x, 1.0 - row * 4.0, false)
+            })
+            .collect();
+        objects.push(tree(-1.3, 1.6, true));
+        objects.push(tree(3.0, -13.0, true));
+        objects.push(DemoObject {
+            fine: Shape::Sphere {
+                rings: 16,
+                segments: 24,
+            },
+            coarse: Shape::Box {
+                half: [0.8, 0.8, 0.8],
+            },
+            fine_color: [0.9, 0.15, 0.1],
+            coarse_color: [0.15, 0.3, 0.95],
+            position: [1.4, -0.3, -1.0],
+            scale: [0.6; 3],
+            transition: true,
+        });
+        objects.push(DemoObject {
+            fine: Shape::Box {
+                half: [1.0, 0.6, 0.04],
+            },
+            coarse: Shape::Box {
+                half: [1.0, 0.6, 0.04],
+            },
+            fine_color: [0.95, 0.8, 0.2],
+            coarse_color: [0.9, 0.45, 0.1],
+            position: [-3.6, 0.2, -5.0],
+            scale: [1.0; 3],
+            transition: true,
+        });
+        objects.push(scenery(
+            [0.0, -1.0, -8.0],
+            [14.0, 0.1, 14.0],
+            [0.45, 0.4, 0.3],
+        ));
+        DemoScene {
+            name: "field".to_owned(),
+            camera: DemoCamera {
+                eye: [0.0, 1.6, 5.5],
+                target: [0.0, 0.0, -6.0],
+                moving_eye: [1.4, 1.9, 4.5],
                 fov_y: 0.8,
             },
             objects,
