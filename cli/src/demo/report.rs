@@ -389,7 +389,7 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     q.push_str(&super::report_fb::quality_markdown(report));
     write(&docs.join("quality.md"), &q)?;
     let mut b = header(report, "Benchmarks");
-    b.push_str("\n## Cost of a transition\n\nTriangles submitted and fragments counted over the transition's frames, static camera. Frame-sequential adds one fullscreen combine pass (one fragment per pixel, included).\n");
+    b.push_str("\n## Cost of a transition\n\nTriangles submitted and fragments counted over the transition's frames, static camera. Frame-sequential adds the combine pass over the screen rectangles of the objects in transition (one fragment per pixel of the rectangles, included; the rest of the frame is a copy). The last column compares the frames before and after the transition, with no object in transition.\n");
     b.push_str(&transition_tables(report, true));
     b.push_str("\n## Pass time ratios\n\nEach pass against the plainest pass with the same memory traffic, timed in interleaved pairs; the figure is the median of the per-pair ratios.\n\n");
     b.push_str(&ratio_table(report).markdown());
