@@ -3,7 +3,7 @@
 
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, LodSample, combine_samples};
-use lodkit::frame_sequential::{Drive, ID_QUARANTINE_FRAMES, TransitionScheduler};
+use lodkit::frame_sequential::{Drive, ID_QUARANTINE_FRAMES, Schedule, TransitionScheduler};
 use lodkit::reproject::{
     in_viewport, new_to_old_matrix, reproject, reproject_base, reproject_refine,
 };
@@ -545,6 +545,32 @@ proptest! {
             let d = s.draw(key).unwrap();
             prop_assert_eq!(d.incoming, k % 2 == 1);
             prop_assert_eq!(d.lod, u8::from(d.incoming));
+        }
+    }
+}
+
+proptest! {
+    /// With a steady frame time, the threshold a LOD is drawn with for the next frame is exactly
+    /// the one it has there, under both schedules, so the older buffer is shown as the frame
+    /// displayed wants it.
+    #[test]
+    fn tau_next_is_the_next_frames_tau_at_a_steady_frame_time(
+        seconds in 0.05f32..2.0, dt in 0.001f32..0.1, complementary: bool,
+    ) {
+        let schedule = if complementary { Schedule::Complementary } else { Schedule::Paper };
+        let mut s = TransitionScheduler::with_schedule(schedule);
+        let key = s.insert(0);
+        s.advance(dt);
+        s.begin_transition(key, 1, Drive::Time { seconds }).unwrap();
+        let mut draw = s.draw(key).unwrap();
+        while s.in_transition(key) {
+            s.advance(dt);
+            let Ok(next) = s.draw(key) else { break };
+            if !s.in_transition(key) {
+                break;
+            }
+            prop_assert_eq!(draw.tau_next, schedule.threshold(next.progress, draw.incoming));
+            draw = next;
         }
     }
 }

@@ -3,12 +3,13 @@
 //! Instances are n-instances (no transition: drawn normally, id 0) or t-instances (in a
 //! transition between two LODs). A t-instance is drawn with ONE of its two LODs per frame,
 //! alternating with its own phase: the frame its transition begins, and every other frame after,
-//! draw the outgoing LOD, the frames between the incoming, each with its visibility threshold tau
-//! under the [`Schedule`] (the paper's Fig. 2 or complementary), the threshold the same LOD will
-//! have next frame (display-time visibility: the combine shows each LOD as it is at the frame
-//! displayed) and the instance's id. A transition may begin on any frame: its first frame draws the
-//! outgoing LOD whole (tau = 1 at progress 0), so the object never drops out of the newer buffer. The combine pass merges
-//! this frame's LOD buffer with last frame's. Pure math, no wgpu.
+//! draw the outgoing LOD, the frames between the incoming. Each draw carries the instance's id,
+//! the LOD's visibility threshold tau under the [`Schedule`] (the paper's Fig. 2 or
+//! complementary) and the threshold the same LOD will have next frame (display-time visibility:
+//! the combine shows each LOD as it is at the frame displayed). A transition may begin on any
+//! frame: its first frame draws the outgoing LOD whole (both schedules show all of it at
+//! progress 0), so the object never drops out of the newer buffer. The combine pass merges this
+//! frame's LOD buffer with last frame's. Pure math, no wgpu.
 //!
 //! ```
 //! use lodkit::frame_sequential::{Drive, TransitionScheduler};
