@@ -1,7 +1,8 @@
 //! The pictures the technique guides show (`docs/img/`), cut from this run's output so that
 //! `lodkit demo --docs docs` keeps them in step with the code: a strip of each transition
-//! technique, the framebuffer-LOD comparison at r = 2, the controller plots, the frame-cost
-//! breakdown and the shading-cost sweep.
+//! technique, close-ups of the `field` scene's objects in transition, the framebuffer-LOD
+//! comparison at r = 2, the controller plots, the frame-cost breakdown and the shading-cost
+//! sweep.
 
 use std::path::Path;
 
@@ -49,6 +50,10 @@ pub fn write_doc_pictures(report: &DemoReport, out: &Path, docs: &Path) -> Resul
         &open(&out.join("upsample/r2.png"))?,
         &img.join("framebuffer-lod.png"),
     )?;
+    let field = out.join("close-ups/field.png");
+    if field.exists() {
+        save(&open(&field)?, &img.join("field-close-ups.png"))?;
+    }
     for (plot, name) in [
         ("controllers", "framerate-control"),
         ("frame-breakdown", "frame-breakdown"),

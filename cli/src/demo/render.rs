@@ -212,6 +212,22 @@ impl<'a> SceneRenderer<'a> {
         &self.counter
     }
 
+    /// Screen rectangles of the transitioning objects (both LODs' box) seen by the static
+    /// camera, in scene order; `None` for one off screen.
+    pub fn transition_rects(&self) -> Vec<Option<ScreenRect>> {
+        let (view, proj) = self.camera(0, false);
+        self.scene
+            .objects
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.transition)
+            .map(|(i, _)| {
+                let bounds = self.bounds[i]?;
+                screen_rect(bounds, self.scene.model(i), &[proj * view], self.size, 3)
+            })
+            .collect()
+    }
+
     fn camera(&self, frame: usize, moving: bool) -> (Mat4, Mat4) {
         let c = &self.scene.camera;
         let s = if moving {

@@ -447,6 +447,14 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
                 &format!("image change per frame, {camera} camera"),
             ));
         }
+        let order: Vec<&str> = rows.iter().map(|t| t.technique.as_str()).collect();
+        h.push_str(&img(
+            &format!("close-ups/{scene}.png"),
+            &format!(
+                "the objects in transition at the middle frame, static camera, enlarged twice; rows: {}",
+                order.join(", ")
+            ),
+        ));
         for t in &rows {
             let name = &t.technique;
             let _ = writeln!(h, "<h4>{name}</h4>");

@@ -450,8 +450,8 @@ impl DemoScene {
             },
             fine_color: [0.9, 0.15, 0.1],
             coarse_color: [0.15, 0.3, 0.95],
-            position: [1.4, -0.3, -1.0],
-            scale: [0.6; 3],
+            position: [0.6, 0.2, 2.0],
+            scale: [0.45; 3],
             transition: true,
         });
         objects.push(DemoObject {
@@ -463,7 +463,7 @@ impl DemoScene {
             },
             fine_color: [0.95, 0.8, 0.2],
             coarse_color: [0.9, 0.45, 0.1],
-            position: [-3.6, 0.2, -5.0],
+            position: [-4.2, 0.4, -4.0],
             scale: [1.0; 3],
             transition: true,
         });

@@ -256,6 +256,44 @@ pub fn sources_image(size: (u32, u32), sources: &[PixelSource]) -> image::RgbaIm
     })
 }
 
+/// Close-ups of the transitioning objects at the middle of the transition, static camera: one
+/// row per technique (in `strips` order), one column per object, each enlarged twice. Objects
+/// off screen are left out; at most six columns.
+fn close_ups(
+    renderer: &SceneRenderer,
+    strips: &[image::RgbaImage],
+    size: (u32, u32),
+) -> image::RgbaImage {
+    const SCALE: u32 = 2;
+    const GAP: u32 = 4;
+    let rects: Vec<_> = renderer
+        .transition_rects()
+        .into_iter()
+        .flatten()
+        .take(6)
+        .collect();
+    let width: u32 = rects.iter().map(|r| r.width * SCALE + GAP).sum();
+    let row = rects.iter().map(|r| r.height * SCALE).max().unwrap_or(0) + GAP;
+    let mut sheet =
+        image::RgbaImage::from_pixel(width, row * strips.len() as u32, image::Rgba([255; 4]));
+    // The strip's middle tile (slot 3 of 7) is the transition's middle frame.
+    for (y, strip) in strips.iter().enumerate() {
+        let mut x = 0;
+        for r in &rects {
+            let crop = image::imageops::crop_imm(strip, 3 * size.0 + r.x, r.y, r.width, r.height);
+            let big = image::imageops::resize(
+                &*crop,
+                r.width * SCALE,
+                r.height * SCALE,
+                image::imageops::FilterType::Nearest,
+            );
+            image::imageops::replace(&mut sheet, &big, i64::from(x), i64::from(row * y as u32));
+            x += r.width * SCALE + GAP;
+        }
+    }
+    sheet
+}
+
 /// Measures every technique on `renderer`'s scene, writing strips, see-through maps and the
 /// frame-sequential source maps under `out`; `tick` is called after each technique.
 pub fn measure_scene(
@@ -272,6 +310,7 @@ pub fn measure_scene(
     // Reference runs of the current technique family (single-frame or frame-sequential),
     // static and moving camera.
     let mut references: Option<(bool, [Vec<Vec<u8>>; 2])> = None;
+    let mut static_strips = Vec::new();
     for technique in Technique::ALL {
         let name = technique.name();
         let family = matches!(technique, Technique::FrameSequential(..));
@@ -298,6 +337,7 @@ pub fn measure_scene(
             }
             if !moving {
                 cost = (run.triangles, run.fragments, run.idle_fragments);
+                static_strips.push(run.strip.clone());
             }
             changes.push(run.change);
         }
@@ -322,6 +362,8 @@ pub fn measure_scene(
         });
         tick(name);
     }
+    let sheet = close_ups(renderer, &static_strips, size);
+    super::save(&sheet, &out.join(format!("close-ups/{scene}.png")))?;
     let hard = rows
         .iter()
         .find(|r| r.technique == "hard-switch")
