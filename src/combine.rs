@@ -214,15 +214,42 @@ pub fn combine_texels(
 }
 
 /// The whole per-pixel combine at `pixel` (the Rust twin of `combine_at`, with the buffers read
-/// back as [`LodImage`]s of the same size; `pixel` must lie inside them).
+/// back as [`LodImage`]s). `None` when the images differ in size or lack texels, or `pixel`
+/// lies outside them.
+///
+/// ```
+/// # use lodkit::combine::*;
+/// # use glam::{Mat4, UVec2, Vec4};
+/// let image = |c: f32| LodImage { width: 1, height: 1, colors: vec![Vec4::splat(c)], ids: vec![0],
+///     depths: vec![0.5], flags: vec![] };
+/// let m = Mat4::IDENTITY; // the same camera: the pixel maps to itself
+/// let std = DepthConvention::Standard;
+/// assert_eq!(combine_at(&image(1.0), &image(0.0), UVec2::ZERO, &m, std), Some(Vec4::ONE));
+/// assert_eq!(combine_at(&image(1.0), &image(0.0), UVec2::new(1, 0), &m, std), None);
+/// ```
 pub fn combine_at(
     newer: &LodImage,
     older: &LodImage,
     pixel: UVec2,
     new_to_old: &Mat4,
     convention: DepthConvention,
-) -> Vec4 {
-    combine_pixel(newer, older, pixel, new_to_old, convention).color
+) -> Option<Vec4> {
+    let inside = pixel.x < newer.width && pixel.y < newer.height;
+    (inside && images_fit(newer, older))
+        .then(|| combine_pixel(newer, older, pixel, new_to_old, convention).color)
+}
+
+/// Whether two LOD images have the same, non-zero size and complete texel arrays.
+fn images_fit(newer: &LodImage, older: &LodImage) -> bool {
+    let n = newer.width as usize * newer.height as usize;
+    let complete = |i: &LodImage| {
+        i.colors.len() == n
+            && i.ids.len() == n
+            && i.depths.len() == n
+            && (i.flags.is_empty() || i.flags.len() == n)
+    };
+    let same_size = (newer.width, newer.height) == (older.width, older.height);
+    n > 0 && same_size && complete(newer) && complete(older)
 }
 
 /// [`combine_at`] with the rule it applied and whether a GPU may read another texel.
@@ -304,18 +331,11 @@ pub fn combine_images(
     new_to_old: &Mat4,
     convention: DepthConvention,
 ) -> Vec<CombinedPixel> {
-    let n = (newer.width * newer.height) as usize;
-    let complete = |i: &LodImage| {
-        i.colors.len() == n
-            && i.ids.len() == n
-            && i.depths.len() == n
-            && (i.flags.is_empty() || i.flags.len() == n)
-    };
-    let same_size = (newer.width, newer.height) == (older.width, older.height);
-    if n == 0 || !same_size || !complete(newer) || !complete(older) {
+    if !images_fit(newer, older) {
         return Vec::new();
     }
-    (0..n as u32)
+    let n = newer.width * newer.height;
+    (0..n)
         .map(|p| {
             let pixel = UVec2::new(p % newer.width, p / newer.width);
             combine_pixel(newer, older, pixel, new_to_old, convention)
