@@ -87,6 +87,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 color: Vec4::new(0.9, 0.2, 0.1, 1.0),
                 state: LodRenderState::OPAQUE,
                 dither_alpha: None,
+                sway: [0.0; 2],
             }];
             let current = &lods[usize::from(selection.current.min(1))];
             match selection.next {
@@ -108,6 +109,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                     color: current.1,
                     state: LodRenderState::OPAQUE,
                     dither_alpha: None,
+                    sway: [0.0; 2],
                 }),
             }
             let clear = wgpu::Color {

@@ -300,6 +300,7 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
         id: 7,
         tau,
         tau_next: tau,
+        sway: [0.0; 2],
     };
     let render = |items: &[LodDrawItem]| {
         let clear = wgpu::Color::BLACK;
@@ -461,4 +462,43 @@ fn the_combine_over_the_t_instances_rectangles_equals_the_full_combine() {
         )
         .unwrap_err();
     assert!(err.to_string().contains("COPY_DST"), "{err}");
+}
+
+#[test]
+fn a_swaying_lod_moves_with_its_phase() {
+    let gpu = lodkit_test_gpu!();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 3);
+    let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.5).unwrap();
+    let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
+    let sphere = GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap();
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.1, 50.0);
+    let view = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.5, 5.0), Vec3::ZERO, Vec3::Y);
+    let render = |sway: [f32; 2]| {
+        let item = LodDrawItem {
+            mesh: &sphere,
+            model: Mat4::IDENTITY,
+            color: Vec4::ONE,
+            id: 3,
+            tau: 0.5,
+            tau_next: 0.5,
+            sway,
+        };
+        let clear = wgpu::Color::BLACK;
+        renderer
+            .render(gpu, &buffers, 0, proj * view, &[item], clear, None)
+            .unwrap();
+        read_lod_image(gpu, &buffers, 0).unwrap()
+    };
+    let still = render([0.0, 0.0]);
+    let (a, b) = (render([0.3, 1.0]), render([0.3, 2.5]));
+    let covered = |i: &lodkit::combine::LodImage| i.ids.iter().filter(|&&id| id == 3).count();
+    assert_eq!(
+        render([0.0, 2.5]).ids,
+        still.ids,
+        "no amplitude: the phase changes nothing"
+    );
+    assert_ne!(a.ids, still.ids, "the sway moves the geometry");
+    assert_ne!(a.ids, b.ids, "and follows its phase");
+    assert!(covered(&a) > 0 && covered(&b) > 0);
 }

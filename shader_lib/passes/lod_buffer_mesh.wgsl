@@ -1,8 +1,9 @@
 // passes/lod_buffer_mesh — a lit mesh drawn into a LOD buffer for frame-sequential LOD: what an
 // engine adds to its forward shader (Scherzer & Wimmer 2008, sec. 4.1).
 //
-// The vertex stage passes the object-space position on (before any animation, so the visibility
-// pattern sticks to the object). The fragment stage keeps every fragment of a t-instance and
+// The vertex stage sways the mesh like a plant in the wind when `draw.sway.x` is not 0 (an
+// engine's own vertex animation goes there) and passes the object-space position on from
+// before the animation, so the visibility pattern sticks to the object. The fragment stage keeps every fragment of a t-instance and
 // flags, in the id word, whether it is shown at tau (this frame) and at tau_next (the next frame,
 // when this buffer is the older one) (lodkit::visibility::visibility_flags): the combine pass
 // then shows each LOD with its visibility at the frame displayed, so its share changes every
@@ -13,6 +14,7 @@
 //   vs_main   @location(0) position, @location(1) normal (object space)
 //   fs_main   LodBufferOutput (location 0 color, location 1 r32uint id word; the depth
 //             attachment keeps the depth)
+//   sway_offset(p, sway) -> vec3<f32>   helper: the wind sway of the vertex stage
 // Bindings: group 0: 0 `camera: Camera` (uniform), 1 `vis_tex: texture_2d<f32>`;
 //   group 1: 0 `draw: LodDraw` (uniform, dynamic offset).
 // Shader defs: none.
@@ -38,6 +40,8 @@ struct LodDraw {
     vis_scale: f32,
     /// Visibility threshold of the same LOD in the next frame.
     tau_next: f32,
+    /// Sway: x amplitude (object units at the top of a unit-high mesh, 0 = none), y phase.
+    sway: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -50,10 +54,16 @@ struct VertexOut {
     @location(1) object_pos: vec3<f32>,
 }
 
-/// Transforms to clip space; hands the object-space position to the fragment stage.
+/// Wind sway of an object-space position: along x, growing with height above the base (y = -1).
+fn sway_offset(p: vec3<f32>, sway: vec2<f32>) -> vec3<f32> {
+    return vec3<f32>(sway.x * max(p.y + 1.0, 0.0) * sin(sway.y + p.x + p.z), 0.0, 0.0);
+}
+
+/// Sways, transforms to clip space; hands the object-space position from before the sway to the
+/// fragment stage.
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
-    let world = draw.model * vec4<f32>(position, 1.0);
+    let world = draw.model * vec4<f32>(position + sway_offset(position, draw.sway.xy), 1.0);
     return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz, position);
 }
 

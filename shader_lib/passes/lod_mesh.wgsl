@@ -1,7 +1,9 @@
 // passes/lod_mesh — a lit mesh drawn as one LOD of a transition: what an engine's forward shader
 // needs for screen-door LOD blending, and the opaque/blended draws of unpopping.
 //
-// The vertex stage transforms by camera and model matrices; the fragment stage shades with one
+// The vertex stage sways the mesh like a plant in the wind when `draw.sway.x` is not 0 (an
+// engine's own vertex animation goes there) and transforms by camera and model matrices; the
+// fragment stage shades with one
 // directional light and, when `draw.dither_alpha` is not DITHER_OFF, keeps only the pixels the
 // screen-door pattern gives this LOD (lodkit::screen_door; negative alpha = inverted pattern).
 // Alpha blending for unpopping and cross-fades uses the blend constant, so the shader is the same
@@ -10,6 +12,7 @@
 // Entry points:
 //   vs_main   @location(0) position, @location(1) normal (object space)
 //   fs_main   @location(0) color (rgb lit, a = draw.color.a)
+//   sway_offset(p, sway) -> vec3<f32>   helper: the wind sway of the vertex stage
 // Bindings: group 0 binding 0 `camera: Camera` (uniform); group 1 binding 0 `draw: Draw`
 // (uniform, dynamic offset).
 // Shader defs: LODKIT_SCREEN_DOOR_BLUE_NOISE (bool, default off) — passed on to lodkit::screen_door.
@@ -26,11 +29,11 @@ struct Camera {
 struct Draw {
     model: mat4x4<f32>,
     color: vec4<f32>,
+    /// Sway: x amplitude (object units at the top of a unit-high mesh, 0 = none), y phase.
+    sway: vec2<f32>,
     /// Screen-door alpha of this LOD, or DITHER_OFF (any value > 1) for no dithering.
     dither_alpha: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
+    _pad: f32,
 }
 
 @group(0) @binding(0) var<uniform> camera: Camera;
@@ -42,9 +45,15 @@ struct VertexOut {
 }
 
 /// Transforms a vertex to clip space and its normal to world space.
+/// Wind sway of an object-space position: along x, growing with height above the base (y = -1).
+fn sway_offset(p: vec3<f32>, sway: vec2<f32>) -> vec3<f32> {
+    return vec3<f32>(sway.x * max(p.y + 1.0, 0.0) * sin(sway.y + p.x + p.z), 0.0, 0.0);
+}
+
+/// Sways, transforms to clip space.
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
-    let world = draw.model * vec4<f32>(position, 1.0);
+    let world = draw.model * vec4<f32>(position + sway_offset(position, draw.sway), 1.0);
     return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz);
 }
 

@@ -32,6 +32,8 @@ pub struct LodDrawUniform {
     pub vis_scale: f32,
     /// Visibility threshold of the same LOD in the next frame.
     pub tau_next: f32,
+    /// Sway: amplitude, phase, padding.
+    pub sway: [f32; 4],
 }
 
 /// One draw into a LOD buffer.
@@ -50,10 +52,13 @@ pub struct LodDrawItem<'a> {
     pub tau: f32,
     /// Visibility threshold of the same LOD in the next frame, when this buffer is the older one.
     pub tau_next: f32,
+    /// Wind sway of the vertex stage: amplitude (object units at the top of a unit-high mesh,
+    /// 0 = none) and phase (advance it over time). The visibility pattern stays on the object.
+    pub sway: [f32; 2],
 }
 
 impl<'a> LodDrawItem<'a> {
-    /// The draw the scheduler asks for: `mesh` is the mesh of LOD `draw.lod`.
+    /// The draw the scheduler asks for: `mesh` is the mesh of LOD `draw.lod` (no sway).
     pub fn from_draw(mesh: &'a GpuMesh, model: Mat4, color: Vec4, draw: &FrameDraw) -> Self {
         Self {
             mesh,
@@ -62,6 +67,7 @@ impl<'a> LodDrawItem<'a> {
             id: draw.id,
             tau: draw.tau,
             tau_next: draw.tau_next,
+            sway: [0.0; 2],
         }
     }
 
@@ -208,6 +214,7 @@ impl LodBufferRenderer {
                     tau: item.tau,
                     vis_scale: self.vis_scale,
                     tau_next: item.tau_next,
+                    sway: [item.sway[0], item.sway[1], 0.0, 0.0],
                 })
                 .collect();
             self.draws.write(gpu, &uniforms)?;

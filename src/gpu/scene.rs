@@ -191,10 +191,12 @@ pub struct DrawUniform {
     pub model: [[f32; 4]; 4],
     /// Base color (rgb) and output alpha.
     pub color: [f32; 4],
+    /// Sway: amplitude (object units at the top of a unit-high mesh, 0 = none) and phase.
+    pub sway: [f32; 2],
     /// Screen-door alpha, or [`DITHER_OFF`].
     pub dither_alpha: f32,
     /// Padding to the WGSL struct's size.
-    pub pad: [f32; 3],
+    pub pad: f32,
 }
 
 /// One draw: a mesh, where, its color, and how it takes part in a transition.
@@ -210,6 +212,9 @@ pub struct DrawItem<'a> {
     pub state: LodRenderState,
     /// Screen-door alpha (negative = inverted pattern), if dithered.
     pub dither_alpha: Option<f32>,
+    /// Wind sway of the vertex stage: amplitude (object units at the top of a unit-high mesh,
+    /// 0 = none) and phase (advance it over time).
+    pub sway: [f32; 2],
 }
 
 /// A color and depth target of one size.
@@ -346,8 +351,9 @@ impl MeshRenderer {
                 .map(|item| DrawUniform {
                     model: item.model.to_cols_array_2d(),
                     color: item.color.to_array(),
+                    sway: item.sway,
                     dither_alpha: item.dither_alpha.unwrap_or(DITHER_OFF),
-                    pad: [0.0; 3],
+                    pad: 0.0,
                 })
                 .collect();
             self.draws.write(gpu, &uniforms)?;

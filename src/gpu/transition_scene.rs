@@ -138,6 +138,7 @@ impl TransitionScene {
                 color: BACKDROP_COLOR,
                 state: LodRenderState::OPAQUE,
                 dither_alpha: None,
+                sway: [0.0; 2],
             });
         }
         // One LOD alone is a hard switch before (fine) or after (coarse) it happens.
@@ -201,6 +202,7 @@ pub fn transition_items<'a>(
             color,
             state,
             dither_alpha,
+            sway: [0.0; 2],
         }
     };
     // Before and after the transition only one LOD is visible: draw only that one.

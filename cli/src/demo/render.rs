@@ -228,6 +228,16 @@ impl<'a> SceneRenderer<'a> {
             .collect()
     }
 
+    /// Whether any object sways: the picture changes without a transition or camera motion.
+    pub fn animated(&self) -> bool {
+        self.scene.objects.iter().any(|o| o.sway != 0.0)
+    }
+
+    /// Sway of object `i` at `frame`: its amplitude, a phase advancing 0.35 radians per frame.
+    fn sway(&self, i: usize, frame: usize) -> [f32; 2] {
+        [self.scene.objects[i].sway, frame as f32 * 0.35]
+    }
+
     fn camera(&self, frame: usize, moving: bool) -> (Mat4, Mat4) {
         let c = &self.scene.camera;
         let s = if moving {
@@ -301,12 +311,14 @@ impl<'a> SceneRenderer<'a> {
                     color: fine.1,
                     state: LodRenderState::OPAQUE,
                     dither_alpha: None,
+                    sway: self.sway(i, frame),
                 });
                 continue;
             }
             let coarse = (&self.meshes[i][1], self.object_color(i, 1, spec.background));
             let depth = (view * model).w_axis.z;
-            for item in transition_items(technique, t, model, fine, coarse) {
+            for mut item in transition_items(technique, t, model, fine, coarse) {
+                item.sway = self.sway(i, frame);
                 if item.state.blend {
                     blended.push((depth, item));
                 } else {
@@ -392,12 +404,14 @@ impl<'a> SceneRenderer<'a> {
                 .filter_map(|(i, key)| {
                     let d = scheduler.draw(*key).ok()?;
                     let lod = usize::from(d.lod.min(1));
-                    Some(LodDrawItem::from_draw(
+                    let mut item = LodDrawItem::from_draw(
                         &self.meshes[i][lod],
                         self.scene.model(i),
                         self.object_color(i, lod, spec.background),
                         &d,
-                    ))
+                    );
+                    item.sway = self.sway(i, frame);
+                    Some(item)
                 })
                 .collect();
             let index = scheduler.buffer_index();
@@ -465,7 +479,8 @@ impl<'a> SceneRenderer<'a> {
     /// scenery in black, so hidden parts do not count), at the middle frame of the static
     /// camera: `true` where the object covers the pixel.
     pub fn lod_masks(&self, gpu: &GpuContext) -> Result<[Vec<bool>; 2], GpuError> {
-        let (view, proj) = self.camera(LEAD_FRAMES + self.frames / 2, false);
+        let middle = LEAD_FRAMES + self.frames / 2;
+        let (view, proj) = self.camera(middle, false);
         let mask = |lod: usize| -> Result<Vec<bool>, GpuError> {
             let items: Vec<DrawItem> = self
                 .scene
@@ -480,6 +495,7 @@ impl<'a> SceneRenderer<'a> {
                         color: if o.transition { Vec4::ONE } else { Vec4::ZERO },
                         state: LodRenderState::OPAQUE,
                         dither_alpha: None,
+                        sway: self.sway(i, middle),
                     }
                 })
                 .collect();

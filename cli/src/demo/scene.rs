@@ -87,6 +87,10 @@ pub struct DemoObject {
     /// its fine LOD.
     #[serde(default = "yes")]
     pub transition: bool,
+    /// Wind sway of both LODs in the vertex stage: amplitude in object units at the top of a
+    /// unit-high mesh (default 0, at most 1), animated every frame.
+    #[serde(default)]
+    pub sway: f32,
 }
 
 /// A procedural shape.
@@ -310,6 +314,9 @@ impl DemoScene {
             if !o.scale.iter().all(|s| s.is_finite() && *s > 0.0) {
                 return Err(at(format!("scale = {:?} must be > 0", o.scale)));
             }
+            if !(0.0..=1.0).contains(&o.sway) {
+                return Err(at(format!("sway = {} is outside 0..=1", o.sway)));
+            }
             triangles += o.fine.triangles() + o.coarse.triangles();
             for (field, rgb) in [
                 ("fine_color", o.fine_color),
@@ -355,6 +362,7 @@ impl DemoScene {
                 position: [(i % 5) as f32 * 2.2 - 4.4, 0.0, -((i / 5) as f32) * 2.5],
                 scale: [0.8; 3],
                 transition: true,
+                sway: 0.0,
             })
             .collect();
         objects.push(scenery(
@@ -389,6 +397,7 @@ impl DemoScene {
                     position: [x, 0.0, z],
                     scale: [0.9; 3],
                     transition: true,
+                    sway: 0.0,
                 }
             })
             .collect();
@@ -418,8 +427,9 @@ impl DemoScene {
 impl DemoScene {
     /// The case engines have: a field of trees at many distances, of which a few objects are in
     /// transition at a time and cover a small part of the screen. Their LOD chains are the ones
-    /// single-frame blends find hard: a near and a far tree, a sphere whose box LOD intersects it
-    /// (corners outside, faces inside), and a flat sign whose two LODs are coplanar.
+    /// single-frame blends find hard: a near tree swaying in the wind (an animated LOD pair), a
+    /// far tree, a sphere whose box LOD intersects it (corners outside, faces inside), and a
+    /// flat sign whose two LODs are coplanar.
     pub fn field() -> DemoScene {
         let tree = |x: f32, z: f32, transition: bool| DemoObject {
             fine: Shape::Tree { puffs: 7, rings: 8 },
@@ -429,6 +439,7 @@ impl DemoScene {
             position: [x, 0.0, z],
             scale: [0.8; 3],
             transition,
+            sway: 0.0,
         };
         let mut objects: Vec<DemoObject> = (0..30)
             .map(|i| {
@@ -438,7 +449,11 @@ impl DemoScene {
                 tree(x, 1.0 - row * 4.0, false)
             })
             .collect();
-        objects.push(tree(-1.3, 1.6, true));
+        // The near tree sways in the wind: an animated LOD pair.
+        objects.push(DemoObject {
+            sway: 0.12,
+            ..tree(-1.3, 1.6, true)
+        });
         objects.push(tree(3.0, -13.0, true));
         objects.push(DemoObject {
             fine: Shape::Sphere {
@@ -453,6 +468,7 @@ impl DemoScene {
             position: [0.6, 0.2, 2.0],
             scale: [0.45; 3],
             transition: true,
+            sway: 0.0,
         });
         objects.push(DemoObject {
             fine: Shape::Box {
@@ -466,6 +482,7 @@ impl DemoScene {
             position: [-4.2, 0.4, -4.0],
             scale: [1.0; 3],
             transition: true,
+            sway: 0.0,
         });
         objects.push(scenery(
             [0.0, -1.0, -8.0],
@@ -494,5 +511,6 @@ fn scenery(position: [f32; 3], scale: [f32; 3], color: [f32; 3]) -> DemoObject {
         position,
         scale,
         transition: false,
+        sway: 0.0,
     }
 }

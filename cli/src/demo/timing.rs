@@ -235,6 +235,7 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
                 id: if k % 3 == 0 { k as u32 + 1 } else { 0 },
                 tau: if k % 3 == 0 { 0.5 } else { 1.0 },
                 tau_next: if k % 3 == 0 { 0.55 } else { 1.0 },
+                sway: [0.0; 2],
             })
             .collect();
         renderer.render(

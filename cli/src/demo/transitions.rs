@@ -88,8 +88,9 @@ fn strip_frames(renderer: &SceneRenderer) -> Vec<usize> {
     (0..7).map(|k| LEAD_FRAMES + (k * n + 3) / 6).collect()
 }
 
-/// The frames of a run without transition, which camera motion is measured against: every frame
-/// for the moving camera, the one picture of the static camera. All single-frame techniques
+/// The frames of a run without transition, which camera motion and animation are measured
+/// against: every frame for the moving camera or an animated scene, else the one picture of the
+/// static camera. All single-frame techniques
 /// draw the same frames without a transition (the fine LOD, opaque), and so do both
 /// frame-sequential patterns, so one run per family and camera serves them all.
 fn reference_run(
@@ -104,7 +105,8 @@ fn reference_run(
         transition: false,
         background: Background::Scene,
     };
-    let wanted = |f: usize| moving || f == 0;
+    let animated = renderer.animated();
+    let wanted = |f: usize| moving || animated || f == 0;
     let mut frames = Vec::new();
     renderer.run(gpu, spec, &wanted, &mut |_, f| frames.push(f.pixels), None)?;
     Ok(frames)
