@@ -2,12 +2,11 @@
 // needs for screen-door LOD blending, and the opaque/blended draws of unpopping.
 //
 // The vertex stage sways the mesh like a plant in the wind when `draw.sway.x` is not 0 (an
-// engine's own vertex animation goes there) and transforms by camera and model matrices; the
-// fragment stage shades with one
-// directional light and, when `draw.dither_alpha` is not DITHER_OFF, keeps only the pixels the
-// screen-door pattern gives this LOD (lodkit::screen_door; negative alpha = inverted pattern).
-// Alpha blending for unpopping and cross-fades uses the blend constant, so the shader is the same
-// for every role (lodkit::gpu::unpopping::lod_blend).
+// engine's own vertex animation goes there) and transforms by camera and model matrices. The
+// fragment stage shades with one directional light and, when `draw.dither_alpha` is not
+// DITHER_OFF, keeps only the pixels the screen-door pattern gives this LOD (lodkit::screen_door;
+// negative alpha = inverted pattern). Alpha blending for unpopping and cross-fades uses the blend
+// constant, so the shader is the same for every role (lodkit::gpu::unpopping::lod_blend).
 //
 // Entry points:
 //   vs_main   @location(0) position, @location(1) normal (object space)
@@ -44,13 +43,12 @@ struct VertexOut {
     @location(0) normal: vec3<f32>,
 }
 
-/// Transforms a vertex to clip space and its normal to world space.
 /// Wind sway of an object-space position: along x, growing with height above the base (y = -1).
 fn sway_offset(p: vec3<f32>, sway: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(sway.x * max(p.y + 1.0, 0.0) * sin(sway.y + p.x + p.z), 0.0, 0.0);
 }
 
-/// Sways, transforms to clip space.
+/// Sways a vertex, transforms it to clip space and its normal to world space.
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
     let world = draw.model * vec4<f32>(position + sway_offset(position, draw.sway), 1.0);
