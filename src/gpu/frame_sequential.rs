@@ -11,8 +11,8 @@ use glam::Mat4;
 use super::error::{check_color_format, has_usage, texture_matches};
 use super::resources::{
     TextureSet, begin_color_pass, begin_load_pass, begin_targets_pass, fullscreen_pipeline_with,
-    new_set, resize_set, texture_2d, texture_entry, textures_and_uniform, uniform_buffer,
-    uniform_entry,
+    new_set, one_group_layout, resize_set, texture_2d, texture_entry, textures_and_uniform,
+    uniform_buffer, uniform_entry,
 };
 use super::{GpuContext, GpuError};
 use crate::combine::{ScreenRect, merge_rects};
@@ -190,30 +190,9 @@ impl CombinePass {
         gpu.guarded(CALL, || {
             let module = gpu.pass_module("combine", defs)?;
             let size = std::mem::size_of::<CombineParams>();
-            // Color, id and depth of each buffer; the depth attachments bind as unfilterable
-            // float textures.
-            let float = wgpu::TextureSampleType::Float { filterable: false };
-            let uint = wgpu::TextureSampleType::Uint;
-            let mut entries: Vec<wgpu::BindGroupLayoutEntry> =
-                [float, uint, float, float, uint, float]
-                    .into_iter()
-                    .enumerate()
-                    .map(|(i, t)| texture_entry(i as u32, t))
-                    .collect();
+            let mut entries = Self::buffer_layout_entries(0);
             entries.push(uniform_entry(6, false));
-            let group = gpu
-                .device
-                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some("lodkit combine"),
-                    entries: &entries,
-                });
-            let layout = gpu
-                .device
-                .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some("lodkit combine"),
-                    bind_group_layouts: &[Some(&group)],
-                    immediate_size: 0,
-                });
+            let (_, layout) = one_group_layout(gpu, &entries, "lodkit combine");
             let label = "lodkit combine";
             Ok(Self {
                 pipeline: fullscreen_pipeline_with(
@@ -227,6 +206,20 @@ impl CombinePass {
                 target_format,
             })
         })
+    }
+
+    /// Bind group layout entries of the six textures the combine reads, from binding `first`:
+    /// color, id and depth of the newer buffer, then of the older one. The depth attachments
+    /// bind as unfilterable float textures (`texture_2d<f32>`), as `lodkit::combine::combine_at`
+    /// reads them; a full-screen pass of the engine's that calls `combine_at` needs these.
+    pub fn buffer_layout_entries(first: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let uint = wgpu::TextureSampleType::Uint;
+        [float, uint, float, float, uint, float]
+            .into_iter()
+            .zip(first..)
+            .map(|(t, binding)| texture_entry(binding, t))
+            .collect()
     }
 
     /// Records the combination of buffer `newer` with the other one (reprojected through
@@ -243,7 +236,25 @@ impl CombinePass {
         new_to_old: Mat4,
         target: &wgpu::TextureView,
     ) -> Result<(), GpuError> {
+        self.check_target("CombinePass::encode", buffers, target)?;
         self.record(gpu, encoder, buffers, newer, new_to_old, target, None)
+    }
+
+    /// The target must have the pass's format and the buffers' size.
+    fn check_target(
+        &self,
+        call: &'static str,
+        buffers: &LodBuffers,
+        target: &wgpu::TextureView,
+    ) -> Result<(), GpuError> {
+        texture_matches(
+            call,
+            "target",
+            target.texture(),
+            buffers.size(),
+            self.target_format,
+            "the pass (built for its format, drawing the LOD buffers' size)",
+        )
     }
 
     /// The combine where it has work to do: copies buffer `newer`'s color into `target` (which
@@ -297,14 +308,7 @@ impl CombinePass {
             })
             .collect();
         let merged = merge_rects(&clipped);
-        texture_matches(
-            CALL,
-            "target",
-            target.texture(),
-            buffers.size(),
-            self.target_format,
-            "the pass (built for its format, drawing the LOD buffers' size)",
-        )?;
+        self.check_target(CALL, buffers, target)?;
         gpu.guarded(CALL, || {
             encoder.copy_texture_to_texture(
                 buffers.color(newer).as_image_copy(),
@@ -327,7 +331,8 @@ impl CombinePass {
         Ok(merged.iter().map(ScreenRect::area).sum())
     }
 
-    /// Records the combine over the whole target, or inside `regions` over what is there.
+    /// Records the combine over the whole target, or inside `regions` over what is there (the
+    /// target already checked).
     #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
@@ -339,16 +344,7 @@ impl CombinePass {
         target: &wgpu::TextureView,
         regions: Option<&[ScreenRect]>,
     ) -> Result<(), GpuError> {
-        const CALL: &str = "CombinePass::encode";
-        texture_matches(
-            CALL,
-            "target",
-            target.texture(),
-            buffers.size(),
-            self.target_format,
-            "the pass (built for its format, drawing the LOD buffers' size)",
-        )?;
-        gpu.guarded(CALL, || {
+        gpu.guarded("CombinePass::encode", || {
             let params = CombineParams {
                 new_to_old: new_to_old.to_cols_array_2d(),
             };

@@ -210,15 +210,9 @@ fn depth_to_r32uint(gpu: &GpuContext, depth: &wgpu::Texture) -> Result<wgpu::Tex
         source: wgpu::ShaderSource::Wgsl(SOURCE.into()),
     });
     let float = wgpu::TextureSampleType::Float { filterable: false };
-    let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("lodkit depth copy"),
-        entries: &[super::resources::texture_entry(0, float)],
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("lodkit depth copy"),
-        bind_group_layouts: &[Some(&group_layout)],
-        immediate_size: 0,
-    });
+    let entries = [super::resources::texture_entry(0, float)];
+    let (group_layout, layout) =
+        super::resources::one_group_layout(gpu, &entries, "lodkit depth copy");
     let pipeline =
         super::resources::fullscreen_pipeline_with(gpu, &module, format, Some(&layout), "depth")?;
     let group =

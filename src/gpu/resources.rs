@@ -327,6 +327,28 @@ pub fn fullscreen_pipeline_with(
     })
 }
 
+/// A bind group layout of `entries` and the pipeline layout holding it as group 0.
+pub fn one_group_layout(
+    gpu: &GpuContext,
+    entries: &[wgpu::BindGroupLayoutEntry],
+    label: &str,
+) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {
+    let group = gpu
+        .device
+        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(label),
+            entries,
+        });
+    let layout = gpu
+        .device
+        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&group)],
+            immediate_size: 0,
+        });
+    (group, layout)
+}
+
 /// A fragment-stage texture binding of `sample_type`, 2D, not multisampled.
 pub fn texture_entry(
     binding: u32,

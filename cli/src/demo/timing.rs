@@ -16,7 +16,7 @@ use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::EdgeScene;
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::{
-    begin_color_pass, fullscreen_pipeline, fullscreen_pipeline_with, texture_2d, texture_entry,
+    begin_color_pass, fullscreen_pipeline, fullscreen_pipeline_with, one_group_layout, texture_2d,
     textures_and_uniform, uniform_buffer,
 };
 use lodkit::gpu::scene::{GpuMesh, Mesh};
@@ -264,27 +264,8 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
         ..Default::default()
     })?;
     let module = gpu.shader_module("copy6.wgsl", &composed)?;
-    // The depth attachments bind as unfilterable float textures, as in the combine pass.
-    let float = wgpu::TextureSampleType::Float { filterable: false };
-    let uint = wgpu::TextureSampleType::Uint;
-    let entries: Vec<wgpu::BindGroupLayoutEntry> = [float, uint, float, float, uint, float]
-        .into_iter()
-        .enumerate()
-        .map(|(i, t)| texture_entry(i as u32, t))
-        .collect();
-    let layout = gpu
-        .device
-        .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("copy6"),
-            entries: &entries,
-        });
-    let pipeline_layout = gpu
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("copy6"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+    let entries = CombinePass::buffer_layout_entries(0);
+    let (layout, pipeline_layout) = one_group_layout(gpu, &entries, "copy6");
     let copy6 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "copy6")?;
     let textures = [1, 0].map(|i| [buffers.color(i), buffers.id(i), buffers.depth(i)]);
     let group = textures_and_uniform(gpu, &layout, textures.as_flattened(), None, "copy6")?;
