@@ -423,22 +423,38 @@ fn add_to_composer_lets_a_foreign_composer_import_lodkit() {
 
 #[test]
 fn rust_uniform_mirrors_match_the_wgsl_layout() {
+    use lodkit::gpu::lod_buffer_scene::{LodCameraUniform, LodDrawUniform};
     use lodkit::gpu::scene::{CameraUniform, DrawUniform};
-    let pass = shaders::find_pass_source("lod_mesh").unwrap();
-    let composed = compose(pass, "lod_mesh.wgsl", SourceLanguage::Wgsl);
-    let mut layouter = naga::proc::Layouter::default();
-    layouter.update(composed.module.to_ctx()).unwrap();
-    let size_of = |name: &str| {
+    let mirrors: [(&str, &str, usize); 4] = [
+        ("lod_mesh", "Camera", std::mem::size_of::<CameraUniform>()),
+        ("lod_mesh", "Draw", std::mem::size_of::<DrawUniform>()),
+        (
+            "lod_buffer_mesh",
+            "LodCamera",
+            std::mem::size_of::<LodCameraUniform>(),
+        ),
+        (
+            "lod_buffer_mesh",
+            "LodDraw",
+            std::mem::size_of::<LodDrawUniform>(),
+        ),
+    ];
+    for (pass_name, name, rust_size) in mirrors {
+        let pass = shaders::find_pass_source(pass_name).unwrap();
+        let composed = compose(pass, &format!("{pass_name}.wgsl"), SourceLanguage::Wgsl);
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(composed.module.to_ctx()).unwrap();
         let (handle, _) = composed
             .module
             .types
             .iter()
             .find(|(_, t)| t.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("no struct {name}"));
-        layouter[handle].size as usize
-    };
-    assert_eq!(size_of("Camera"), std::mem::size_of::<CameraUniform>());
-    assert_eq!(size_of("Draw"), std::mem::size_of::<DrawUniform>());
+            .unwrap_or_else(|| panic!("{pass_name}: no struct {name}"));
+        assert_eq!(
+            layouter[handle].size as usize, rust_size,
+            "{pass_name}: {name}"
+        );
+    }
 }
 
 #[test]

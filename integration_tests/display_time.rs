@@ -271,13 +271,26 @@ fn combine_at_twins_match_on_two_lod_images() {
                 })
                 .collect(),
             flags: (0..n).map(|i| (r(i, 2) * 37.0) as u32 % 4).collect(),
+            // Object motion of up to two texels either way, none on a third of the pixels.
+            motion: (0..n)
+                .map(|i| {
+                    let m = glam::Vec2::new(r(i, 0) - 0.5, r(i, 1) - 0.5) * 4.0;
+                    let still = (i % 3 == 0) as u32 as f32;
+                    (1.0 - still) * m / glam::Vec2::new(w as f32, h as f32)
+                })
+                .collect(),
         }
     };
     let (newer, older) = (image(0), image(1));
+    let still = LodImage {
+        motion: Vec::new(),
+        ..newer.clone()
+    };
     let proj = glam::camera::rh::proj::directx::perspective(0.9, w as f32 / h as f32, 0.1, 50.0);
     let eye =
         |x: f32| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 0.2, 3.0), Vec3::ZERO, Vec3::Y);
     let m = new_to_old_matrix(&eye(0.15), &proj, &eye(0.0), &proj);
+    let want_still = combine_images(&still, &older, &m, DepthConvention::Standard);
     let want = combine_images(&newer, &older, &m, DepthConvention::Standard);
     let inputs: Vec<u32> = (0..n as u32)
         .flat_map(|p| {
@@ -292,20 +305,33 @@ fn combine_at_twins_match_on_two_lod_images() {
     let (nc, oc) = (colors(&newer), colors(&older));
     let (nd, od) = (depths(&newer), depths(&older));
     let (nw, ow) = (words(&newer), words(&older));
+    let motion: Vec<Vec4> = newer
+        .motion
+        .iter()
+        .map(|v| v.extend(0.0).extend(0.0))
+        .collect();
     let matrix = "mat4x4<f32>(vec4(inp_f(0u), inp_f(1u), inp_f(2u), inp_f(3u)), vec4(inp_f(4u), inp_f(5u), inp_f(6u), inp_f(7u)), vec4(inp_f(8u), inp_f(9u), inp_f(10u), inp_f(11u)), vec4(inp_f(12u), inp_f(13u), inp_f(14u), inp_f(15u)))";
     let wgsl = format!(
-        "let c = combine_at(probe_rgba0, probe_urgba0, probe_rgba2, probe_rgba1, probe_urgba1, probe_rgba3, vec2(inp_u(16u), inp_u(17u)), {matrix});
-        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);"
+        "let px = vec2(inp_u(16u), inp_u(17u));
+        let c = combine_at(probe_rgba0, probe_urgba0, probe_rgba2, probe_rgba1, probe_urgba1, probe_rgba3, px, {matrix});
+        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);
+        let mo = textureLoad(probe_rgba4, px, 0).xy;
+        let d = combine_at_moved(probe_rgba0, probe_urgba0, probe_rgba2, probe_rgba1, probe_urgba1, probe_rgba3, px, {matrix}, mo);
+        out_f(4u, d.x); out_f(5u, d.y); out_f(6u, d.z); out_f(7u, d.w);"
     );
     let glsl = format!(
-        "vec4 c = lodkit_combine_at(sampler2D(probe_rgba0, probe_sampler), usampler2D(probe_urgba0, probe_sampler), sampler2D(probe_rgba2, probe_sampler), sampler2D(probe_rgba1, probe_sampler), usampler2D(probe_urgba1, probe_sampler), sampler2D(probe_rgba3, probe_sampler), uvec2(inp_u(16u), inp_u(17u)), {});
-        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);",
-        matrix.replace("mat4x4<f32>", "mat4")
+        "uvec2 px = uvec2(inp_u(16u), inp_u(17u));
+        vec4 c = lodkit_combine_at(sampler2D(probe_rgba0, probe_sampler), usampler2D(probe_urgba0, probe_sampler), sampler2D(probe_rgba2, probe_sampler), sampler2D(probe_rgba1, probe_sampler), usampler2D(probe_urgba1, probe_sampler), sampler2D(probe_rgba3, probe_sampler), px, {m});
+        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);
+        vec2 mo = texelFetch(sampler2D(probe_rgba4, probe_sampler), ivec2(px), 0).xy;
+        vec4 d = lodkit_combine_at_moved(sampler2D(probe_rgba0, probe_sampler), usampler2D(probe_urgba0, probe_sampler), sampler2D(probe_rgba2, probe_sampler), sampler2D(probe_rgba1, probe_sampler), usampler2D(probe_urgba1, probe_sampler), sampler2D(probe_rgba3, probe_sampler), px, {m}, mo);
+        out_f(4u, d.x); out_f(5u, d.y); out_f(6u, d.z); out_f(7u, d.w);",
+        m = matrix.replace("mat4x4<f32>", "mat4")
     );
     for (language, header, body) in [
         (
             SourceLanguage::Wgsl,
-            "#import lodkit::combine::combine_at",
+            "#import lodkit::combine::{combine_at, combine_at_moved}",
             wgsl.as_str(),
         ),
         (GLSL, "#include \"lodkit/combine.glsl\"", glsl.as_str()),
@@ -314,31 +340,52 @@ fn combine_at_twins_match_on_two_lod_images() {
             header,
             body,
             inputs: 18,
-            outputs: 4,
+            outputs: 8,
             texture: None,
-            rgba: &[(w, h, &nc), (w, h, &oc), (w, h, &nd), (w, h, &od)],
+            rgba: &[
+                (w, h, &nc),
+                (w, h, &oc),
+                (w, h, &nd),
+                (w, h, &od),
+                (w, h, &motion),
+            ],
             urgba: &[(w, h, &nw), (w, h, &ow)],
         };
         let got = floats(&run_with(gpu, &probe, &inputs, language, &[]));
-        let mut compared = 0;
-        for (p, (g, want)) in got.chunks(4).zip(&want).enumerate() {
-            if want.on_texel_edge {
-                continue;
+        for (half, want, what) in [
+            (0, &want_still, "combine_at"),
+            (1, &want, "combine_at_moved"),
+        ] {
+            let mut compared = 0;
+            for (p, (g, want)) in got.chunks(8).zip(want).enumerate() {
+                if want.on_texel_edge {
+                    continue;
+                }
+                compared += 1;
+                let g = Vec4::from_slice(&g[4 * half..4 * half + 4]);
+                assert!(
+                    (g - want.color).abs().max_element() < 1e-5,
+                    "{language:?} {what}, pixel {p}: {g} vs {} ({:?})",
+                    want.color,
+                    want.source
+                );
             }
-            compared += 1;
-            let g = Vec4::from_slice(g);
             assert!(
-                (g - want.color).abs().max_element() < 1e-5,
-                "{language:?} pixel {p}: {g} vs {} ({:?})",
-                want.color,
-                want.source
+                compared * 10 > n * 9,
+                "{language:?} {what}: only {compared} pixels compared"
             );
         }
-        assert!(
-            compared * 10 > n * 9,
-            "{language:?}: only {compared} pixels compared"
-        );
     }
+    // The motion moves the texel read on most pixels, so the two combines differ.
+    let differ = want
+        .iter()
+        .zip(&want_still)
+        .filter(|(a, b)| a.color != b.color)
+        .count();
+    assert!(
+        differ * 4 > n,
+        "the motion changed only {differ} of {n} pixels"
+    );
     // The images exercise every rule.
     use lodkit::combine::PixelSource::*;
     for source in [Newer, Older, Average, OutsideOlder] {
@@ -361,25 +408,80 @@ fn blue_share(pixels: &[u8]) -> (f32, usize) {
     (share, object.len())
 }
 
+/// One sphere as both LODs of a t-instance, in red (LOD 0) and blue (LOD 1), so both cover the
+/// same pixels with the same visibility texels; the LOD pass and the combine pass for RGBA8 LOD
+/// buffers, and a `w` x `w` target the combine writes.
+pub struct SphereLods {
+    pub renderer: LodBufferRenderer,
+    pub combine: CombinePass,
+    pub sphere: GpuMesh,
+    pub colors: [Vec4; 2],
+    pub proj: Mat4,
+    pub target: wgpu::Texture,
+    pub target_view: wgpu::TextureView,
+}
+
+impl SphereLods {
+    pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+    pub fn new(gpu: &lodkit::gpu::GpuContext, w: u32) -> Self {
+        let format = Self::FORMAT;
+        let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 2);
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let target =
+            lodkit::gpu::resources::texture_2d(gpu, (w, w), format, usage, "combined").unwrap();
+        Self {
+            renderer: LodBufferRenderer::new(gpu, format, &vis, 1.0).unwrap(),
+            combine: CombinePass::new(gpu, format, false).unwrap(),
+            sphere: GpuMesh::new(gpu, &Mesh::sphere(24, 32)).unwrap(),
+            colors: [Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 0.0, 1.0, 1.0)],
+            proj: glam::camera::rh::proj::directx::perspective(0.9, 1.0, 0.1, 50.0),
+            target_view: target.create_view(&Default::default()),
+            target,
+        }
+    }
+
+    /// Renders `item` into buffer `index` of `buffers` seen by `view`, over black, combines it
+    /// with the other buffer through `new_to_old` and reads the combined image back.
+    pub fn frame(
+        &self,
+        gpu: &lodkit::gpu::GpuContext,
+        buffers: &LodBuffers,
+        index: usize,
+        view: impl Into<lodkit::gpu::lod_buffer_scene::LodView>,
+        item: LodDrawItem,
+        new_to_old: Mat4,
+    ) -> Vec<u8> {
+        let clear = wgpu::Color::BLACK;
+        self.renderer
+            .render(gpu, buffers, index, view, &[item], clear, None)
+            .unwrap();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.combine
+            .encode(
+                gpu,
+                &mut encoder,
+                buffers,
+                index,
+                new_to_old,
+                &self.target_view,
+            )
+            .unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        read_texture_rgba8(gpu, &self.target).unwrap()
+    }
+}
+
 #[test]
 fn each_lod_is_shown_as_it_is_at_the_frame_displayed() {
     const W: u32 = 64;
     const FRAMES: u32 = 12;
     let gpu = lodkit_test_gpu!();
-    let format = wgpu::TextureFormat::Rgba8Unorm;
-    let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 2);
-    let renderer = LodBufferRenderer::new(gpu, format, &vis, 1.0).unwrap();
-    let combine = CombinePass::new(gpu, format, false).unwrap();
-    // Both LODs are the same sphere, so both cover the same pixels with the same texels: the
-    // blue (incoming) share of the object is exactly the schedule's, progress p in both.
-    let sphere = GpuMesh::new(gpu, &Mesh::sphere(24, 32)).unwrap();
-    let colors = [Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 0.0, 1.0, 1.0)];
-    let proj = glam::camera::rh::proj::directx::perspective(0.9, 1.0, 0.1, 50.0);
+    let format = SphereLods::FORMAT;
+    // The blue (incoming) share of the object is exactly the schedule's, progress p in both.
+    let lods = SphereLods::new(gpu, W);
+    let proj = lods.proj;
     let view = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let target =
-        lodkit::gpu::resources::texture_2d(gpu, (W, W), format, usage, "combined").unwrap();
-    let target_view = target.create_view(&Default::default());
     let mut rows = Vec::new();
     for schedule in [Schedule::Paper, Schedule::Complementary] {
         for start in [3u64, 4] {
@@ -403,24 +505,15 @@ fn each_lod_is_shown_as_it_is_at_the_frame_displayed() {
                     }
                 }
                 let d = s.draw(key).unwrap();
-                let item =
-                    LodDrawItem::from_draw(&sphere, Mat4::IDENTITY, colors[usize::from(d.lod)], &d);
-                let index = s.buffer_index();
-                let clear = wgpu::Color::BLACK;
-                renderer
-                    .render(gpu, &buffers, index, proj * view, &[item], clear, None)
-                    .unwrap();
+                let color = lods.colors[usize::from(d.lod)];
+                let item = LodDrawItem::from_draw(&lods.sphere, Mat4::IDENTITY, color, &d);
                 let m = if f == 0 {
                     CombinePass::NO_HISTORY
                 } else {
                     new_to_old_matrix(&view, &proj, &view, &proj)
                 };
-                let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                combine
-                    .encode(gpu, &mut encoder, &buffers, index, m, &target_view)
-                    .unwrap();
-                gpu.queue.submit([encoder.finish()]);
-                let (share, covered) = blue_share(&read_texture_rgba8(gpu, &target).unwrap());
+                let pixels = lods.frame(gpu, &buffers, s.buffer_index(), proj * view, item, m);
+                let (share, covered) = blue_share(&pixels);
                 shares.push(share);
                 coverage.push(covered);
             }

@@ -301,6 +301,8 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
         tau,
         tau_next: tau,
         sway: [0.0; 2],
+        prev_model: Mat4::IDENTITY,
+        prev_sway_phase: 0.0,
     };
     let render = |items: &[LodDrawItem]| {
         let clear = wgpu::Color::BLACK;
@@ -483,6 +485,8 @@ fn a_swaying_lod_moves_with_its_phase() {
             tau: 0.5,
             tau_next: 0.5,
             sway,
+            prev_model: Mat4::IDENTITY,
+            prev_sway_phase: sway[1],
         };
         let clear = wgpu::Color::BLACK;
         renderer

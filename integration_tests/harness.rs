@@ -70,7 +70,7 @@ pub fn wgsl_probe(p: &Probe) -> String {
     for k in 0..p.urgba.len() {
         texture.push_str(&format!(
             "\n@group(0) @binding({}) var probe_urgba{k}: texture_2d<u32>;",
-            8 + k
+            12 + k
         ));
     }
     format!(
@@ -111,7 +111,7 @@ pub fn glsl_probe(p: &Probe) -> String {
     for k in 0..p.urgba.len() {
         texture.push_str(&format!(
             "layout(set = 0, binding = {}) uniform utexture2D probe_urgba{k};\n",
-            8 + k
+            12 + k
         ));
     }
     if p.texture.is_some() || !p.rgba.is_empty() || !p.urgba.is_empty() {
@@ -278,9 +278,9 @@ fn run(
         let format = wgpu::TextureFormat::Rgba32Uint;
         texture((*w, *h), format, bytemuck::cast_slice(texels))
     });
-    // Float textures from binding 4, unsigned ones from binding 8.
+    // Float textures from binding 4 (at most 8), unsigned ones from binding 12.
     let views: [(u32, Vec<wgpu::TextureView>); 2] =
-        [(4, float_views.collect()), (8, uint_views.collect())];
+        [(4, float_views.collect()), (12, uint_views.collect())];
     for (first, list) in &views {
         for (k, v) in list.iter().enumerate() {
             entries.push(wgpu::BindGroupEntry {

@@ -13,6 +13,7 @@ mod framebuffer_lod;
 mod gpu_twins;
 mod harness;
 mod host_errors;
+mod object_motion;
 mod portability;
 mod robustness;
 mod selection;

@@ -1,7 +1,7 @@
 //! The combination rule of two LOD buffers (Scherzer & Wimmer 2008, sec. 3.4): Rust twins of
 //! `lodkit::combine`.
 
-use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
+use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
 /// One texel of a LOD buffer (mirror of WGSL `LodSample`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,6 +98,10 @@ pub struct LodImage {
     /// Display-time flags (`LOD_BUFFER_SHOWN_NOW`, `LOD_BUFFER_SHOWN_NEXT`); empty: shown in
     /// both frames.
     pub flags: Vec<u32>,
+    /// Object motion of each texel in texture-space uv
+    /// ([`lod_buffer_motion`](crate::lod_buffer::lod_buffer_motion)), read from the newer
+    /// buffer; empty: nothing moved by itself.
+    pub motion: Vec<Vec2>,
 }
 
 impl LodImage {
@@ -108,6 +112,11 @@ impl LodImage {
             id: self.ids[p],
             depth: self.depths[p],
         }
+    }
+
+    /// The object motion at pixel index `p` (zero without motion).
+    pub fn motion_at(&self, p: usize) -> Vec2 {
+        self.motion.get(p).copied().unwrap_or(Vec2::ZERO)
     }
 
     /// The id word at pixel index `p` as the shader reads it (id with the flags).
@@ -161,25 +170,104 @@ pub fn combine_uv(pixel: UVec2, size: UVec2) -> Vec2 {
     (pixel.as_vec2() + 0.5) / size.as_vec2()
 }
 
-/// The older buffer's texel the combine reads for the newer pixel `pixel` with clip depth
-/// `newer_depth`: where the point of the pixel's ray at the older depth `first_depth` (found at
-/// the first estimate) reprojects, or the first estimate where there is none.
+/// Where in the older buffer (texture-space uv) the combine reads for the newer pixel `pixel`
+/// with clip depth `newer_depth`: where the point of the pixel's ray at the older depth
+/// `first_depth` (found at the first estimate) reprojects, or the first estimate where that
+/// leaves the view; both moved by the object motion `motion` (texture-space uv).
+pub fn combine_older_uv(
+    pixel: UVec2,
+    size: UVec2,
+    newer_depth: f32,
+    first_depth: f32,
+    new_to_old: &Mat4,
+    motion: Vec2,
+) -> Vec2 {
+    use crate::reproject::{in_viewport, reproject_base, reproject_from_base, reproject_refine};
+    let base = reproject_base(combine_uv(pixel, size), new_to_old);
+    let first = reproject_from_base(base, newer_depth, new_to_old).truncate() + motion;
+    let refined = reproject_refine(base, newer_depth, first_depth, new_to_old).truncate() + motion;
+    if in_viewport(refined) { refined } else { first }
+}
+
+/// The older buffer's texel at [`combine_older_uv`].
 pub fn combine_older_texel(
     pixel: UVec2,
     size: UVec2,
     newer_depth: f32,
     first_depth: f32,
     new_to_old: &Mat4,
+    motion: Vec2,
 ) -> UVec2 {
-    use crate::reproject::{in_viewport, reproject_base, reproject_from_base, reproject_refine};
-    let base = reproject_base(combine_uv(pixel, size), new_to_old);
-    let first = reproject_from_base(base, newer_depth, new_to_old);
-    let refined = reproject_refine(base, newer_depth, first_depth, new_to_old);
-    if in_viewport(refined.truncate()) {
-        combine_texel(refined.truncate(), size)
-    } else {
-        combine_texel(first.truncate(), size)
+    let uv = combine_older_uv(pixel, size, newer_depth, first_depth, new_to_old, motion);
+    combine_texel(uv, size)
+}
+
+/// The texel next to the one holding texture-space `uv` along `axis` (0 x, 1 y), on the side
+/// `uv` lies off that texel's center; the texel itself within 1/1000 texel of the center on that
+/// axis or where the neighbour would leave the texture.
+///
+/// ```
+/// # use lodkit::combine::combine_side_texel;
+/// # use glam::{UVec2, Vec2};
+/// let size = UVec2::new(4, 4);
+/// // uv (0.3, 0.6) is texel (1, 2), left of its center on x and right of it on y.
+/// assert_eq!(combine_side_texel(Vec2::new(0.3, 0.6), size, 0), UVec2::new(0, 2));
+/// assert_eq!(combine_side_texel(Vec2::new(0.3, 0.6), size, 1), UVec2::new(1, 1));
+/// assert_eq!(combine_side_texel(Vec2::new(0.375, 0.6), size, 0), UVec2::new(1, 2));
+/// ```
+pub fn combine_side_texel(uv: Vec2, size: UVec2, axis: usize) -> UVec2 {
+    let texel = combine_texel(uv, size);
+    let offset = uv[axis] * size[axis] as f32 - (texel[axis] as f32 + 0.5);
+    let mut side = texel;
+    if offset > 1e-3 && texel[axis] + 1 < size[axis] {
+        side[axis] = texel[axis] + 1;
+    } else if offset < -1e-3 && texel[axis] > 0 {
+        side[axis] = texel[axis] - 1;
     }
+    side
+}
+
+/// The older texel to read for a newer sample of instance `id`: `nearest` (the texel holding
+/// the read position) unless `id` is a t-instance's and `nearest` holds another id; then the
+/// first of its side texels `x`, `y` ([`combine_side_texel`]) and the diagonal `(x.x, y.y)` that
+/// holds `id`, if any. `ids` are the instance ids at nearest, x, y and the diagonal.
+///
+/// ```
+/// # use lodkit::combine::combine_match_texel;
+/// # use glam::{UVec2, UVec4};
+/// let (n, x, y) = (UVec2::new(1, 1), UVec2::new(2, 1), UVec2::new(1, 0));
+/// assert_eq!(combine_match_texel(7, UVec4::new(0, 0, 0, 7), n, x, y), UVec2::new(2, 0));
+/// assert_eq!(combine_match_texel(7, UVec4::new(0, 0, 7, 7), n, x, y), y);
+/// assert_eq!(combine_match_texel(7, UVec4::new(3, 0, 0, 0), n, x, y), n);
+/// assert_eq!(combine_match_texel(0, UVec4::new(3, 0, 0, 0), n, x, y), n);
+/// ```
+pub fn combine_match_texel(id: u32, ids: UVec4, nearest: UVec2, x: UVec2, y: UVec2) -> UVec2 {
+    if id == 0 || ids.x == id {
+        nearest
+    } else if ids.y == id {
+        x
+    } else if ids.z == id {
+        y
+    } else if ids.w == id {
+        UVec2::new(x.x, y.y)
+    } else {
+        nearest
+    }
+}
+
+/// The object motion of the surface at texture-space `uv` with clip depth `depth` from an
+/// engine's motion vector (uv now minus uv in the previous frame, camera motion included): where
+/// the surface was minus where the camera's reprojection puts it.
+///
+/// ```
+/// # use lodkit::combine::combine_object_motion;
+/// # use glam::{Mat4, Vec2};
+/// // A still camera: the whole motion vector is the object's, pointing back in time.
+/// let m = combine_object_motion(Vec2::splat(0.5), 0.3, &Mat4::IDENTITY, Vec2::new(0.25, 0.0));
+/// assert_eq!(m, Vec2::new(-0.25, 0.0));
+/// ```
+pub fn combine_object_motion(uv: Vec2, depth: f32, new_to_old: &Mat4, motion_vector: Vec2) -> Vec2 {
+    uv - motion_vector - crate::reproject::reproject(uv, depth, new_to_old).truncate()
 }
 
 /// The combined color from the fetched texels: the newer color and id word, `old` = the newer
@@ -214,14 +302,14 @@ pub fn combine_texels(
 }
 
 /// The whole per-pixel combine at `pixel` (the Rust twin of `combine_at`, with the buffers read
-/// back as [`LodImage`]s). `None` when the images differ in size or lack texels, or `pixel`
-/// lies outside them.
+/// back as [`LodImage`]s; the newer image's motion is not used). `None` when the images differ
+/// in size or lack texels, or `pixel` lies outside them.
 ///
 /// ```
 /// # use lodkit::combine::*;
 /// # use glam::{Mat4, UVec2, Vec4};
 /// let image = |c: f32| LodImage { width: 1, height: 1, colors: vec![Vec4::splat(c)], ids: vec![0],
-///     depths: vec![0.5], flags: vec![] };
+///     depths: vec![0.5], ..Default::default() };
 /// let m = Mat4::IDENTITY; // the same camera: the pixel maps to itself
 /// let std = DepthConvention::Standard;
 /// assert_eq!(combine_at(&image(1.0), &image(0.0), UVec2::ZERO, &m, std), Some(Vec4::ONE));
@@ -234,9 +322,23 @@ pub fn combine_at(
     new_to_old: &Mat4,
     convention: DepthConvention,
 ) -> Option<Vec4> {
+    combine_at_moved(newer, older, pixel, new_to_old, Vec2::ZERO, convention)
+}
+
+/// [`combine_at`] for a pixel whose surface moved by itself: the older buffer is read `motion`
+/// (texture-space uv) away from where the camera's reprojection puts it (the Rust twin of
+/// `combine_at_moved`).
+pub fn combine_at_moved(
+    newer: &LodImage,
+    older: &LodImage,
+    pixel: UVec2,
+    new_to_old: &Mat4,
+    motion: Vec2,
+    convention: DepthConvention,
+) -> Option<Vec4> {
     let inside = pixel.x < newer.width && pixel.y < newer.height;
     (inside && images_fit(newer, older))
-        .then(|| combine_pixel(newer, older, pixel, new_to_old, convention).color)
+        .then(|| combine_pixel(newer, older, pixel, new_to_old, motion, convention).color)
 }
 
 /// Whether two LOD images have the same, non-zero size and complete texel arrays.
@@ -247,6 +349,7 @@ fn images_fit(newer: &LodImage, older: &LodImage) -> bool {
             && i.ids.len() == n
             && i.depths.len() == n
             && (i.flags.is_empty() || i.flags.len() == n)
+            && (i.motion.is_empty() || i.motion.len() == n)
     };
     let same_size = (newer.width, newer.height) == (older.width, older.height);
     n > 0 && same_size && complete(newer) && complete(older)
@@ -258,6 +361,7 @@ fn combine_pixel(
     older: &LodImage,
     pixel: UVec2,
     new_to_old: &Mat4,
+    motion: Vec2,
     convention: DepthConvention,
 ) -> CombinedPixel {
     use crate::lod_buffer::{LOD_BUFFER_SHOWN_NEXT, LOD_BUFFER_SHOWN_NOW};
@@ -273,9 +377,22 @@ fn combine_pixel(
             on_texel_edge: false,
         };
     }
-    let first = combine_texel(old.truncate(), size);
+    let first = combine_texel(old.truncate() + motion, size);
     let first_depth = older.depths[index(first)];
-    let texel = combine_older_texel(pixel, size, depth, first_depth, new_to_old);
+    let at = combine_older_uv(pixel, size, depth, first_depth, new_to_old, motion);
+    let nearest = combine_texel(at, size);
+    let (x, y) = (
+        combine_side_texel(at, size, 0),
+        combine_side_texel(at, size, 1),
+    );
+    let id_at = |t: UVec2| older.ids[index(t)];
+    let ids = UVec4::new(
+        id_at(nearest),
+        id_at(x),
+        id_at(y),
+        id_at(UVec2::new(x.x, y.y)),
+    );
+    let texel = combine_match_texel(newer.ids[p], ids, nearest, x, y);
     let o = index(texel);
     let color = combine_texels(
         newer.colors[p],
@@ -294,7 +411,15 @@ fn combine_pixel(
     };
     let base = crate::reproject::reproject_base(combine_uv(pixel, size), new_to_old);
     let refined = crate::reproject::reproject_refine(base, depth, first_depth, new_to_old);
-    let on_texel_edge = near_edge(old.truncate()) || near_edge(refined.truncate());
+    // Off the center by about 1/1000 texel, a GPU may pick another side texel.
+    let near_center = |uv: Vec2| {
+        let f = uv * size.as_vec2();
+        let off = (f - f.floor() - 0.5).abs();
+        (off - Vec2::splat(1e-3)).abs().min_element() < 1e-4
+    };
+    let on_texel_edge = near_edge(old.truncate() + motion)
+        || near_edge(refined.truncate() + motion)
+        || near_center(at);
     let (n, o) = (newer.sample(p), older.sample(o));
     let (n_shown, o_shown) = (
         newer.shown(p, LOD_BUFFER_SHOWN_NOW),
@@ -322,9 +447,9 @@ fn combine_pixel(
     }
 }
 
-/// The combine pass on the CPU: [`combine_at`] at every pixel, with the rule applied. Both
-/// images must have the same, non-zero size and complete texel arrays; otherwise the result is
-/// empty.
+/// The combine pass on the CPU: [`combine_at_moved`] at every pixel with the newer image's
+/// motion there, and the rule applied. Both images must have the same, non-zero size and
+/// complete texel arrays; otherwise the result is empty.
 pub fn combine_images(
     newer: &LodImage,
     older: &LodImage,
@@ -338,7 +463,8 @@ pub fn combine_images(
     (0..n)
         .map(|p| {
             let pixel = UVec2::new(p % newer.width, p / newer.width);
-            combine_pixel(newer, older, pixel, new_to_old, convention)
+            let motion = newer.motion_at(p as usize);
+            combine_pixel(newer, older, pixel, new_to_old, motion, convention)
         })
         .collect()
 }

@@ -1,23 +1,25 @@
 // passes/combine — the frame-sequential combination pass (Scherzer & Wimmer 2008, sec. 3.4):
 // merges the LOD buffer rendered this frame with the one from the frame before, reprojected.
 //
-// For each pixel, lodkit::combine::combine_at: read the newer color, id word and depth; reproject
-// (uv, depth) into the older buffer, then once more at the older buffer's depth there (the older
-// surface's own parallax); outside the older view -> newer color; else combine_shown, the newer
-// sample shown if its LOD_BUFFER_SHOWN_NOW flag is set, the older one if its
-// LOD_BUFFER_SHOWN_NEXT flag is (display-time visibility; n-instances always). An engine with a
-// full-screen pass of its own calls combine_at there instead.
+// For each pixel, lodkit::combine::combine_at_moved: read the newer color, id word, depth and
+// object motion; reproject (uv, depth) into the older buffer, then once more at the older
+// buffer's depth there (the older surface's own parallax), and move by the object motion the LOD
+// pass wrote (where a swaying or moving surface was); outside the older view -> newer color; else
+// combine_shown, the newer sample shown if its LOD_BUFFER_SHOWN_NOW flag is set, the older one if
+// its LOD_BUFFER_SHOWN_NEXT flag is (display-time visibility; n-instances always). An engine with
+// a full-screen pass of its own calls combine_at_moved (or combine_at) there instead.
 // Built only from lodkit::fullscreen and lodkit::combine.
 //
 // Entry points:
 //   vs_main   fullscreen triangle, draw(0..3)
 //   fs_main   @location(0) combined color
 // Bindings (group 0): 0 newer_color texture_2d<f32>, 1 newer_id texture_2d<u32>, 2 newer_depth
-//   texture_2d<f32> (the depth attachment), 3 older_color, 4 older_id, 5 older_depth, 6 params:
+//   texture_2d<f32> (the depth attachment), 3 older_color, 4 older_id, 5 older_depth,
+//   6 object_motion texture_2d<f32> (the LOD pass's location 2, this frame), 7 params:
 //   CombineParams.
 // Shader defs: LODKIT_REVERSE_Z (bool, default off) — passed on to lodkit::combine.
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
-#import lodkit::combine::combine_at
+#import lodkit::combine::combine_at_moved
 
 /// Per-frame parameters.
 struct CombineParams {
@@ -31,7 +33,8 @@ struct CombineParams {
 @group(0) @binding(3) var older_color: texture_2d<f32>;
 @group(0) @binding(4) var older_id: texture_2d<u32>;
 @group(0) @binding(5) var older_depth: texture_2d<f32>;
-@group(0) @binding(6) var<uniform> params: CombineParams;
+@group(0) @binding(6) var object_motion: texture_2d<f32>;
+@group(0) @binding(7) var<uniform> params: CombineParams;
 
 /// Fullscreen triangle.
 @vertex
@@ -43,5 +46,6 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 @fragment
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(v.position.xy);
-    return combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel, params.new_to_old);
+    let motion = textureLoad(object_motion, pixel, 0).xy;
+    return combine_at_moved(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel, params.new_to_old, motion);
 }

@@ -8,22 +8,27 @@
 // when this buffer is the older one) (lodkit::visibility::visibility_flags): the combine pass
 // then shows each LOD with its visibility at the frame displayed, so its share changes every
 // frame, and a sample hidden in its buffer never leaves a hole where the other buffer has none.
-// n-instances use id 0 (always shown).
+// n-instances use id 0 (always shown). Location 2 gets the fragment's object motion
+// (lodkit::lod_buffer::lod_buffer_motion): where its surface point was in the previous frame
+// (previous model matrix and sway phase) minus where it is now, both seen by the previous
+// camera; the combine reads the older buffer there.
 //
 // Entry points:
 //   vs_main   @location(0) position, @location(1) normal (object space)
-//   fs_main   LodBufferOutput (location 0 color, location 1 r32uint id word; the depth
-//             attachment keeps the depth)
+//   fs_main   LodBufferMotionOutput (location 0 color, location 1 r32uint id word, location 2
+//             rg16float object motion; the depth attachment keeps the depth)
 //   sway_offset(p, sway) -> vec3<f32>   helper: the wind sway of the vertex stage
-// Bindings: group 0: 0 `camera: Camera` (uniform), 1 `vis_tex: texture_2d<f32>`;
+// Bindings: group 0: 0 `camera: LodCamera` (uniform), 1 `vis_tex: texture_2d<f32>`;
 //   group 1: 0 `draw: LodDraw` (uniform, dynamic offset).
 // Shader defs: none.
 #import lodkit::visibility::visibility_flags
-#import lodkit::lod_buffer::{LodBufferOutput, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT, lod_buffer_output_flags}
+#import lodkit::lod_buffer::{LodBufferMotionOutput, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT, lod_buffer_output_motion, lod_buffer_motion}
 
 /// Per-view data.
-struct Camera {
+struct LodCamera {
     view_proj: mat4x4<f32>,
+    /// The previous frame's view_proj (the same on a frame without one).
+    prev_view_proj: mat4x4<f32>,
     /// World-space direction toward the light (w unused).
     light_dir: vec4<f32>,
 }
@@ -31,6 +36,8 @@ struct Camera {
 /// Per-draw data.
 struct LodDraw {
     model: mat4x4<f32>,
+    /// The previous frame's model (the same for an object that did not move).
+    prev_model: mat4x4<f32>,
     color: vec4<f32>,
     /// 0 for n-instances.
     instance_id: u32,
@@ -40,11 +47,12 @@ struct LodDraw {
     vis_scale: f32,
     /// Visibility threshold of the same LOD in the next frame.
     tau_next: f32,
-    /// Sway: x amplitude (object units at the top of a unit-high mesh, 0 = none), y phase.
+    /// Sway: x amplitude (object units at the top of a unit-high mesh, 0 = none), y phase,
+    /// z the previous frame's phase.
     sway: vec4<f32>,
 }
 
-@group(0) @binding(0) var<uniform> camera: Camera;
+@group(0) @binding(0) var<uniform> camera: LodCamera;
 @group(0) @binding(1) var vis_tex: texture_2d<f32>;
 @group(1) @binding(0) var<uniform> draw: LodDraw;
 
@@ -52,6 +60,9 @@ struct VertexOut {
     @builtin(position) position: vec4<f32>,
     @location(0) normal: vec3<f32>,
     @location(1) object_pos: vec3<f32>,
+    /// The surface point now and in the previous frame, in the previous frame's clip space.
+    @location(2) now_clip: vec4<f32>,
+    @location(3) then_clip: vec4<f32>,
 }
 
 /// Wind sway of an object-space position: along x, growing with height above the base (y = -1).
@@ -59,22 +70,30 @@ fn sway_offset(p: vec3<f32>, sway: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(sway.x * max(p.y + 1.0, 0.0) * sin(sway.y + p.x + p.z), 0.0, 0.0);
 }
 
-/// Sways, transforms to clip space; hands the object-space position from before the sway to the
-/// fragment stage.
+/// Sways, transforms to clip space; hands the object-space position from before the sway and
+/// the point now and in the previous frame, seen by the previous camera, to the fragment stage.
 @vertex
 fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> VertexOut {
     let world = draw.model * vec4<f32>(position + sway_offset(position, draw.sway.xy), 1.0);
-    return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz, position);
+    let then = draw.prev_model * vec4<f32>(position + sway_offset(position, draw.sway.xz), 1.0);
+    return VertexOut(
+        camera.view_proj * world,
+        (draw.model * vec4<f32>(normal, 0.0)).xyz,
+        position,
+        camera.prev_view_proj * world,
+        camera.prev_view_proj * then,
+    );
 }
 
-/// Display-time visibility flags, Lambert shading, LOD buffer output.
+/// Display-time visibility flags, Lambert shading, object motion, LOD buffer output.
 @fragment
-fn fs_main(in: VertexOut) -> LodBufferOutput {
+fn fs_main(in: VertexOut) -> LodBufferMotionOutput {
     var flags = LOD_BUFFER_SHOWN_NOW | LOD_BUFFER_SHOWN_NEXT;
     if (draw.instance_id != 0u) {
         flags = visibility_flags(vis_tex, in.object_pos * draw.vis_scale, draw.tau, draw.tau_next);
     }
     let lambert = max(dot(normalize(in.normal), normalize(camera.light_dir.xyz)), 0.0);
     let color = vec4<f32>(draw.color.rgb * (0.35 + 0.65 * lambert), 1.0);
-    return lod_buffer_output_flags(color, draw.instance_id, flags);
+    let motion = lod_buffer_motion(in.then_clip, in.now_clip);
+    return lod_buffer_output_motion(color, draw.instance_id, flags, motion);
 }

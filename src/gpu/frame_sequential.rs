@@ -16,13 +16,14 @@ use super::resources::{
 };
 use super::{GpuContext, GpuError};
 use crate::combine::{ScreenRect, merge_rects};
-use crate::lod_buffer::ID_FORMAT;
+use crate::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
 
 /// Depth format of each LOD buffer's depth attachment (the combine pass reads it).
 pub const LOD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Two LOD buffers, each a color target, an id target and the depth attachment it is rendered
-/// with (read by the combine pass as the fragments' clip depth).
+/// with (read by the combine pass as the fragments' clip depth), and one object motion target
+/// for the frame being rendered (`MOTION_FORMAT`, location 2, see `lodkit::lod_buffer`).
 #[derive(Debug)]
 pub struct LodBuffers {
     color_format: wgpu::TextureFormat,
@@ -30,6 +31,7 @@ pub struct LodBuffers {
     colors: [wgpu::Texture; 2],
     ids: [wgpu::Texture; 2],
     depths: [wgpu::Texture; 2],
+    motion: wgpu::Texture,
 }
 
 impl TextureSet for LodBuffers {
@@ -59,6 +61,7 @@ impl TextureSet for LodBuffers {
                 texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 0")?,
                 texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 1")?,
             ],
+            motion: texture(MOTION_FORMAT, usage, "lod buffer object motion")?,
         })
     }
 
@@ -75,6 +78,7 @@ impl TextureSet for LodBuffers {
             .iter()
             .chain(&self.ids)
             .chain(&self.depths)
+            .chain([&self.motion])
             .collect()
     }
 }
@@ -122,8 +126,15 @@ impl LodBuffers {
         &self.depths[index % 2]
     }
 
-    /// Begins a render pass into buffer `index` that clears color to `clear`, the id to 0 and
-    /// the depth attachment to `far_depth` (1 for standard Z, 0 for reversed).
+    /// The object motion target (`MOTION_FORMAT`): written by the frame rendered last, read by
+    /// its combine.
+    pub fn motion(&self) -> &wgpu::Texture {
+        &self.motion
+    }
+
+    /// Begins a render pass into buffer `index` that clears color to `clear`, the id and the
+    /// object motion (location 2) to 0 and the depth attachment to `far_depth` (1 for standard
+    /// Z, 0 for reversed).
     /// `occlusion_query_set` is passed on to the pass (see
     /// [`FragmentCounter`](super::counters::FragmentCounter)).
     pub fn begin_pass<'e>(
@@ -137,9 +148,11 @@ impl LodBuffers {
         let color = self.colors[index % 2].create_view(&Default::default());
         let id = self.ids[index % 2].create_view(&Default::default());
         let depth = self.depths[index % 2].create_view(&Default::default());
+        let motion = self.motion.create_view(&Default::default());
+        let zero = wgpu::Color::TRANSPARENT;
         begin_targets_pass(
             encoder,
-            &[(&color, clear), (&id, wgpu::Color::TRANSPARENT)],
+            &[(&color, clear), (&id, zero), (&motion, zero)],
             &depth,
             far_depth,
             occlusion_query_set,
@@ -191,7 +204,8 @@ impl CombinePass {
             let module = gpu.pass_module("combine", defs)?;
             let size = std::mem::size_of::<CombineParams>();
             let mut entries = Self::buffer_layout_entries(0);
-            entries.push(uniform_entry(6, false));
+            entries.push(Self::motion_layout_entry(6));
+            entries.push(uniform_entry(7, false));
             let (_, layout) = one_group_layout(gpu, &entries, "lodkit combine");
             let label = "lodkit combine";
             Ok(Self {
@@ -220,6 +234,16 @@ impl CombinePass {
             .zip(first..)
             .map(|(t, binding)| texture_entry(binding, t))
             .collect()
+    }
+
+    /// Bind group layout entry of the object motion texture (`LodBuffers::motion`) at
+    /// `binding`, read as an unfilterable float texture, for a pass of the engine's that calls
+    /// `lodkit::combine::combine_at_moved`.
+    pub fn motion_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+        texture_entry(
+            binding,
+            wgpu::TextureSampleType::Float { filterable: false },
+        )
     }
 
     /// Records the combination of buffer `newer` with the other one (reprojected through
@@ -357,6 +381,7 @@ impl CombinePass {
                 buffers.color(newer + 1),
                 buffers.id(newer + 1),
                 buffers.depth(newer + 1),
+                buffers.motion(),
             ];
             let layout = self.pipeline.get_bind_group_layout(0);
             let bind_group = textures_and_uniform(
@@ -387,8 +412,9 @@ impl CombinePass {
     }
 }
 
-/// Reads buffer `index` of `buffers` back to the CPU (its color format must be RGBA8, unorm or
-/// sRGB: [`GpuError::UnsupportedFormat`] otherwise).
+/// Reads buffer `index` of `buffers` back to the CPU, with the object motion target (which holds
+/// the motion of the buffer rendered last). Its color format must be RGBA8, unorm or sRGB
+/// ([`GpuError::UnsupportedFormat`] otherwise).
 pub fn read_lod_image(
     gpu: &GpuContext,
     buffers: &LodBuffers,
@@ -404,12 +430,13 @@ pub fn read_lod_image(
                 .into(),
         });
     }
-    let (colors, ids, depths) = gpu.guarded("read_lod_image", || {
+    let (colors, ids, depths, motion) = gpu.guarded("read_lod_image", || {
         use super::readback::{read_depth32, read_texture, read_texture_rgba8};
         Ok((
             read_texture_rgba8(gpu, buffers.color(index))?,
             read_texture(gpu, buffers.id(index), 4)?,
             read_depth32(gpu, buffers.depth(index))?,
+            read_texture(gpu, buffers.motion(), 4)?,
         ))
     })?;
     let words = |bytes: Vec<u8>| -> Vec<u32> {
@@ -436,5 +463,12 @@ pub fn read_lod_image(
             .map(|w| crate::lod_buffer::lod_buffer_flags(*w))
             .collect(),
         depths,
+        motion: motion
+            .chunks(4)
+            .map(|c| {
+                let half = |lo: u8, hi: u8| half::f16::from_le_bytes([lo, hi]).to_f32();
+                glam::Vec2::new(half(c[0], c[1]), half(c[2], c[3]))
+            })
+            .collect(),
     })
 }

@@ -9,12 +9,24 @@ use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
 use super::resources::{
     DrawUniforms, depth_write_state, mesh_pipeline, r32float_texture, uniform_buffer, uniform_entry,
 };
-use super::scene::{CameraUniform, GpuMesh};
+use super::scene::GpuMesh;
 use super::{GpuContext, GpuError};
 use crate::combine::DepthConvention;
 use crate::frame_sequential::FrameDraw;
-use crate::lod_buffer::ID_FORMAT;
+use crate::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
 use crate::visibility::VisibilityTexture;
+
+/// Rust mirror of `LodCamera` in `passes/lod_buffer_mesh.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LodCameraUniform {
+    /// Projection x view.
+    pub view_proj: [[f32; 4]; 4],
+    /// The previous frame's projection x view.
+    pub prev_view_proj: [[f32; 4]; 4],
+    /// World-space direction toward the light.
+    pub light_dir: [f32; 4],
+}
 
 /// Rust mirror of `LodDraw` in `passes/lod_buffer_mesh.wgsl`.
 #[repr(C)]
@@ -22,6 +34,8 @@ use crate::visibility::VisibilityTexture;
 pub struct LodDrawUniform {
     /// Object to world.
     pub model: [[f32; 4]; 4],
+    /// Object to world in the previous frame.
+    pub prev_model: [[f32; 4]; 4],
     /// Base color.
     pub color: [f32; 4],
     /// 0 for n-instances.
@@ -32,8 +46,28 @@ pub struct LodDrawUniform {
     pub vis_scale: f32,
     /// Visibility threshold of the same LOD in the next frame.
     pub tau_next: f32,
-    /// Sway: amplitude, phase, padding.
+    /// Sway: amplitude, phase, the previous frame's phase, padding.
     pub sway: [f32; 4],
+}
+
+/// The cameras of a LOD buffer frame. The previous frame's view-projection only matters for
+/// objects that move by themselves (their object motion is measured in its view); a `Mat4`
+/// converts to a view with no previous frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LodView {
+    /// Projection x view of this frame.
+    pub view_proj: Mat4,
+    /// Projection x view of the previous frame (the frame of the older LOD buffer).
+    pub prev_view_proj: Mat4,
+}
+
+impl From<Mat4> for LodView {
+    fn from(view_proj: Mat4) -> Self {
+        Self {
+            view_proj,
+            prev_view_proj: view_proj,
+        }
+    }
 }
 
 /// One draw into a LOD buffer.
@@ -43,6 +77,9 @@ pub struct LodDrawItem<'a> {
     pub mesh: &'a GpuMesh,
     /// Object to world.
     pub model: Mat4,
+    /// Object to world in the previous frame (`model` for an object that did not move): with
+    /// the sway phases, it gives the object motion the combine follows.
+    pub prev_model: Mat4,
     /// Base color.
     pub color: Vec4,
     /// Instance id (0 = n-instance, always shown).
@@ -55,19 +92,24 @@ pub struct LodDrawItem<'a> {
     /// Wind sway of the vertex stage: amplitude (object units at the top of a unit-high mesh,
     /// 0 = none) and phase (advance it over time). The visibility pattern stays on the object.
     pub sway: [f32; 2],
+    /// The sway phase of the previous frame.
+    pub prev_sway_phase: f32,
 }
 
 impl<'a> LodDrawItem<'a> {
-    /// The draw the scheduler asks for: `mesh` is the mesh of LOD `draw.lod` (no sway).
+    /// The draw the scheduler asks for: `mesh` is the mesh of LOD `draw.lod` (no sway; at the
+    /// same place in the previous frame).
     pub fn from_draw(mesh: &'a GpuMesh, model: Mat4, color: Vec4, draw: &FrameDraw) -> Self {
         Self {
             mesh,
             model,
+            prev_model: model,
             color,
             id: draw.id,
             tau: draw.tau,
             tau_next: draw.tau_next,
             sway: [0.0; 2],
+            prev_sway_phase: 0.0,
         }
     }
 
@@ -138,11 +180,16 @@ impl LodBufferRenderer {
                 gpu,
                 &module,
                 &layout,
-                &[Some(color_format.into()), Some(ID_FORMAT.into())],
+                &[
+                    Some(color_format.into()),
+                    Some(ID_FORMAT.into()),
+                    Some(MOTION_FORMAT.into()),
+                ],
                 depth_write_state(LOD_DEPTH_FORMAT, depth_compare(depth)),
                 "lod_buffer_mesh",
             )?;
-            let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
+            let size = std::mem::size_of::<LodCameraUniform>();
+            let camera = uniform_buffer(gpu, size, "lod camera")?;
             let draws = DrawUniforms::new(
                 gpu,
                 std::mem::size_of::<LodDrawUniform>(),
@@ -178,8 +225,9 @@ impl LodBufferRenderer {
         })
     }
 
-    /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers`, cleared to
-    /// `clear`, counting the pass's fragments with `counter` if given. Returns the triangles
+    /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers` seen by
+    /// `view` (a `Mat4` view-projection, or a [`LodView`] with the previous frame's for moving
+    /// objects), cleared to `clear`, counting the pass's fragments with `counter` if given. Returns the triangles
     /// drawn and the count (0 without a counter). A t-instance item shown in neither this frame
     /// nor the next (tau and tau_next 0 or NaN: visibility texels lie strictly between 0 and 1)
     /// is not submitted. Every fragment of a t-instance is kept and flagged (see
@@ -190,17 +238,19 @@ impl LodBufferRenderer {
         gpu: &GpuContext,
         buffers: &LodBuffers,
         index: usize,
-        view_proj: Mat4,
+        view: impl Into<LodView>,
         items: &[LodDrawItem],
         clear: wgpu::Color,
         counter: Option<&FragmentCounter>,
     ) -> Result<(u64, u64), GpuError> {
         const CALL: &str = "LodBufferRenderer::render";
         same_color_format(CALL, "buffers", buffers.color_format(), self.color_format)?;
+        let view = view.into();
         gpu.guarded(CALL, || {
             let items = &items[..items.len().min(self.draws.capacity())];
-            let camera = CameraUniform {
-                view_proj: view_proj.to_cols_array_2d(),
+            let camera = LodCameraUniform {
+                view_proj: view.view_proj.to_cols_array_2d(),
+                prev_view_proj: view.prev_view_proj.to_cols_array_2d(),
                 light_dir: Vec3::new(0.4, 0.8, 0.6).extend(0.0).to_array(),
             };
             gpu.queue
@@ -209,12 +259,13 @@ impl LodBufferRenderer {
                 .iter()
                 .map(|item| LodDrawUniform {
                     model: item.model.to_cols_array_2d(),
+                    prev_model: item.prev_model.to_cols_array_2d(),
                     color: item.color.to_array(),
                     instance_id: item.id,
                     tau: item.tau,
                     vis_scale: self.vis_scale,
                     tau_next: item.tau_next,
-                    sway: [item.sway[0], item.sway[1], 0.0, 0.0],
+                    sway: [item.sway[0], item.sway[1], item.prev_sway_phase, 0.0],
                 })
                 .collect();
             self.draws.write(gpu, &uniforms)?;

@@ -8,7 +8,7 @@ use lodkit::combine::{DepthConvention, PixelSource, ScreenRect, combine_images, 
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::counters::FragmentCounter;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshRenderer, RenderTarget};
@@ -411,15 +411,20 @@ impl<'a> SceneRenderer<'a> {
                         &d,
                     );
                     item.sway = self.sway(i, frame);
+                    item.prev_sway_phase = self.sway(i, frame.saturating_sub(1))[1];
                     Some(item)
                 })
                 .collect();
             let index = scheduler.buffer_index();
+            let lod_view = LodView {
+                view_proj: proj * view,
+                prev_view_proj: proj * previous.unwrap_or(view),
+            };
             let (triangles, fragments) = renderer.render(
                 gpu,
                 &self.buffers,
                 index,
-                proj * view,
+                lod_view,
                 &items,
                 color(clear),
                 Some(&self.counter),

@@ -21,7 +21,7 @@ use lodkit::gpu::resources::{
 };
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::gpu::{GpuContext, GpuError};
-use lodkit::lod_buffer::ID_FORMAT;
+use lodkit::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
@@ -142,19 +142,21 @@ pub fn plain_pass(
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// Color, id word and depth of both buffers, read at the pixel and summed.
-const COPY6: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+const COPY7: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 @group(0) @binding(0) var a: texture_2d<f32>;
 @group(0) @binding(1) var b: texture_2d<u32>;
 @group(0) @binding(2) var c: texture_2d<f32>;
 @group(0) @binding(3) var d: texture_2d<f32>;
 @group(0) @binding(4) var e: texture_2d<u32>;
 @group(0) @binding(5) var f: texture_2d<f32>;
+@group(0) @binding(6) var g: texture_2d<f32>;
 @vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
 @fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let p = vec2<u32>(v.position.xy);
     let ids = textureLoad(b, p, 0).x ^ textureLoad(e, p, 0).x;
     let depth = textureLoad(c, p, 0).x + textureLoad(f, p, 0).x;
-    return textureLoad(a, p, 0) + textureLoad(d, p, 0) + vec4<f32>(f32(ids & 1u), depth, 0.0, 0.0);
+    let motion = textureLoad(g, p, 0).xy;
+    return textureLoad(a, p, 0) + textureLoad(d, p, 0) + vec4<f32>(f32(ids & 1u), depth, motion);
 }
 ";
 
@@ -208,8 +210,8 @@ fn draw_fullscreen(
     gpu.wait_idle()
 }
 
-/// The combine pass against a plain pass reading the same six textures (color, id and depth of
-/// each buffer) at `size` x `size`, on two LOD buffers of a grid of spheres and boxes with a third
+/// The combine pass against a plain pass reading the same seven textures (color, id and depth of
+/// each buffer, the object motion) at `size` x `size`, on two LOD buffers of a grid of spheres and boxes with a third
 /// of them in transition and the camera moved between the frames.
 pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<PassRatio, GpuError> {
     let buffers = LodBuffers::new(gpu, size, size, FORMAT)?;
@@ -236,6 +238,12 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
                 tau: if k % 3 == 0 { 0.5 } else { 1.0 },
                 tau_next: if k % 3 == 0 { 0.55 } else { 1.0 },
                 sway: [0.0; 2],
+                prev_model: Mat4::from_translation(Vec3::new(
+                    (k % 5) as f32 * 2.0 - 4.0,
+                    0.0,
+                    -((k / 5) as f32) * 2.0,
+                )),
+                prev_sway_phase: 0.0,
             })
             .collect();
         renderer.render(
@@ -259,33 +267,37 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     let combine = CombinePass::new(gpu, FORMAT, false)?;
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
     let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-        source: COPY6,
-        file_path: "copy6.wgsl",
+        source: COPY7,
+        file_path: "copy7.wgsl",
         ..Default::default()
     })?;
-    let module = gpu.shader_module("copy6.wgsl", &composed)?;
-    let entries = CombinePass::buffer_layout_entries(0);
-    let (layout, pipeline_layout) = one_group_layout(gpu, &entries, "copy6");
-    let copy6 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "copy6")?;
+    let module = gpu.shader_module("copy7.wgsl", &composed)?;
+    let mut entries = CombinePass::buffer_layout_entries(0);
+    entries.push(CombinePass::motion_layout_entry(6));
+    let (layout, pipeline_layout) = one_group_layout(gpu, &entries, "copy7");
+    let copy7 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "copy7")?;
     let textures = [1, 0].map(|i| [buffers.color(i), buffers.id(i), buffers.depth(i)]);
-    let group = textures_and_uniform(gpu, &layout, textures.as_flattened(), None, "copy6")?;
+    let mut textures = textures.as_flattened().to_vec();
+    textures.push(buffers.motion());
+    let group = textures_and_uniform(gpu, &layout, &textures, None, "copy7")?;
     let run_combine = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         combine.encode(gpu, &mut encoder, &buffers, 1, m, &target_view)?;
         gpu.queue.submit([encoder.finish()]);
         gpu.wait_idle()
     };
-    let run_copy = || draw_fullscreen(gpu, &copy6, &group, &target_view);
+    let run_copy = || draw_fullscreen(gpu, &copy7, &group, &target_view);
     let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs)?;
-    // The copy reads color, id and depth of each buffer; the combine also the older depth at
-    // its first estimate.
+    // The copy reads color, id and depth of each buffer and the object motion; the combine
+    // also the older depth at its first estimate.
     let copy = Reads::NONE
         .plus(2, 1, FORMAT)
         .plus(2, 1, ID_FORMAT)
-        .plus(2, 1, LOD_DEPTH_FORMAT);
+        .plus(2, 1, LOD_DEPTH_FORMAT)
+        .plus(1, 1, MOTION_FORMAT);
     Ok(PassRatio {
         pass: "combine (frame-sequential)".to_owned(),
-        baseline: "plain copy of the same 6 textures".to_owned(),
+        baseline: "plain copy of the same 7 textures".to_owned(),
         size: (size, size),
         pass_ms,
         baseline_ms,

@@ -9,13 +9,21 @@
 //   lodkit_combine_shown(newer, newer_shown, older, older_shown) -> vec4   exactly one shown: it;
 //       both or neither: lodkit_combine_samples
 //   lodkit_combine_texel(uv, size) -> uvec2, lodkit_combine_uv(pixel, size) -> vec2
-//   lodkit_combine_older_texel(pixel, size, newer_depth, first_depth, new_to_old) -> uvec2
+//   lodkit_combine_older_uv(pixel, size, newer_depth, first_depth, new_to_old, motion) -> vec2
+//   lodkit_combine_older_texel(pixel, size, newer_depth, first_depth, new_to_old, motion) -> uvec2
+//   lodkit_combine_side_texel(uv, size, axis) -> uvec2   the neighbour on uv's side on an axis
+//   lodkit_combine_match_texel(id, ids, nearest, x, y) -> uvec2   the older texel of the newer
+//       pixel's t-instance among the nearest, its side texels and the diagonal
+//   lodkit_combine_object_motion(uv, depth, new_to_old, motion_vector) -> vec2   object motion
+//       from an engine's motion vector (uv now minus uv before, camera motion included)
 //   lodkit_combine_texels(newer_color, newer_word, old, older_color, older_word, older_depth)
 //       -> vec4
 //   lodkit_combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth,
 //       pixel, new_to_old) -> vec4   the whole per-pixel combine (a macro: takes sampler2D /
 //       usampler2D, or sampler2D(texture, sampler) / usampler2D(texture, sampler) in Vulkan
-//       GLSL, the depths as sampler2D of the depth attachments; pixel a uvec2)
+//       GLSL, the depths as sampler2D of the depth attachments; pixel a uvec2); nothing moves
+//   lodkit_combine_at_moved(newer_color, ..., older_depth, pixel, new_to_old, motion) -> vec4
+//       the same for a pixel whose surface moved by itself (motion: its object motion, a vec2)
 //   lodkit_depth_closer(a, b) -> bool
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z).
@@ -74,12 +82,53 @@ vec2 lodkit_combine_uv(uvec2 pixel, uvec2 size) {
     return (vec2(pixel) + 0.5) / vec2(size);
 }
 
-/// The older buffer's texel for the newer pixel: the reprojection refined at the older depth.
-uvec2 lodkit_combine_older_texel(uvec2 pixel, uvec2 size, float newer_depth, float first_depth, mat4 new_to_old) {
+/// Where in the older buffer (uv) the combine reads for the newer pixel: the reprojection refined
+/// at the older depth, moved by the object motion.
+vec2 lodkit_combine_older_uv(uvec2 pixel, uvec2 size, float newer_depth, float first_depth, mat4 new_to_old, vec2 motion) {
     vec4 base = lodkit_reproject_base(lodkit_combine_uv(pixel, size), new_to_old);
-    vec3 first = lodkit_reproject_from_base(base, newer_depth, new_to_old);
-    vec3 refined = lodkit_reproject_refine(base, newer_depth, first_depth, new_to_old);
-    return lodkit_in_viewport(refined.xy) ? lodkit_combine_texel(refined.xy, size) : lodkit_combine_texel(first.xy, size);
+    vec2 first = lodkit_reproject_from_base(base, newer_depth, new_to_old).xy + motion;
+    vec2 refined = lodkit_reproject_refine(base, newer_depth, first_depth, new_to_old).xy + motion;
+    return lodkit_in_viewport(refined) ? refined : first;
+}
+
+/// The older buffer's texel at lodkit_combine_older_uv.
+uvec2 lodkit_combine_older_texel(uvec2 pixel, uvec2 size, float newer_depth, float first_depth, mat4 new_to_old, vec2 motion) {
+    return lodkit_combine_texel(lodkit_combine_older_uv(pixel, size, newer_depth, first_depth, new_to_old, motion), size);
+}
+
+/// The texel next to the one holding uv along `axis` (0 x, 1 y), on the side uv lies off its
+/// center; the texel itself within 1/1000 texel of the center or at the border.
+uvec2 lodkit_combine_side_texel(vec2 uv, uvec2 size, uint axis) {
+    uvec2 texel = lodkit_combine_texel(uv, size);
+    float offset = uv[axis] * float(size[axis]) - (float(texel[axis]) + 0.5);
+    uvec2 side = texel;
+    if (offset > 1e-3 && texel[axis] + 1u < size[axis]) {
+        side[axis] = texel[axis] + 1u;
+    } else if (offset < -1e-3 && texel[axis] > 0u) {
+        side[axis] = texel[axis] - 1u;
+    }
+    return side;
+}
+
+/// The older texel for a newer sample of instance `id`: `nearest`, unless `id` is a
+/// t-instance's and `nearest` holds another id; then the first of x, y and the diagonal
+/// (x.x, y.y) holding `id` (`ids`: the ids at nearest, x, y and the diagonal).
+uvec2 lodkit_combine_match_texel(uint id, uvec4 ids, uvec2 nearest, uvec2 x, uvec2 y) {
+    if (id == 0u || ids.x == id) {
+        return nearest;
+    }
+    if (ids.y == id) {
+        return x;
+    }
+    if (ids.z == id) {
+        return y;
+    }
+    return ids.w == id ? uvec2(x.x, y.y) : nearest;
+}
+
+/// The object motion at uv with clip depth `depth` from an engine's motion vector.
+vec2 lodkit_combine_object_motion(vec2 uv, float depth, mat4 new_to_old, vec2 motion_vector) {
+    return uv - motion_vector - lodkit_reproject(uv, depth, new_to_old).xy;
 }
 
 /// The combined color from the fetched texels.
@@ -101,16 +150,43 @@ vec4 lodkit_combine_texels(vec4 newer_color, uint newer_word, vec3 old, vec4 old
 /// The newer pixel reprojected with its own depth.
 #define LODKIT_COMBINE_OLD_(nc, nd, px, m) \
     lodkit_reproject(lodkit_combine_uv((px), LODKIT_COMBINE_SIZE_(nc)), LODKIT_COMBINE_DEPTH_(nd, px), (m))
-/// The older texel read (refined at the older depth of the first estimate).
-#define LODKIT_COMBINE_OLDER_(nc, nd, od, px, m) \
-    ivec2(lodkit_combine_older_texel((px), LODKIT_COMBINE_SIZE_(nc), LODKIT_COMBINE_DEPTH_(nd, px), \
-        texelFetch((od), ivec2(lodkit_combine_texel(LODKIT_COMBINE_OLD_(nc, nd, px, m).xy, LODKIT_COMBINE_SIZE_(nc))), 0).x, (m)))
+/// Where the older buffer is read (uv; refined at the older depth of the first estimate, moved
+/// by `mo`).
+#define LODKIT_COMBINE_AT_(nc, nd, od, px, m, mo) \
+    lodkit_combine_older_uv((px), LODKIT_COMBINE_SIZE_(nc), LODKIT_COMBINE_DEPTH_(nd, px), \
+        texelFetch((od), ivec2(lodkit_combine_texel(LODKIT_COMBINE_OLD_(nc, nd, px, m).xy + (mo), LODKIT_COMBINE_SIZE_(nc))), 0).x, (m), (mo))
+/// The instance id at texel `t` of an id texture.
+#define LODKIT_COMBINE_ID_(tex, t) lodkit_lod_buffer_id(texelFetch((tex), ivec2(t), 0).x)
+/// A texel around the read position: `axis` 2 the one holding it, 0 or 1 its side texel, 3 the
+/// diagonal.
+#define LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, axis) \
+    ((axis) == 2u ? lodkit_combine_texel(LODKIT_COMBINE_AT_(nc, nd, od, px, m, mo), LODKIT_COMBINE_SIZE_(nc)) \
+        : (axis) == 3u ? uvec2(LODKIT_COMBINE_AROUND_X_(nc, nd, od, px, m, mo, 0u).x, LODKIT_COMBINE_AROUND_X_(nc, nd, od, px, m, mo, 1u).y) \
+        : LODKIT_COMBINE_AROUND_X_(nc, nd, od, px, m, mo, axis))
+/// The side texel of the read position on `axis`.
+#define LODKIT_COMBINE_AROUND_X_(nc, nd, od, px, m, mo, axis) \
+    lodkit_combine_side_texel(LODKIT_COMBINE_AT_(nc, nd, od, px, m, mo), LODKIT_COMBINE_SIZE_(nc), (axis))
+/// The older texel read: the one holding the read position, or a side or diagonal texel of the
+/// newer pixel's t-instance (lodkit_combine_match_texel).
+#define LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo) \
+    ivec2(lodkit_combine_match_texel(LODKIT_COMBINE_ID_(nid, px), \
+        uvec4(LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 2u)), \
+            LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 0u)), \
+            LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 1u)), \
+            LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 3u))), \
+        LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 2u), LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 0u), \
+        LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 1u)))
 
-/// The whole per-pixel combine at `px` (uvec2), for a full-screen pass the engine already has.
+/// The whole per-pixel combine at `px` (uvec2) where nothing moves by itself.
 #define lodkit_combine_at(nc, nid, nd, oc, oid, od, px, m) \
+    lodkit_combine_at_moved(nc, nid, nd, oc, oid, od, px, m, vec2(0.0))
+
+/// The whole per-pixel combine at `px` (uvec2) of a pixel whose surface moved by `mo` (vec2,
+/// object motion), for a full-screen pass the engine already has.
+#define lodkit_combine_at_moved(nc, nid, nd, oc, oid, od, px, m, mo) \
     lodkit_combine_texels(texelFetch((nc), ivec2(px), 0), texelFetch((nid), ivec2(px), 0).x, LODKIT_COMBINE_OLD_(nc, nd, px, m), \
-        texelFetch((oc), LODKIT_COMBINE_OLDER_(nc, nd, od, px, m), 0), \
-        texelFetch((oid), LODKIT_COMBINE_OLDER_(nc, nd, od, px, m), 0).x, \
-        texelFetch((od), LODKIT_COMBINE_OLDER_(nc, nd, od, px, m), 0).x)
+        texelFetch((oc), LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo), 0), \
+        texelFetch((oid), LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo), 0).x, \
+        texelFetch((od), LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo), 0).x)
 
 #endif // LODKIT_COMBINE_GLSL

@@ -14,6 +14,10 @@
 //       frames (depth is kept by the depth attachment; the parameter is not stored)
 //   lodkit_lod_buffer_id(word) -> uint, lodkit_lod_buffer_flags(word) -> uint
 //   lodkit_lod_buffer_shown(word, flag) -> bool   n-instance, or the flag is set
+//   lodkit_LodBufferMotionOutput { color, id, motion }   with location 2 (rg16f), the object motion
+//   lodkit_lod_buffer_output_motion(color, instance_id, flags, motion) -> lodkit_LodBufferMotionOutput
+//   lodkit_lod_buffer_motion(then_clip, now_clip) -> vec2   object motion in texture-space uv
+//       (the surface point then minus now, both in the previous frame's clip space; 0 behind it)
 // Usage: lodkit_LodBufferOutput o = lodkit_lod_buffer_output(c, id, gl_FragCoord.z);
 //        out_color = o.color; out_id = o.id;
 // Shader defs: none.
@@ -56,6 +60,28 @@ uint lodkit_lod_buffer_flags(uint word) {
 /// Whether a texel is shown in the frame `flag` names (always for n-instances).
 bool lodkit_lod_buffer_shown(uint word, uint flag) {
     return lodkit_lod_buffer_id(word) == 0u || (lodkit_lod_buffer_flags(word) & flag) != 0u;
+}
+
+/// Fragment output of a LOD buffer pass whose objects may move by themselves.
+struct lodkit_LodBufferMotionOutput {
+    vec4 color;
+    uint id;
+    vec2 motion;
+};
+
+/// lodkit_lod_buffer_output_flags with the fragment's object motion.
+lodkit_LodBufferMotionOutput lodkit_lod_buffer_output_motion(vec4 color, uint instance_id, uint flags, vec2 motion) {
+    lodkit_LodBufferOutput o = lodkit_lod_buffer_output_flags(color, instance_id, flags);
+    return lodkit_LodBufferMotionOutput(o.color, o.id, motion);
+}
+
+/// Object motion in texture-space uv: the surface point then minus now, both in the previous
+/// frame's clip space; 0 when either has w <= 0.
+vec2 lodkit_lod_buffer_motion(vec4 then_clip, vec4 now_clip) {
+    if (then_clip.w <= 0.0 || now_clip.w <= 0.0) {
+        return vec2(0.0);
+    }
+    return (then_clip.xy / then_clip.w - now_clip.xy / now_clip.w) * vec2(0.5, -0.5);
 }
 
 #endif // LODKIT_LOD_BUFFER_GLSL

@@ -11,6 +11,12 @@
 // frames its flag names; n-instances are always shown.
 // Bytes per pixel per LOD buffer beyond its depth attachment: 4 (rgba8 color) + 4 (id word) = 8
 // (the paper: 7, with a 16-bit depth in the target and an id exact to 2048).
+// Objects that move or deform between frames (a t-instance on a moving platform, a plant in the
+// wind) also write their object motion at location 2 (rg16float, one texture for the frame, not
+// per buffer): where the fragment's surface point was in the previous frame minus where it is
+// now, both projected with the previous frame's view-projection, in texture-space uv. It is 0
+// for anything that did not move by itself (the camera's motion is the combine's reprojection),
+// so the target is cleared to 0. The combine reads the older buffer there (combine_at_moved).
 //
 // Exports:
 //   LodBufferOutput { color (location 0), id (location 1) }   fragment output
@@ -20,8 +26,14 @@
 //   lod_buffer_output_flags(color, instance_id, flags) -> LodBufferOutput
 //   lod_buffer_id(word) -> u32, lod_buffer_flags(word) -> u32   unpacking the id word
 //   lod_buffer_shown(word, flag) -> bool   n-instance, or the flag is set
+//   LodBufferMotionOutput { color (location 0), id (location 1), motion (location 2) }
+//   lod_buffer_output_motion(color, instance_id, flags, motion) -> LodBufferMotionOutput
+//   lod_buffer_motion(then_clip, now_clip) -> vec2<f32>   object motion from the fragment's
+//       surface point in the previous frame and now, both in the previous frame's clip space
+//       (0 when either lies behind that camera)
 // Usage: return lod_buffer_output(shaded, draw.instance_id, in.position.z); or with
-//   lodkit::visibility::visibility_flags for display-time visibility (passes/lod_buffer_mesh.wgsl).
+//   lodkit::visibility::visibility_flags for display-time visibility, and lod_buffer_motion for
+//   moving objects (passes/lod_buffer_mesh.wgsl).
 // Shader defs: none.
 #define_import_path lodkit::lod_buffer
 
@@ -64,4 +76,27 @@ fn lod_buffer_flags(word: u32) -> u32 {
 /// Whether a texel is shown in the frame `flag` names: always for n-instances (id 0).
 fn lod_buffer_shown(word: u32, flag: u32) -> bool {
     return lod_buffer_id(word) == 0u || (lod_buffer_flags(word) & flag) != 0u;
+}
+
+/// Fragment output of a LOD buffer pass whose objects may move by themselves.
+struct LodBufferMotionOutput {
+    @location(0) color: vec4<f32>,
+    @location(1) id: u32,
+    @location(2) motion: vec2<f32>,
+}
+
+/// lod_buffer_output_flags with the fragment's object motion (from lod_buffer_motion).
+fn lod_buffer_output_motion(color: vec4<f32>, instance_id: u32, flags: u32, motion: vec2<f32>) -> LodBufferMotionOutput {
+    let o = lod_buffer_output_flags(color, instance_id, flags);
+    return LodBufferMotionOutput(o.color, o.id, motion);
+}
+
+/// Object motion of a fragment in texture-space uv: `then_clip` (its surface point in the
+/// previous frame) minus `now_clip` (the point now), both projected with the previous frame's
+/// view-projection and interpolated from the vertex stage; 0 when either has w <= 0.
+fn lod_buffer_motion(then_clip: vec4<f32>, now_clip: vec4<f32>) -> vec2<f32> {
+    if (then_clip.w <= 0.0 || now_clip.w <= 0.0) {
+        return vec2<f32>(0.0);
+    }
+    return (then_clip.xy / then_clip.w - now_clip.xy / now_clip.w) * vec2<f32>(0.5, -0.5);
 }
