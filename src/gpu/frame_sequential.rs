@@ -222,10 +222,12 @@ impl CombinePass {
         })
     }
 
-    /// Bind group layout entries of the six textures the combine reads, from binding `first`:
-    /// color, id and depth of the newer buffer, then of the older one. The depth attachments
-    /// bind as unfilterable float textures (`texture_2d<f32>`), as `lodkit::combine::combine_at`
-    /// reads them; a full-screen pass of the engine's that calls `combine_at` needs these.
+    /// Bind group layout entries of the six LOD buffer textures the combine reads, from binding
+    /// `first`: color, id and depth of the newer buffer, then of the older one. The depth
+    /// attachments bind as unfilterable float textures (`texture_2d<f32>`), as
+    /// `lodkit::combine::combine_at` reads them; a full-screen pass of the engine's that calls
+    /// `combine_at` needs these (`combine_at_moved` also the motion, see
+    /// [`motion_layout_entry`](Self::motion_layout_entry)).
     pub fn buffer_layout_entries(first: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
         let float = wgpu::TextureSampleType::Float { filterable: false };
         let uint = wgpu::TextureSampleType::Uint;
