@@ -174,9 +174,10 @@ fn combine_texels(newer_color: vec4<f32>, newer_word: u32, old: vec3<f32>, older
 
 /// The whole per-pixel combine of frame-sequential LOD at `pixel` (what passes/combine.wgsl
 /// draws), for an engine to call in a full-screen pass it already runs (tonemapping, TAA) and
-/// save the pass. Six texel loads: the newer color, id and depth, the older depth at the first
-/// estimate, the older color and id (plus the older depth there) at the refined texel. For
-/// scenes where nothing moves by itself; else combine_at_moved.
+/// save the pass. Seven texel loads: the newer color, id and depth, the older depth at the
+/// first estimate, the older color, id and depth at the refined texel; four more id loads where
+/// a t-instance's read lands on another object (combine_match_texel). For scenes where nothing
+/// moves by itself; else combine_at_moved.
 fn combine_at(
     newer_color: texture_2d<f32>,
     newer_id: texture_2d<u32>,
