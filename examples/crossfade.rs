@@ -88,6 +88,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 state: LodRenderState::OPAQUE,
                 dither_alpha: None,
                 sway: [0.0; 2],
+                alpha_rect: Vec4::ZERO,
             }];
             let current = &lods[usize::from(selection.current.min(1))];
             match selection.next {
@@ -110,6 +111,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                     state: LodRenderState::OPAQUE,
                     dither_alpha: None,
                     sway: [0.0; 2],
+                    alpha_rect: Vec4::ZERO,
                 }),
             }
             let clear = wgpu::Color {

@@ -466,13 +466,16 @@ fn glsl_texture_macros_compile_with_glslang() {
 #extension GL_GOOGLE_include_directive : require
 #include \"lodkit/visibility.glsl\"
 #include \"lodkit/bilateral.glsl\"
+#include \"lodkit/alpha_mask.glsl\"
 layout(set = 0, binding = 0) uniform sampler2D vis_tex;
+layout(set = 0, binding = 3) uniform sampler2D alpha_tex;
 layout(set = 0, binding = 1) uniform sampler2D low_color;
 layout(set = 0, binding = 2) uniform sampler2D low_geometry;
 layout(location = 0) in vec3 object_pos;
 layout(location = 0) out vec4 color;
 void main() {
     if (!lodkit_check_visibility(vis_tex, object_pos, 0.5)) discard;
+    if (!lodkit_alpha_mask_keep(alpha_tex, object_pos, vec4(0.5, -0.5, 0.5, 0.5))) discard;
     color = lodkit_bilateral_upsample_at(low_color, low_geometry, vec2(320.0, 180.0), vec2(640.0, 360.0),
                                          gl_FragCoord.xy, 4.0, vec3(0.0, 0.0, 1.0), 0.25, 0.4);
 }

@@ -303,6 +303,7 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
         sway: [0.0; 2],
         prev_model: Mat4::IDENTITY,
         prev_sway_phase: 0.0,
+        alpha_rect: Vec4::ZERO,
     };
     let render = |items: &[LodDrawItem]| {
         let clear = wgpu::Color::BLACK;
@@ -487,6 +488,7 @@ fn a_swaying_lod_moves_with_its_phase() {
             sway,
             prev_model: Mat4::IDENTITY,
             prev_sway_phase: sway[1],
+            alpha_rect: Vec4::ZERO,
         };
         let clear = wgpu::Color::BLACK;
         renderer

@@ -4,7 +4,9 @@ use glam::Vec3;
 use lodkit::fullscreen::fullscreen_vertex;
 use lodkit::normal_distance::{NORMAL_DISTANCE_MIN_Z, foreshortened_normal_distance};
 
-use crate::harness::{Probe, assert_close, floats, run_glsl, run_wgsl, words};
+use lodkit::shaders::SourceLanguage;
+
+use crate::harness::{Probe, assert_close, floats, run_glsl, run_wgsl, run_with, words};
 
 /// Hand-picked pairs (identical, facing vs tilted, grazing, back-facing, just either side of the
 /// guard) plus a deterministic spread of unit normals.
@@ -198,5 +200,108 @@ fn headless_context_reports_a_missing_backend_clearly() {
     assert!(
         text.contains("no GPU adapter") && text.contains("mesa-vulkan-drivers"),
         "{text}"
+    );
+}
+
+#[test]
+fn alpha_mask_twins_match_on_a_real_mask() {
+    use glam::{Vec2, Vec4};
+    use lodkit::alpha_mask::*;
+    let gpu = lodkit_test_gpu!();
+    // An 8x8 mask: a disk, so covered and uncovered texels border each other everywhere.
+    let size = 8u32;
+    let texels: Vec<f32> = (0..size * size)
+        .map(|i| {
+            let c = Vec2::new((i % size) as f32 + 0.5, (i / size) as f32 + 0.5) - 4.0;
+            if c.length() < 3.2 { 1.0 } else { 0.0 }
+        })
+        .collect();
+    let mask = AlphaMask { size, texels };
+    // Points over and around the mask's rectangle (x -1..1, y 0..2), with and without a rect.
+    let rect = alpha_mask_rect(Vec2::new(-1.0, 0.0), Vec2::new(1.0, 2.0));
+    let noise = lodkit::noise::white_noise(3 * 200, 9);
+    let cases: Vec<(Vec3, Vec4)> = noise
+        .chunks(3)
+        .enumerate()
+        .map(|(i, r)| {
+            let p = Vec3::new(r[0] * 2.6 - 1.3, r[1] * 2.6 - 0.3, r[2] - 0.5);
+            (p, if i % 10 == 9 { Vec4::ZERO } else { rect })
+        })
+        .collect();
+    let inputs: Vec<u32> = cases
+        .iter()
+        .flat_map(|(p, r)| words(&[p.x, p.y, p.z, r.x, r.y, r.z, r.w]))
+        .collect();
+    let want: Vec<u32> = cases
+        .iter()
+        .flat_map(|(p, r)| {
+            let uv = alpha_mask_uv(*p, *r);
+            let t = alpha_mask_texel(uv, glam::UVec2::splat(size));
+            let mut w = words(&[uv.x, uv.y]);
+            w.extend([
+                u32::from(alpha_mask_inside(uv)),
+                t.x,
+                t.y,
+                u32::from(alpha_mask_keep(&mask, *p, *r)),
+            ]);
+            w
+        })
+        .collect();
+    let wgsl = "let p = vec3(inp_f(0u), inp_f(1u), inp_f(2u));
+        let r = vec4(inp_f(3u), inp_f(4u), inp_f(5u), inp_f(6u));
+        let uv = alpha_mask_uv(p, r);
+        let t = alpha_mask_texel(uv, textureDimensions(probe_tex, 0));
+        out_f(0u, uv.x); out_f(1u, uv.y); out_u(2u, u32(alpha_mask_inside(uv)));
+        out_u(3u, t.x); out_u(4u, t.y); out_u(5u, u32(alpha_mask_keep(probe_tex, p, r)));";
+    let glsl = "vec3 p = vec3(inp_f(0u), inp_f(1u), inp_f(2u));
+        vec4 r = vec4(inp_f(3u), inp_f(4u), inp_f(5u), inp_f(6u));
+        vec2 uv = lodkit_alpha_mask_uv(p, r);
+        uvec2 t = lodkit_alpha_mask_texel(uv, uvec2(textureSize(sampler2D(probe_tex, probe_sampler), 0)));
+        out_f(0u, uv.x); out_f(1u, uv.y); out_u(2u, uint(lodkit_alpha_mask_inside(uv)));
+        out_u(3u, t.x); out_u(4u, t.y);
+        out_u(5u, uint(lodkit_alpha_mask_keep(sampler2D(probe_tex, probe_sampler), p, r)));";
+    for (language, header, body) in [
+        (
+            SourceLanguage::Wgsl,
+            "#import lodkit::alpha_mask::{alpha_mask_uv, alpha_mask_inside, alpha_mask_texel, alpha_mask_keep}",
+            wgsl,
+        ),
+        (
+            SourceLanguage::Glsl(naga::ShaderStage::Compute),
+            "#include \"lodkit/alpha_mask.glsl\"",
+            glsl,
+        ),
+    ] {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 7,
+            outputs: 6,
+            texture: Some((size, &mask.texels)),
+            rgba: &[],
+            urgba: &[],
+        };
+        let got = run_with(gpu, &probe, &inputs, language, &[]);
+        for (i, (g, w)) in got.chunks(6).zip(want.chunks(6)).enumerate() {
+            assert_eq!(
+                &g[2..],
+                &w[2..],
+                "{language:?} case {i}: inside, texel, keep"
+            );
+            let (g, w) = (floats(&g[..2]), floats(&w[..2]));
+            assert!(
+                (g[0] - w[0]).abs() < 1e-6 && (g[1] - w[1]).abs() < 1e-6,
+                "{language:?} case {i}: uv {g:?} vs {w:?}"
+            );
+        }
+    }
+    // Hand-derived: the mask's center is covered, its corner not, and without a rect all is kept.
+    let keep = |p: Vec3, r: Vec4| alpha_mask_keep(&mask, p, r);
+    assert!(keep(Vec3::new(0.0, 1.0, 0.0), rect) && !keep(Vec3::new(-0.95, 1.95, 0.0), rect));
+    assert!(keep(Vec3::new(-0.95, 1.95, 0.0), Vec4::ZERO));
+    let kept = want.chunks(6).filter(|w| w[5] == 1).count();
+    assert!(
+        kept > 40 && kept < 170,
+        "{kept} of 200 kept: the cases miss the disk's edge"
     );
 }

@@ -5,6 +5,7 @@
 
 #[macro_use]
 mod support;
+mod alpha_tested;
 mod composition;
 mod display_time;
 mod frame_sequential;

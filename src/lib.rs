@@ -37,6 +37,7 @@
 
 #![warn(missing_docs)]
 
+pub mod alpha_mask;
 pub mod bilateral;
 pub mod combine;
 pub mod frame_sequential;

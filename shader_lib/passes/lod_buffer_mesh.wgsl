@@ -18,10 +18,15 @@
 //   fs_main   LodBufferMotionOutput (location 0 color, location 1 r32uint id word, location 2
 //             rg16float object motion; the depth attachment keeps the depth)
 //   sway_offset(p, sway) -> vec3<f32>   helper: the wind sway of the vertex stage
-// Bindings: group 0: 0 `camera: LodCamera` (uniform), 1 `vis_tex: texture_2d<f32>`;
+// An alpha-tested LOD (a billboard impostor) discards what its mask does not cover
+// (lodkit::alpha_mask) before anything is written.
+//
+// Bindings: group 0: 0 `camera: LodCamera` (uniform), 1 `vis_tex: texture_2d<f32>`,
+//   2 `alpha_mask: texture_2d<f32>` (r32float, lodkit::alpha_mask);
 //   group 1: 0 `draw: LodDraw` (uniform, dynamic offset).
 // Shader defs: none.
 #import lodkit::visibility::visibility_flags
+#import lodkit::alpha_mask::alpha_mask_keep
 #import lodkit::lod_buffer::{LodBufferMotionOutput, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT, lod_buffer_output_motion, lod_buffer_motion}
 
 /// Per-view data.
@@ -50,10 +55,13 @@ struct LodDraw {
     /// Sway: x amplitude (object units at the top of a unit-high mesh, 0 = none), y phase,
     /// z the previous frame's phase.
     sway: vec4<f32>,
+    /// Alpha mask rect (lodkit::alpha_mask; x == 0: no alpha test).
+    alpha_rect: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> camera: LodCamera;
 @group(0) @binding(1) var vis_tex: texture_2d<f32>;
+@group(0) @binding(2) var alpha_mask: texture_2d<f32>;
 @group(1) @binding(0) var<uniform> draw: LodDraw;
 
 struct VertexOut {
@@ -85,9 +93,12 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
     );
 }
 
-/// Display-time visibility flags, Lambert shading, object motion, LOD buffer output.
+/// Alpha test, display-time visibility flags, Lambert shading, object motion, LOD buffer output.
 @fragment
 fn fs_main(in: VertexOut) -> LodBufferMotionOutput {
+    if (!alpha_mask_keep(alpha_mask, in.object_pos, draw.alpha_rect)) {
+        discard;
+    }
     var flags = LOD_BUFFER_SHOWN_NOW | LOD_BUFFER_SHOWN_NEXT;
     if (draw.instance_id != 0u) {
         flags = visibility_flags(vis_tex, in.object_pos * draw.vis_scale, draw.tau, draw.tau_next);

@@ -99,7 +99,7 @@ impl GBufferRenderer {
         };
         let module = gpu.pass_module("gbuffer_mesh", defs)?;
         let device = &gpu.device;
-        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "gbuffer_mesh")?;
+        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "gbuffer_mesh", &[])?;
         let pipeline = mesh_pipeline(
             gpu,
             &module,

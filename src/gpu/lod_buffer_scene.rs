@@ -7,10 +7,12 @@ use super::counters::FragmentCounter;
 use super::error::{check_color_format, same_color_format};
 use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
 use super::resources::{
-    DrawUniforms, depth_write_state, mesh_pipeline, r32float_texture, uniform_buffer, uniform_entry,
+    DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, r32float_texture,
+    texture_entry, uniform_buffer,
 };
-use super::scene::GpuMesh;
+use super::scene::{GpuMesh, UNFILTERABLE, view_group};
 use super::{GpuContext, GpuError};
+use crate::alpha_mask::AlphaMask;
 use crate::combine::DepthConvention;
 use crate::frame_sequential::FrameDraw;
 use crate::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
@@ -48,6 +50,8 @@ pub struct LodDrawUniform {
     pub tau_next: f32,
     /// Sway: amplitude, phase, the previous frame's phase, padding.
     pub sway: [f32; 4],
+    /// Alpha mask rect (`lodkit::alpha_mask`; x = 0: no alpha test).
+    pub alpha_rect: [f32; 4],
 }
 
 /// The cameras of a LOD buffer frame. The previous frame's view-projection only matters for
@@ -94,6 +98,9 @@ pub struct LodDrawItem<'a> {
     pub sway: [f32; 2],
     /// The sway phase of the previous frame.
     pub prev_sway_phase: f32,
+    /// Where the renderer's alpha mask lies in object space
+    /// ([`alpha_mask_rect`](crate::alpha_mask::alpha_mask_rect)); `Vec4::ZERO`: no alpha test.
+    pub alpha_rect: Vec4,
 }
 
 impl<'a> LodDrawItem<'a> {
@@ -110,6 +117,7 @@ impl<'a> LodDrawItem<'a> {
             tau_next: draw.tau_next,
             sway: [0.0; 2],
             prev_sway_phase: 0.0,
+            alpha_rect: Vec4::ZERO,
         }
     }
 
@@ -126,6 +134,8 @@ impl<'a> LodDrawItem<'a> {
 pub struct LodBufferRenderer {
     pipeline: wgpu::RenderPipeline,
     camera: wgpu::Buffer,
+    camera_layout: wgpu::BindGroupLayout,
+    vis_view: wgpu::TextureView,
     camera_group: wgpu::BindGroup,
     draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
@@ -174,8 +184,12 @@ impl LodBufferRenderer {
         gpu.guarded(CALL, || {
             let vis_texture = r32float_texture(gpu, vis.size, &vis.texels, "visibility texture")?;
             let module = gpu.pass_module("lod_buffer_mesh", &[])?;
-            let device = &gpu.device;
-            let (view_layout, draw_layout, layout) = layouts(device);
+            let extra = [
+                texture_entry(1, UNFILTERABLE),
+                texture_entry(2, UNFILTERABLE),
+            ];
+            let (view_layout, draw_layout, layout) =
+                camera_draw_layouts(gpu, "lod_buffer_mesh", &extra)?;
             let pipeline = mesh_pipeline(
                 gpu,
                 &module,
@@ -197,24 +211,15 @@ impl LodBufferRenderer {
                 "lod draws",
             )?;
             let vis_view = vis_texture.create_view(&Default::default());
-            let camera_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &view_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: camera.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&vis_view),
-                    },
-                ],
-            });
+            let mask = r32float_texture(gpu, 1, &AlphaMask::opaque().texels, "alpha mask")?;
+            let mask_view = mask.create_view(&Default::default());
+            let camera_group = view_group(gpu, &view_layout, &camera, &[&vis_view, &mask_view]);
             let draw_group = draws.bind_group(gpu, &draw_layout)?;
             Ok(Self {
                 pipeline,
                 camera,
+                camera_layout: view_layout,
+                vis_view,
                 camera_group,
                 draws,
                 draw_group,
@@ -223,6 +228,19 @@ impl LodBufferRenderer {
                 depth,
             })
         })
+    }
+
+    /// Binds `mask` as the alpha mask of every draw whose `alpha_rect` is set (one mask, or an
+    /// atlas, per renderer; a 1x1 opaque one until then). [`GpuError::Mismatch`] when its texels
+    /// do not fill `size` x `size` or `size` is 0.
+    pub fn set_alpha_mask(&mut self, gpu: &GpuContext, mask: &AlphaMask) -> Result<(), GpuError> {
+        let texture = r32float_texture(gpu, mask.size, &mask.texels, "alpha mask")?;
+        let view = texture.create_view(&Default::default());
+        let views = [&self.vis_view, &view];
+        self.camera_group = gpu.guarded("LodBufferRenderer::set_alpha_mask", || {
+            Ok(view_group(gpu, &self.camera_layout, &self.camera, &views))
+        })?;
+        Ok(())
     }
 
     /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers` seen by
@@ -266,6 +284,7 @@ impl LodBufferRenderer {
                     vis_scale: self.vis_scale,
                     tau_next: item.tau_next,
                     sway: [item.sway[0], item.sway[1], item.prev_sway_phase, 0.0],
+                    alpha_rect: item.alpha_rect.to_array(),
                 })
                 .collect();
             self.draws.write(gpu, &uniforms)?;
@@ -305,43 +324,6 @@ impl LodBufferRenderer {
             }
         })
     }
-}
-
-/// The view (camera, visibility texture) and per-draw bind group layouts of
-/// `passes/lod_buffer_mesh.wgsl`, and the pipeline layout over both.
-fn layouts(
-    device: &wgpu::Device,
-) -> (
-    wgpu::BindGroupLayout,
-    wgpu::BindGroupLayout,
-    wgpu::PipelineLayout,
-) {
-    let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("lod_buffer_mesh view"),
-        entries: &[
-            uniform_entry(0, false),
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            },
-        ],
-    });
-    let draw_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("lod_buffer_mesh draw"),
-        entries: &[uniform_entry(0, true)],
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("lod_buffer_mesh"),
-        bind_group_layouts: &[Some(&view_layout), Some(&draw_layout)],
-        immediate_size: 0,
-    });
-    (view_layout, draw_layout, layout)
 }
 
 /// The depth test that keeps the nearer fragment under `depth`.

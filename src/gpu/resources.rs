@@ -507,11 +507,12 @@ pub fn begin_targets_pass<'e>(
     })
 }
 
-/// The bind group layouts of a mesh pass with a camera uniform in group 0 and per-draw uniforms
-/// (dynamic offset) in group 1, and the pipeline layout over both.
+/// The per-view (a uniform at binding 0, then `view_extra`) and per-draw (a dynamic-offset
+/// uniform) bind group layouts of a mesh pass, and the pipeline layout over both.
 pub fn camera_draw_layouts(
     gpu: &GpuContext,
     label: &str,
+    view_extra: &[wgpu::BindGroupLayoutEntry],
 ) -> Result<
     (
         wgpu::BindGroupLayout,
@@ -521,34 +522,28 @@ pub fn camera_draw_layouts(
     GpuError,
 > {
     gpu.guarded("resources::camera_draw_layouts", || {
-        Ok(camera_draw_layouts_unguarded(gpu, label))
-    })
-}
-
-fn camera_draw_layouts_unguarded(
-    gpu: &GpuContext,
-    label: &str,
-) -> (
-    wgpu::BindGroupLayout,
-    wgpu::BindGroupLayout,
-    wgpu::PipelineLayout,
-) {
-    let layout_of = |dynamic| {
-        gpu.device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let mut view_entries = vec![uniform_entry(0, false)];
+        view_entries.extend_from_slice(view_extra);
+        let layout_of = |entries: &[wgpu::BindGroupLayoutEntry]| {
+            gpu.device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries,
+                })
+        };
+        let (camera, draw) = (
+            layout_of(&view_entries),
+            layout_of(&[uniform_entry(0, true)]),
+        );
+        let layout = gpu
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(label),
-                entries: &[uniform_entry(0, dynamic)],
-            })
-    };
-    let (camera, draw) = (layout_of(false), layout_of(true));
-    let layout = gpu
-        .device
-        .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(label),
-            bind_group_layouts: &[Some(&camera), Some(&draw)],
-            immediate_size: 0,
-        });
-    (camera, draw, layout)
+                bind_group_layouts: &[Some(&camera), Some(&draw)],
+                immediate_size: 0,
+            });
+        Ok((camera, draw, layout))
+    })
 }
 
 /// Textures of one size and color format allocated together (the LOD buffer pair, the

@@ -11,10 +11,11 @@ use super::counters::FragmentCounter;
 use super::error::texture_extent;
 use super::resources::{
     DrawUniforms, begin_targets_pass, buffer_with_data, camera_draw_layouts, mesh_pipeline,
-    texture_2d, uniform_buffer,
+    r32float_texture, texture_2d, texture_entry, uniform_buffer,
 };
 use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
 use super::{GpuContext, GpuError};
+use crate::alpha_mask::AlphaMask;
 use crate::unpopping::LodRenderState;
 
 /// Depth format of [`RenderTarget`].
@@ -87,6 +88,25 @@ impl Mesh {
             }
         }
         m
+    }
+
+    /// A card: the rectangle `min..max` in the z = 0 plane, facing +z (two triangles). With an
+    /// alpha mask over the same rectangle
+    /// ([`alpha_mask_rect`](crate::alpha_mask::alpha_mask_rect)) it is a billboard impostor.
+    pub fn card(min: glam::Vec2, max: glam::Vec2) -> Self {
+        let corners = [
+            (min.x, min.y),
+            (max.x, min.y),
+            (max.x, max.y),
+            (min.x, max.y),
+        ];
+        Mesh {
+            vertices: corners
+                .iter()
+                .map(|&(x, y)| [x, y, 0.0, 0.0, 0.0, 1.0])
+                .collect(),
+            indices: vec![0, 1, 2, 0, 2, 3],
+        }
     }
 
     /// Object-space bounding box (min, max) of the vertices; `None` for an empty mesh.
@@ -197,6 +217,8 @@ pub struct DrawUniform {
     pub dither_alpha: f32,
     /// Padding to the WGSL struct's size.
     pub pad: f32,
+    /// Alpha mask rect (`lodkit::alpha_mask`; x = 0: no alpha test).
+    pub alpha_rect: [f32; 4],
 }
 
 /// One draw: a mesh, where, its color, and how it takes part in a transition.
@@ -215,6 +237,9 @@ pub struct DrawItem<'a> {
     /// Wind sway of the vertex stage: amplitude (object units at the top of a unit-high mesh,
     /// 0 = none) and phase (advance it over time).
     pub sway: [f32; 2],
+    /// Where the renderer's alpha mask lies in object space
+    /// ([`alpha_mask_rect`](crate::alpha_mask::alpha_mask_rect)); `Vec4::ZERO`: no alpha test.
+    pub alpha_rect: Vec4,
 }
 
 /// A color and depth target of one size.
@@ -256,6 +281,7 @@ pub struct MeshRenderer {
     opaque: wgpu::RenderPipeline,
     blended: wgpu::RenderPipeline,
     camera: wgpu::Buffer,
+    camera_layout: wgpu::BindGroupLayout,
     camera_group: wgpu::BindGroup,
     draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
@@ -277,8 +303,8 @@ impl MeshRenderer {
             &[]
         };
         let module = gpu.pass_module("lod_mesh", defs)?;
-        let device = &gpu.device;
-        let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "lod_mesh")?;
+        let (camera_layout, draw_layout, layout) =
+            camera_draw_layouts(gpu, "lod_mesh", &[texture_entry(1, UNFILTERABLE)])?;
         let pipeline = |state: LodRenderState| {
             let target = wgpu::ColorTargetState {
                 format: COLOR_FORMAT,
@@ -296,16 +322,9 @@ impl MeshRenderer {
             blend: true,
         };
         let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
-        let camera_group = gpu.guarded("MeshRenderer::new", || {
-            Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: None,
-                layout: &camera_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: camera.as_entire_binding(),
-                }],
-            }))
-        })?;
+        let mask = r32float_texture(gpu, 1, &AlphaMask::opaque().texels, "alpha mask")?;
+        let mask_view = mask.create_view(&Default::default());
+        let camera_group = view_group(gpu, &camera_layout, &camera, &[&mask_view]);
         let draws = DrawUniforms::new(
             gpu,
             std::mem::size_of::<DrawUniform>(),
@@ -316,10 +335,23 @@ impl MeshRenderer {
             opaque: pipeline(opaque_state)?,
             blended: pipeline(blended_state)?,
             camera_group,
+            camera_layout,
             draw_group: draws.bind_group(gpu, &draw_layout)?,
             camera,
             draws,
         })
+    }
+
+    /// Binds `mask` as the alpha mask of every draw whose `alpha_rect` is set (one mask, or an
+    /// atlas, per renderer; a 1x1 opaque one until then). [`GpuError::Mismatch`] when its texels
+    /// do not fill `size` x `size` or `size` is 0.
+    pub fn set_alpha_mask(&mut self, gpu: &GpuContext, mask: &AlphaMask) -> Result<(), GpuError> {
+        let texture = r32float_texture(gpu, mask.size, &mask.texels, "alpha mask")?;
+        let view = texture.create_view(&Default::default());
+        self.camera_group = gpu.guarded("MeshRenderer::set_alpha_mask", || {
+            Ok(view_group(gpu, &self.camera_layout, &self.camera, &[&view]))
+        })?;
+        Ok(())
     }
 
     /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]; the
@@ -354,6 +386,7 @@ impl MeshRenderer {
                     sway: item.sway,
                     dither_alpha: item.dither_alpha.unwrap_or(DITHER_OFF),
                     pad: 0.0,
+                    alpha_rect: item.alpha_rect.to_array(),
                 })
                 .collect();
             self.draws.write(gpu, &uniforms)?;
@@ -396,4 +429,35 @@ impl MeshRenderer {
             }
         })
     }
+}
+
+/// Texture binding type of the masks and patterns the mesh passes read with `textureLoad`.
+pub(crate) const UNFILTERABLE: wgpu::TextureSampleType =
+    wgpu::TextureSampleType::Float { filterable: false };
+
+/// The per-view bind group of a mesh pass: `camera` at binding 0, then `views` from binding 1.
+pub(crate) fn view_group(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    camera: &wgpu::Buffer,
+    views: &[&wgpu::TextureView],
+) -> wgpu::BindGroup {
+    let mut entries = vec![wgpu::BindGroupEntry {
+        binding: 0,
+        resource: camera.as_entire_binding(),
+    }];
+    entries.extend(
+        views
+            .iter()
+            .zip(1..)
+            .map(|(v, binding)| wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::TextureView(v),
+            }),
+    );
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout,
+        entries: &entries,
+    })
 }

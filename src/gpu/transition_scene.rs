@@ -139,6 +139,7 @@ impl TransitionScene {
                 state: LodRenderState::OPAQUE,
                 dither_alpha: None,
                 sway: [0.0; 2],
+                alpha_rect: Vec4::ZERO,
             });
         }
         // One LOD alone is a hard switch before (fine) or after (coarse) it happens.
@@ -203,6 +204,7 @@ pub fn transition_items<'a>(
             state,
             dither_alpha,
             sway: [0.0; 2],
+            alpha_rect: Vec4::ZERO,
         }
     };
     // Before and after the transition only one LOD is visible: draw only that one.

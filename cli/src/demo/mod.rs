@@ -14,6 +14,7 @@ pub mod closed_loop;
 pub mod cpu;
 pub mod doc_pictures;
 pub mod frame_cost;
+pub mod impostor;
 pub mod plots;
 pub mod render;
 pub mod report;

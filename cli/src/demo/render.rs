@@ -3,6 +3,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+use super::impostor::bake;
 use super::scene::DemoScene;
 use lodkit::combine::{DepthConvention, PixelSource, ScreenRect, combine_images, screen_rect};
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
@@ -105,6 +106,8 @@ pub struct SceneRenderer<'a> {
     meshes: Vec<[GpuMesh; 2]>,
     /// Object-space box of both LODs of each object.
     bounds: Vec<Option<(Vec3, Vec3)>>,
+    /// Alpha mask rect of both LODs of each object (zero: no alpha test).
+    alpha_rects: Vec<[Vec4; 2]>,
     single: [MeshRenderer; 2],
     target: RenderTarget,
     lod_buffer: [LodBufferRenderer; 2],
@@ -165,26 +168,47 @@ impl<'a> SceneRenderer<'a> {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::COPY_DST;
+        let mut single = [
+            MeshRenderer::new(gpu, false)?,
+            MeshRenderer::new(gpu, true)?,
+        ];
+        let mut lod_buffer = [
+            LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::WhiteNoise), VIS_SCALE)?,
+            LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), VIS_SCALE)?,
+        ];
+        // A scene has at most one kind of impostor (validated): its mask is every renderer's.
+        let impostor = scene
+            .objects
+            .iter()
+            .flat_map(|o| [o.fine, o.coarse])
+            .find(|s| s.impostor_of().is_some());
+        if let Some(mask) = impostor
+            .map(|s| bake(gpu, &single[0], s))
+            .transpose()?
+            .flatten()
+        {
+            for r in &mut single {
+                r.set_alpha_mask(gpu, &mask)?;
+            }
+            for r in &mut lod_buffer {
+                r.set_alpha_mask(gpu, &mask)?;
+            }
+        }
+        let alpha_rects = scene
+            .objects
+            .iter()
+            .map(|o| [o.fine.alpha_rect(), o.coarse.alpha_rect()])
+            .collect();
         Ok(Self {
             scene,
             size,
             frames: frames.max(2),
             meshes,
             bounds,
-            single: [
-                MeshRenderer::new(gpu, false)?,
-                MeshRenderer::new(gpu, true)?,
-            ],
+            alpha_rects,
+            single,
             target: RenderTarget::new(gpu, size.0, size.1)?,
-            lod_buffer: [
-                LodBufferRenderer::new(
-                    gpu,
-                    FORMAT,
-                    &vis(VisibilityPattern::WhiteNoise),
-                    VIS_SCALE,
-                )?,
-                LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), VIS_SCALE)?,
-            ],
+            lod_buffer,
             buffers: LodBuffers::new(gpu, size.0, size.1, FORMAT)?,
             combine: CombinePass::new(gpu, FORMAT, false)?,
             combined: texture_2d(gpu, size, FORMAT, usage, "combined")?,
@@ -312,6 +336,7 @@ impl<'a> SceneRenderer<'a> {
                     state: LodRenderState::OPAQUE,
                     dither_alpha: None,
                     sway: self.sway(i, frame),
+                    alpha_rect: self.alpha_rects[i][0],
                 });
                 continue;
             }
@@ -319,6 +344,8 @@ impl<'a> SceneRenderer<'a> {
             let depth = (view * model).w_axis.z;
             for mut item in transition_items(technique, t, model, fine, coarse) {
                 item.sway = self.sway(i, frame);
+                let lod = usize::from(std::ptr::eq(item.mesh, coarse.0));
+                item.alpha_rect = self.alpha_rects[i][lod];
                 if item.state.blend {
                     blended.push((depth, item));
                 } else {
@@ -412,6 +439,7 @@ impl<'a> SceneRenderer<'a> {
                     );
                     item.sway = self.sway(i, frame);
                     item.prev_sway_phase = self.sway(i, frame.saturating_sub(1))[1];
+                    item.alpha_rect = self.alpha_rects[i][lod];
                     Some(item)
                 })
                 .collect();
@@ -501,6 +529,7 @@ impl<'a> SceneRenderer<'a> {
                         state: LodRenderState::OPAQUE,
                         dither_alpha: None,
                         sway: self.sway(i, middle),
+                        alpha_rect: self.alpha_rects[i][k],
                     }
                 })
                 .collect();

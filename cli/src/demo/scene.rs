@@ -16,7 +16,7 @@
 
 use std::path::Path;
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
 use lodkit::gpu::scene::Mesh;
@@ -117,12 +117,25 @@ pub enum Shape {
         /// Rings of each canopy sphere (segments are twice as many).
         rings: u32,
     },
+    /// Alpha-tested billboard impostor of `Tree { puffs, rings }`: a card over the tree's front
+    /// (x, y) extent, facing +z, whose alpha mask is the tree's silhouette, rendered when the
+    /// scene is loaded. One impostor kind per scene (the renderers bind one mask).
+    Impostor {
+        /// Canopy spheres of the tree it stands for.
+        puffs: u32,
+        /// Rings of each canopy sphere of that tree.
+        rings: u32,
+    },
 }
 
 impl Shape {
     /// The mesh of the shape.
     pub fn mesh(self) -> Mesh {
         match self {
+            Shape::Impostor { .. } => {
+                let (min, max) = self.card_rect();
+                Mesh::card(min, max)
+            }
             Shape::Sphere { rings, segments } => Mesh::sphere(rings, segments),
             Shape::Cube => Mesh::cube(),
             Shape::Box { half } => {
@@ -163,9 +176,37 @@ impl Shape {
         match self {
             Shape::Sphere { rings, segments } => sphere(rings.max(2), segments.max(3)),
             Shape::Cube | Shape::Box { .. } => 12,
+            Shape::Impostor { .. } => 2,
             Shape::Tree { puffs, rings } => {
                 12 + u64::from(puffs) * sphere(rings.max(2), rings.saturating_mul(2).max(3))
             }
+        }
+    }
+
+    /// The tree an impostor stands for.
+    pub fn impostor_of(self) -> Option<Shape> {
+        match self {
+            Shape::Impostor { puffs, rings } => Some(Shape::Tree { puffs, rings }),
+            _ => None,
+        }
+    }
+
+    /// The object-space rectangle (x, y) an impostor's card and mask cover: its tree's extent.
+    pub fn card_rect(self) -> (Vec2, Vec2) {
+        let tree = self.impostor_of().unwrap_or(self).mesh();
+        let (min, max) = tree.bounds().unwrap_or((Vec3::NEG_ONE, Vec3::ONE));
+        (min.truncate(), max.truncate())
+    }
+
+    /// Where the alpha mask lies on the shape (`lodkit::alpha_mask`): an impostor's card
+    /// rectangle; zero (no alpha test) for the others.
+    pub fn alpha_rect(self) -> Vec4 {
+        match self {
+            Shape::Impostor { .. } => {
+                let (min, max) = self.card_rect();
+                lodkit::alpha_mask::alpha_mask_rect(min, max)
+            }
+            _ => Vec4::ZERO,
         }
     }
 
@@ -177,11 +218,15 @@ impl Shape {
             Shape::Sphere { segments, .. } if !(3..=512).contains(&segments) => {
                 Err(format!("Sphere segments = {segments} is outside 3..=512"))
             }
-            Shape::Tree { puffs, .. } if !(1..=32).contains(&puffs) => {
-                Err(format!("Tree puffs = {puffs} is outside 1..=32"))
+            Shape::Tree { puffs, .. } | Shape::Impostor { puffs, .. }
+                if !(1..=32).contains(&puffs) =>
+            {
+                Err(format!("puffs = {puffs} is outside 1..=32"))
             }
-            Shape::Tree { rings, .. } if !(2..=64).contains(&rings) => {
-                Err(format!("Tree rings = {rings} is outside 2..=64"))
+            Shape::Tree { rings, .. } | Shape::Impostor { rings, .. }
+                if !(2..=64).contains(&rings) =>
+            {
+                Err(format!("rings = {rings} is outside 2..=64"))
             }
             Shape::Box { half } if !half.iter().all(|h| *h > 0.0 && *h <= 100.0) => {
                 Err(format!("Box half = {half:?} must lie in (0, 100]"))
@@ -327,6 +372,19 @@ impl DemoScene {
                 }
             }
         }
+        let mut impostors: Vec<Shape> = Vec::new();
+        for shape in self.objects.iter().flat_map(|o| [o.fine, o.coarse]) {
+            if shape.impostor_of().is_some() && !impostors.contains(&shape) {
+                impostors.push(shape);
+            }
+        }
+        if impostors.len() > 1 {
+            return Err(format!(
+                "objects: {} kinds of Impostor ({impostors:?}); a scene has at most one (the \
+                 renderers bind one alpha mask)",
+                impostors.len()
+            ));
+        }
         if triangles > MAX_TRIANGLES {
             return Err(format!(
                 "objects: {triangles} triangles over both LODs of every object, at most \
@@ -428,8 +486,9 @@ impl DemoScene {
     /// The case engines have: a field of trees at many distances, of which a few objects are in
     /// transition at a time and cover a small part of the screen. Their LOD chains are the ones
     /// single-frame blends find hard: a near tree swaying in the wind (an animated LOD pair), a
-    /// far tree, a sphere whose box LOD intersects it (corners outside, faces inside), and a
-    /// flat sign whose two LODs are coplanar.
+    /// far tree whose coarse LOD is an alpha-tested billboard impostor, a sphere whose box LOD
+    /// intersects it (corners outside, faces inside), and a flat sign whose two LODs are
+    /// coplanar.
     pub fn field() -> DemoScene {
         let tree = |x: f32, z: f32, transition: bool| DemoObject {
             fine: Shape::Tree { puffs: 7, rings: 8 },
@@ -454,7 +513,12 @@ impl DemoScene {
             sway: 0.12,
             ..tree(-1.3, 1.6, true)
         });
-        objects.push(tree(3.0, -13.0, true));
+        // The far tree's coarse LOD is an alpha-tested billboard impostor.
+        objects.push(DemoObject {
+            coarse: Shape::Impostor { puffs: 7, rings: 8 },
+            coarse_color: [0.1, 0.5, 0.25],
+            ..tree(3.0, -13.0, true)
+        });
         objects.push(DemoObject {
             fine: Shape::Sphere {
                 rings: 16,

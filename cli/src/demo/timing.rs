@@ -244,6 +244,7 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
                     -((k / 5) as f32) * 2.0,
                 )),
                 prev_sway_phase: 0.0,
+                alpha_rect: Vec4::ZERO,
             })
             .collect();
         renderer.render(
