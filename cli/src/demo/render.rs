@@ -509,11 +509,11 @@ impl<'a> SceneRenderer<'a> {
     }
 
     /// Masks of the transitioning objects drawn opaque at the fine and at the coarse LOD (the
-    /// scenery in black, so hidden parts do not count), at the middle frame of the static
-    /// camera: `true` where the object covers the pixel.
-    pub fn lod_masks(&self, gpu: &GpuContext) -> Result<[Vec<bool>; 2], GpuError> {
+    /// scenery in black, so hidden parts do not count), at the middle frame of the static or
+    /// `moving` camera: `true` where the object covers the pixel.
+    pub fn lod_masks(&self, gpu: &GpuContext, moving: bool) -> Result<[Vec<bool>; 2], GpuError> {
         let middle = LEAD_FRAMES + self.frames / 2;
-        let (view, proj) = self.camera(middle, false);
+        let (view, proj) = self.camera(middle, moving);
         let mask = |lod: usize| -> Result<Vec<bool>, GpuError> {
             let items: Vec<DrawItem> = self
                 .scene

@@ -203,7 +203,13 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
         }
     } else {
         Table {
-            header: &["technique", "pop (static)", "pop (moving)", "see-through"],
+            header: &[
+                "technique",
+                "pop (static)",
+                "pop (moving)",
+                "see-through",
+                "silhouette error (moving)",
+            ],
             rows: rows
                 .map(|t| {
                     vec![
@@ -211,6 +217,7 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                         format!("{:.3}", t.pop_static),
                         format!("{:.3}", t.pop_moving),
                         pct(t.see_through),
+                        pct(t.silhouette_error),
                     ]
                 })
                 .collect(),
@@ -366,7 +373,9 @@ causes (1.0: all of it in one frame, as a hard switch; 1/N: spread evenly over N
 the moving camera, the change of a run without transition is subtracted frame by frame. \
 See-through is the share of the transitioning objects' interior (pixels both LODs cover) where \
 the background contributes to the middle frame: the frame is rendered over black and over white \
-scenery and the pixels that differ are counted.\n";
+scenery and the pixels that differ are counted. Silhouette error is measured at the middle frame \
+of the moving camera: pixels both LODs cover that show the background, plus pixels neither \
+covers that show a transitioning object, as a share of the pixels either covers.\n";
 
 /// Writes `benchmarks.md` and `quality.md` into `docs`.
 pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
@@ -522,17 +531,18 @@ pub fn summary(report: &DemoReport) -> String {
     for scene in &report.scenes {
         let _ = writeln!(
             s,
-            "\n{scene:<24} {:>8} {:>8} {:>12} {:>10} {:>10} {:>10}",
-            "pop", "pop mov", "see-through", "tris", "frags", "idle"
+            "\n{scene:<24} {:>8} {:>8} {:>12} {:>8} {:>10} {:>10} {:>10}",
+            "pop", "pop mov", "see-through", "sil mov", "tris", "frags", "idle"
         );
         for t in report.transitions.iter().filter(|t| &t.scene == scene) {
             let _ = writeln!(
                 s,
-                "  {:<22} {:>8.3} {:>8.3} {:>12} {:>9.3}x {:>10} {:>10}",
+                "  {:<22} {:>8.3} {:>8.3} {:>12} {:>8} {:>9.3}x {:>10} {:>10}",
                 t.technique,
                 t.pop_static,
                 t.pop_moving,
                 pct(t.see_through),
+                pct(t.silhouette_error),
                 t.triangles_vs_hard,
                 times(t.fragments_vs_hard),
                 times(t.idle_fragments_vs_hard)

@@ -26,6 +26,10 @@ pub struct TransitionMetrics {
     /// Share of the transitioning objects' interior (pixels both LODs cover) where the
     /// background contributes to the middle frame.
     pub see_through: f32,
+    /// Silhouette error with the moving camera at the middle frame: pixels both LODs cover that
+    /// show the background, plus pixels neither covers that show a transitioning object, as a
+    /// share of the pixels either covers.
+    pub silhouette_error: f32,
     /// Triangles submitted over the transition, relative to a hard switch.
     pub triangles_vs_hard: f64,
     /// Counted fragments over the transition, relative to a hard switch (None when the
@@ -196,9 +200,46 @@ fn transition_run(
     }
 }
 
-/// See-through at the middle frame: renders it over black and over white scenery; interior
-/// pixels that differ show the background. Returns the share and a false-color map (interior
-/// gray, see-through red).
+/// The middle frame of `technique` over black and over white scenery (every object but the
+/// transitioning ones in the flat color), with the static or `moving` camera.
+fn over_black_and_white(
+    gpu: &GpuContext,
+    renderer: &SceneRenderer,
+    technique: Technique,
+    moving: bool,
+) -> Result<[Vec<u8>; 2], DemoError> {
+    let middle = LEAD_FRAMES + renderer.transition_frames() / 2;
+    let only_middle = |f: usize| f == middle;
+    let mut over = [Vec::new(), Vec::new()];
+    for (flat, pixels) in [Vec4::new(0.0, 0.0, 0.0, 1.0), Vec4::ONE]
+        .iter()
+        .zip(&mut over)
+    {
+        let spec = RunSpec {
+            technique,
+            moving,
+            transition: true,
+            background: Background::Flat(*flat),
+        };
+        renderer.run(
+            gpu,
+            spec,
+            &only_middle,
+            &mut |_, f| *pixels = f.pixels,
+            None,
+        )?;
+    }
+    Ok(over)
+}
+
+/// Whether pixel `i` differs between the two renders `over` (the background shows there).
+fn shows_background(over: &[Vec<u8>; 2], i: usize) -> bool {
+    (0..3).any(|c| over[0][i * 4 + c].abs_diff(over[1][i * 4 + c]) > 2)
+}
+
+/// See-through at the middle frame, static camera: interior pixels (both LODs cover them) where
+/// the renders over black and white scenery differ. Returns the share and a false-color map
+/// (interior gray, see-through red).
 fn see_through(
     gpu: &GpuContext,
     renderer: &SceneRenderer,
@@ -206,20 +247,7 @@ fn see_through(
     masks: &[Vec<bool>; 2],
     size: (u32, u32),
 ) -> Result<(f32, image::RgbaImage), DemoError> {
-    let middle = LEAD_FRAMES + renderer.transition_frames() / 2;
-    let only_middle = |f: usize| f == middle;
-    let mut over = Vec::new();
-    for flat in [Vec4::new(0.0, 0.0, 0.0, 1.0), Vec4::ONE] {
-        let spec = RunSpec {
-            technique,
-            moving: false,
-            transition: true,
-            background: Background::Flat(flat),
-        };
-        let mut pixels = Vec::new();
-        renderer.run(gpu, spec, &only_middle, &mut |_, f| pixels = f.pixels, None)?;
-        over.push(pixels);
-    }
+    let over = over_black_and_white(gpu, renderer, technique, false)?;
     let (mut interior, mut seen) = (0usize, 0usize);
     let mut map = image::RgbaImage::new(size.0, size.1);
     for (i, px) in map.pixels_mut().enumerate() {
@@ -228,20 +256,45 @@ fn see_through(
             continue;
         }
         interior += 1;
-        let differs = (0..3).any(|c| over[0][i * 4 + c].abs_diff(over[1][i * 4 + c]) > 2);
-        if differs {
+        if shows_background(&over, i) {
             seen += 1;
             *px = image::Rgba([235, 40, 30, 255]);
         } else {
             *px = image::Rgba([150, 150, 150, 255]);
         }
     }
-    let share = if interior == 0 {
+    Ok((share(seen, interior), map))
+}
+
+/// Silhouette error at the middle frame, moving camera (`masks` of that frame): holes (pixels
+/// both LODs cover that show the background) plus ghosts (pixels neither covers where the
+/// render over black scenery shows a transitioning object), over the pixels either covers.
+/// Single-frame techniques draw the frame's own geometry; frame-sequential LOD reprojects last
+/// frame's buffer, and this is where that shows.
+fn silhouette_error(
+    gpu: &GpuContext,
+    renderer: &SceneRenderer,
+    technique: Technique,
+    masks: &[Vec<bool>; 2],
+) -> Result<f32, DemoError> {
+    let over = over_black_and_white(gpu, renderer, technique, true)?;
+    let (mut union, mut wrong) = (0usize, 0usize);
+    for i in 0..masks[0].len().min(over[0].len() / 4) {
+        let (a, b) = (masks[0][i], masks[1][i]);
+        union += usize::from(a || b);
+        let hole = a && b && shows_background(&over, i);
+        let ghost = !a && !b && over[0][i * 4..i * 4 + 3].iter().any(|&c| c > 8);
+        wrong += usize::from(hole || ghost);
+    }
+    Ok(share(wrong, union))
+}
+
+fn share(part: usize, whole: usize) -> f32 {
+    if whole == 0 {
         0.0
     } else {
-        seen as f32 / interior as f32
-    };
-    Ok((share, map))
+        part as f32 / whole as f32
+    }
 }
 
 /// False color of the combine rule per pixel: gray newer, orange older, magenta average of the
@@ -306,7 +359,8 @@ pub fn measure_scene(
     out: &Path,
     tick: &mut dyn FnMut(&str),
 ) -> Result<Vec<TransitionMetrics>, DemoError> {
-    let masks = renderer.lod_masks(gpu)?;
+    let masks = renderer.lod_masks(gpu, false)?;
+    let moving_masks = renderer.lod_masks(gpu, true)?;
     let counts = renderer.counter().kind().is_count();
     let mut rows: Vec<TransitionMetrics> = Vec::new();
     // Reference runs of the current technique family (single-frame or frame-sequential),
@@ -344,6 +398,7 @@ pub fn measure_scene(
             changes.push(run.change);
         }
         let (share, map) = see_through(gpu, renderer, technique, &masks, size)?;
+        let silhouette = silhouette_error(gpu, renderer, technique, &moving_masks)?;
         super::save(&map, &out.join(format!("see-through/{scene}-{name}.png")))?;
         let moving_change = changes.pop().unwrap_or_default();
         let static_change = changes.pop().unwrap_or_default();
@@ -353,6 +408,7 @@ pub fn measure_scene(
             pop_static: pop(&static_change),
             pop_moving: pop(&moving_change),
             see_through: share,
+            silhouette_error: silhouette,
             triangles_vs_hard: 0.0,
             fragments_vs_hard: None,
             idle_fragments_vs_hard: None,
