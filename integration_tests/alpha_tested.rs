@@ -105,3 +105,54 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
         W * W
     ));
 }
+
+#[test]
+fn a_bad_alpha_mask_is_refused_and_the_old_one_kept() {
+    use lodkit::gpu::GpuError;
+    let gpu = lodkit_test_gpu!();
+    let bad = AlphaMask {
+        size: 4,
+        texels: vec![1.0; 15],
+    };
+    let empty = AlphaMask {
+        size: 0,
+        texels: Vec::new(),
+    };
+    let mut single = MeshRenderer::new(gpu, false).unwrap();
+    let vis = visibility_texture(VisibilityPattern::BlueNoise, 8, 1);
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let mut lod = LodBufferRenderer::new(gpu, format, &vis, 1.0).unwrap();
+    for mask in [&bad, &empty] {
+        let errors = [
+            single.set_alpha_mask(gpu, mask).unwrap_err(),
+            lod.set_alpha_mask(gpu, mask).unwrap_err(),
+        ];
+        for e in errors {
+            assert!(matches!(e, GpuError::Mismatch { .. }), "{e}");
+            assert!(e.to_string().contains("texels"), "{e}");
+        }
+    }
+    // Both still draw (with the opaque mask they had).
+    let target = RenderTarget::new(gpu, 8, 8).unwrap();
+    let card = GpuMesh::new(gpu, &Mesh::card(Vec2::splat(-1.0), Vec2::ONE)).unwrap();
+    let item = DrawItem {
+        mesh: &card,
+        model: Mat4::IDENTITY,
+        color: Vec4::ONE,
+        state: LodRenderState::OPAQUE,
+        dither_alpha: None,
+        sway: [0.0; 2],
+        alpha_rect: alpha_mask_rect(Vec2::splat(-1.0), Vec2::ONE),
+    };
+    let view_proj = glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0)
+        * glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
+    let black = wgpu::Color::BLACK;
+    single
+        .render(gpu, &target, black, view_proj, Vec3::Z, &[item], None)
+        .unwrap();
+    let lit = read_texture_rgba8(gpu, &target.color).unwrap();
+    assert!(
+        lit.chunks(4).all(|p| p[0] > 8),
+        "the opaque mask covers the card"
+    );
+}

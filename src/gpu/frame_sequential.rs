@@ -1,10 +1,11 @@
 //! wgpu glue for frame-sequential LOD: the LOD buffer pair (ping-pong) and the combine pass.
 //!
 //! Each frame the engine renders its scene into LOD buffer `scheduler.buffer_index()` (color at
-//! location 0, the id word at location 1, the buffer's own depth attachment, see
-//! `lodkit::lod_buffer`), then calls
-//! [`CombinePass::encode`] with the matrix from [`new_to_old_matrix`](crate::reproject::new_to_old_matrix)
-//! to write the final image into its own target.
+//! location 0, the id word at location 1, the object motion at location 2, the buffer's own
+//! depth attachment, see `lodkit::lod_buffer`), then calls [`CombinePass::encode`] (or
+//! [`CombinePass::encode_regions`]) with the matrix from
+//! [`new_to_old_matrix`](crate::reproject::new_to_old_matrix) to write the final image into its
+//! own target.
 
 use glam::Mat4;
 
