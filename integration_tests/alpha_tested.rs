@@ -13,6 +13,25 @@ use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 use crate::harness::say;
 
+/// An orthographic camera looking down -z that maps x and y in -1..1 onto the whole target.
+fn head_on() -> Mat4 {
+    glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0)
+        * glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y)
+}
+
+/// An opaque white draw of `card` with the alpha mask over `rect`.
+fn card_draw(card: &GpuMesh, rect: Vec4) -> DrawItem<'_> {
+    DrawItem {
+        mesh: card,
+        model: Mat4::IDENTITY,
+        color: Vec4::ONE,
+        state: LodRenderState::OPAQUE,
+        dither_alpha: None,
+        sway: [0.0; 2],
+        alpha_rect: rect,
+    }
+}
+
 #[test]
 fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
     const W: u32 = 64;
@@ -31,8 +50,7 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
     let card = GpuMesh::new(gpu, &Mesh::card(min, max)).unwrap();
     // Seen head-on through an orthographic camera that maps the card onto the whole target, so
     // each pixel center has an object-space point to test on the CPU.
-    let view_proj = glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0)
-        * glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
+    let view_proj = head_on();
     let want: Vec<bool> = (0..W * W)
         .map(|i| {
             let uv = (Vec2::new((i % W) as f32, (i / W) as f32) + 0.5) / W as f32;
@@ -46,15 +64,7 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
     let mut single = MeshRenderer::new(gpu, false).unwrap();
     single.set_alpha_mask(gpu, &mask).unwrap();
     let target = RenderTarget::new(gpu, W, W).unwrap();
-    let item = DrawItem {
-        mesh: &card,
-        model: Mat4::IDENTITY,
-        color: Vec4::ONE,
-        state: LodRenderState::OPAQUE,
-        dither_alpha: None,
-        sway: [0.0; 2],
-        alpha_rect: rect,
-    };
+    let item = card_draw(&card, rect);
     let light = Vec3::Z;
     let black = wgpu::Color::BLACK;
     single
@@ -135,17 +145,8 @@ fn a_bad_alpha_mask_is_refused_and_the_old_one_kept() {
     // Both still draw (with the opaque mask they had).
     let target = RenderTarget::new(gpu, 8, 8).unwrap();
     let card = GpuMesh::new(gpu, &Mesh::card(Vec2::splat(-1.0), Vec2::ONE)).unwrap();
-    let item = DrawItem {
-        mesh: &card,
-        model: Mat4::IDENTITY,
-        color: Vec4::ONE,
-        state: LodRenderState::OPAQUE,
-        dither_alpha: None,
-        sway: [0.0; 2],
-        alpha_rect: alpha_mask_rect(Vec2::splat(-1.0), Vec2::ONE),
-    };
-    let view_proj = glam::camera::rh::proj::directx::orthographic(-1.0, 1.0, -1.0, 1.0, 0.1, 10.0)
-        * glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
+    let item = card_draw(&card, alpha_mask_rect(Vec2::splat(-1.0), Vec2::ONE));
+    let view_proj = head_on();
     let black = wgpu::Color::BLACK;
     single
         .render(gpu, &target, black, view_proj, Vec3::Z, &[item], None)
