@@ -222,6 +222,12 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
         let fade = row("cross-fade");
         assert_eq!(fade.triangles, expected_triangles(scene, frames, true));
         assert!(fade.see_through > 0.5, "cross-fade: {}", fade.see_through);
+        // Half-transparent LODs show the background inside the silhouette: the metric sees it.
+        assert!(
+            fade.silhouette_error > 0.3,
+            "cross-fade: silhouette error {}",
+            fade.silhouette_error
+        );
         if let Some(f) = fade.fragments_vs_hard {
             assert!(f > 1.05, "drawing both LODs must shade more: {f}");
         }
