@@ -245,8 +245,8 @@ impl LodBufferRenderer {
 
     /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers` seen by
     /// `view` (a `Mat4` view-projection, or a [`LodView`] with the previous frame's for moving
-    /// objects), cleared to `clear`, counting the pass's fragments with `counter` if given. Returns the triangles
-    /// drawn and the count (0 without a counter). A t-instance item shown in neither this frame
+    /// objects), cleared to `clear`, counting the pass's fragments with `counter` if given.
+    /// Returns the triangles drawn and the count (0 without a counter). A t-instance item shown in neither this frame
     /// nor the next (tau and tau_next 0 or NaN: visibility texels lie strictly between 0 and 1)
     /// is not submitted. Every fragment of a t-instance is kept and flagged (see
     /// `passes/lod_buffer_mesh.wgsl`).

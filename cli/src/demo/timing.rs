@@ -211,8 +211,8 @@ fn draw_fullscreen(
 }
 
 /// The combine pass against a plain pass reading the same seven textures (color, id and depth of
-/// each buffer, the object motion) at `size` x `size`, on two LOD buffers of a grid of spheres and boxes with a third
-/// of them in transition and the camera moved between the frames.
+/// each buffer, the object motion) at `size` x `size`, on two LOD buffers of a grid of spheres
+/// and boxes with a third of them in transition and the camera moved between the frames.
 pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<PassRatio, GpuError> {
     let buffers = LodBuffers::new(gpu, size, size, FORMAT)?;
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
