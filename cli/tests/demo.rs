@@ -490,6 +490,21 @@ fn a_baked_impostor_mask_is_its_trees_silhouette() {
 }
 
 #[test]
+fn an_impostor_scene_reads_from_ron() {
+    use lodkit_cli::demo::scene::Shape;
+    let text = "(name: \"card\", camera: (eye: (0.0, 1.0, 6.0), target: (0.0, 0.0, 0.0), \
+        moving_eye: (1.0, 1.0, 5.0)), objects: [(fine: Tree(puffs: 5, rings: 6), \
+        coarse: Impostor(puffs: 5, rings: 6), fine_color: (0.2, 0.6, 0.2), \
+        coarse_color: (0.2, 0.5, 0.3), position: (0.0, 0.0, 0.0))])";
+    let scene = DemoScene::from_ron(text, "card.ron").unwrap();
+    assert_eq!(scene.objects[0].coarse, Shape::Impostor { puffs: 5, rings: 6 });
+    assert_eq!(scene.objects[0].coarse.mesh().triangles(), 2);
+    let bad = text.replace("Impostor(puffs: 5", "Impostor(puffs: 50");
+    let err = DemoScene::from_ron(&bad, "card.ron").unwrap_err().to_string();
+    assert!(err.contains("objects[0].coarse: puffs = 50"), "{err}");
+}
+
+#[test]
 fn a_scene_with_two_kinds_of_impostor_is_refused() {
     use lodkit_cli::demo::scene::Shape;
     let mut scene = DemoScene::field();
