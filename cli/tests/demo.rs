@@ -497,10 +497,15 @@ fn an_impostor_scene_reads_from_ron() {
         coarse: Impostor(puffs: 5, rings: 6), fine_color: (0.2, 0.6, 0.2), \
         coarse_color: (0.2, 0.5, 0.3), position: (0.0, 0.0, 0.0))])";
     let scene = DemoScene::from_ron(text, "card.ron").unwrap();
-    assert_eq!(scene.objects[0].coarse, Shape::Impostor { puffs: 5, rings: 6 });
+    assert_eq!(
+        scene.objects[0].coarse,
+        Shape::Impostor { puffs: 5, rings: 6 }
+    );
     assert_eq!(scene.objects[0].coarse.mesh().triangles(), 2);
     let bad = text.replace("Impostor(puffs: 5", "Impostor(puffs: 50");
-    let err = DemoScene::from_ron(&bad, "card.ron").unwrap_err().to_string();
+    let err = DemoScene::from_ron(&bad, "card.ron")
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("objects[0].coarse: puffs = 50"), "{err}");
 }
 
