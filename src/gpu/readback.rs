@@ -101,7 +101,16 @@ pub fn map_read(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuE
         Ok(())
     })?;
     gpu.wait_idle()?;
-    let mapped = status.lock().unwrap_or_else(PoisonError::into_inner).take();
+    // On a device shared between threads, another thread's poll may be the one running the
+    // callback, and still be running it when this poll returns: give it a moment.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(2);
+    let mapped = loop {
+        let taken = status.lock().unwrap_or_else(PoisonError::into_inner).take();
+        if taken.is_some() || std::time::Instant::now() > deadline {
+            break taken;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    };
     let bytes = match mapped {
         Some(Ok(())) => slice
             .get_mapped_range()
