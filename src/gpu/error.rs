@@ -212,6 +212,21 @@ pub(crate) fn buffer_size(
     Ok(())
 }
 
+/// `UnsupportedFormat` for `parameter` of `call`.
+fn unsupported_format(
+    call: &'static str,
+    parameter: &'static str,
+    format: wgpu::TextureFormat,
+    reason: String,
+) -> GpuError {
+    GpuError::UnsupportedFormat {
+        call,
+        parameter,
+        format,
+        reason,
+    }
+}
+
 /// Checks that `format` is a floating-point color format (what lodkit's passes read and write
 /// as `vec4<f32>`) that the device allows with `usages`.
 pub(crate) fn check_color_format(
@@ -221,12 +236,7 @@ pub(crate) fn check_color_format(
     format: wgpu::TextureFormat,
     usages: wgpu::TextureUsages,
 ) -> Result<(), GpuError> {
-    let unsupported = |reason: String| GpuError::UnsupportedFormat {
-        call,
-        parameter,
-        format,
-        reason,
-    };
+    let unsupported = |reason: String| unsupported_format(call, parameter, format, reason);
     if format.is_depth_stencil_format() {
         return Err(unsupported(
             "it is a depth/stencil format; a color format is needed".into(),
@@ -251,12 +261,7 @@ pub(crate) fn check_format_usages(
     format: wgpu::TextureFormat,
     usages: wgpu::TextureUsages,
 ) -> Result<(), GpuError> {
-    let unsupported = |reason: String| GpuError::UnsupportedFormat {
-        call,
-        parameter,
-        format,
-        reason,
-    };
+    let unsupported = |reason: String| unsupported_format(call, parameter, format, reason);
     let missing_features = format.required_features() - gpu.device.features();
     if !missing_features.is_empty() {
         return Err(unsupported(format!(

@@ -10,7 +10,7 @@ use super::resources::{
     DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, r32float_texture,
     texture_entry, uniform_buffer,
 };
-use super::scene::{GpuMesh, UNFILTERABLE, view_group};
+use super::scene::{GpuMesh, UNFILTERABLE, masked_view_group};
 use super::{GpuContext, GpuError};
 use crate::alpha_mask::AlphaMask;
 use crate::combine::DepthConvention;
@@ -211,9 +211,9 @@ impl LodBufferRenderer {
                 "lod draws",
             )?;
             let vis_view = vis_texture.create_view(&Default::default());
-            let mask = r32float_texture(gpu, 1, &AlphaMask::opaque().texels, "alpha mask")?;
-            let mask_view = mask.create_view(&Default::default());
-            let camera_group = view_group(gpu, &view_layout, &camera, &[&vis_view, &mask_view]);
+            let opaque = AlphaMask::opaque();
+            let camera_group =
+                masked_view_group(gpu, &view_layout, &camera, &[&vis_view], &opaque)?;
             let draw_group = draws.bind_group(gpu, &draw_layout)?;
             Ok(Self {
                 pipeline,
@@ -234,12 +234,9 @@ impl LodBufferRenderer {
     /// atlas, per renderer; a 1x1 opaque one until then). [`GpuError::Mismatch`] when its texels
     /// do not fill `size` x `size` or `size` is 0.
     pub fn set_alpha_mask(&mut self, gpu: &GpuContext, mask: &AlphaMask) -> Result<(), GpuError> {
-        let texture = r32float_texture(gpu, mask.size, &mask.texels, "alpha mask")?;
-        let view = texture.create_view(&Default::default());
-        let views = [&self.vis_view, &view];
-        self.camera_group = gpu.guarded("LodBufferRenderer::set_alpha_mask", || {
-            Ok(view_group(gpu, &self.camera_layout, &self.camera, &views))
-        })?;
+        let views = [&self.vis_view];
+        self.camera_group =
+            masked_view_group(gpu, &self.camera_layout, &self.camera, &views, mask)?;
         Ok(())
     }
 

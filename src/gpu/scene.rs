@@ -322,9 +322,8 @@ impl MeshRenderer {
             blend: true,
         };
         let camera = uniform_buffer(gpu, std::mem::size_of::<CameraUniform>(), "camera")?;
-        let mask = r32float_texture(gpu, 1, &AlphaMask::opaque().texels, "alpha mask")?;
-        let mask_view = mask.create_view(&Default::default());
-        let camera_group = view_group(gpu, &camera_layout, &camera, &[&mask_view]);
+        let camera_group =
+            masked_view_group(gpu, &camera_layout, &camera, &[], &AlphaMask::opaque())?;
         let draws = DrawUniforms::new(
             gpu,
             std::mem::size_of::<DrawUniform>(),
@@ -346,11 +345,7 @@ impl MeshRenderer {
     /// atlas, per renderer; a 1x1 opaque one until then). [`GpuError::Mismatch`] when its texels
     /// do not fill `size` x `size` or `size` is 0.
     pub fn set_alpha_mask(&mut self, gpu: &GpuContext, mask: &AlphaMask) -> Result<(), GpuError> {
-        let texture = r32float_texture(gpu, mask.size, &mask.texels, "alpha mask")?;
-        let view = texture.create_view(&Default::default());
-        self.camera_group = gpu.guarded("MeshRenderer::set_alpha_mask", || {
-            Ok(view_group(gpu, &self.camera_layout, &self.camera, &[&view]))
-        })?;
+        self.camera_group = masked_view_group(gpu, &self.camera_layout, &self.camera, &[], mask)?;
         Ok(())
     }
 
@@ -435,8 +430,27 @@ impl MeshRenderer {
 pub(crate) const UNFILTERABLE: wgpu::TextureSampleType =
     wgpu::TextureSampleType::Float { filterable: false };
 
+/// The per-view bind group of a mesh pass whose last texture is the alpha mask: `camera` at
+/// binding 0, `views` from binding 1, then `mask` uploaded as an `R32Float` texture
+/// ([`GpuError::Mismatch`] when its texels do not fill it).
+pub(crate) fn masked_view_group(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    camera: &wgpu::Buffer,
+    views: &[&wgpu::TextureView],
+    mask: &AlphaMask,
+) -> Result<wgpu::BindGroup, GpuError> {
+    let texture = r32float_texture(gpu, mask.size, &mask.texels, "alpha mask")?;
+    let mask_view = texture.create_view(&Default::default());
+    let mut all = views.to_vec();
+    all.push(&mask_view);
+    gpu.guarded("alpha mask bind group", || {
+        Ok(view_group(gpu, layout, camera, &all))
+    })
+}
+
 /// The per-view bind group of a mesh pass: `camera` at binding 0, then `views` from binding 1.
-pub(crate) fn view_group(
+fn view_group(
     gpu: &GpuContext,
     layout: &wgpu::BindGroupLayout,
     camera: &wgpu::Buffer,
