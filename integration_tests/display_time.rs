@@ -243,7 +243,8 @@ fn lod_buffer_flags_and_combine_shown_twins_match() {
 
 #[test]
 fn combine_at_twins_match_on_two_lod_images() {
-    use lodkit::combine::{LodImage, combine_images};
+    use glam::UVec2;
+    use lodkit::combine::{LodImage, combine_images, combine_ring_texel, combine_search_texel};
     let gpu = lodkit_test_gpu!();
     let (w, h) = (12u32, 10u32);
     let n = (w * h) as usize;
@@ -317,7 +318,10 @@ fn combine_at_twins_match_on_two_lod_images() {
         out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);
         let mo = textureLoad(probe_rgba4, px, 0).xy;
         let d = combine_at_moved(probe_rgba0, probe_urgba0, probe_rgba2, probe_rgba1, probe_urgba1, probe_rgba3, px, {matrix}, mo);
-        out_f(4u, d.x); out_f(5u, d.y); out_f(6u, d.z); out_f(7u, d.w);"
+        out_f(4u, d.x); out_f(5u, d.y); out_f(6u, d.z); out_f(7u, d.w);
+        let s = combine_search_texel(probe_urgba1, 5u, px, vec2(99u));
+        let r = combine_ring_texel(px, vec2({w}u, {h}u), (px.x * 7u + px.y) % 9u);
+        out_u(8u, s.x); out_u(9u, s.y); out_u(10u, r.x); out_u(11u, r.y);"
     );
     let glsl = format!(
         "uvec2 px = uvec2(inp_u(16u), inp_u(17u));
@@ -325,13 +329,16 @@ fn combine_at_twins_match_on_two_lod_images() {
         out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);
         vec2 mo = texelFetch(sampler2D(probe_rgba4, probe_sampler), ivec2(px), 0).xy;
         vec4 d = lodkit_combine_at_moved(sampler2D(probe_rgba0, probe_sampler), usampler2D(probe_urgba0, probe_sampler), sampler2D(probe_rgba2, probe_sampler), sampler2D(probe_rgba1, probe_sampler), usampler2D(probe_urgba1, probe_sampler), sampler2D(probe_rgba3, probe_sampler), px, {m}, mo);
-        out_f(4u, d.x); out_f(5u, d.y); out_f(6u, d.z); out_f(7u, d.w);",
+        out_f(4u, d.x); out_f(5u, d.y); out_f(6u, d.z); out_f(7u, d.w);
+        uvec2 s = lodkit_combine_search_texel(usampler2D(probe_urgba1, probe_sampler), 5u, px, uvec2(99u));
+        uvec2 r = lodkit_combine_ring_texel(px, uvec2({w}u, {h}u), (px.x * 7u + px.y) % 9u);
+        out_u(8u, s.x); out_u(9u, s.y); out_u(10u, r.x); out_u(11u, r.y);",
         m = matrix.replace("mat4x4<f32>", "mat4")
     );
     for (language, header, body) in [
         (
             SourceLanguage::Wgsl,
-            "#import lodkit::combine::{combine_at, combine_at_moved}",
+            "#import lodkit::combine::{combine_at, combine_at_moved, combine_search_texel, combine_ring_texel}",
             wgsl.as_str(),
         ),
         (GLSL, "#include \"lodkit/combine.glsl\"", glsl.as_str()),
@@ -340,7 +347,7 @@ fn combine_at_twins_match_on_two_lod_images() {
             header,
             body,
             inputs: 18,
-            outputs: 8,
+            outputs: 12,
             texture: None,
             rgba: &[
                 (w, h, &nc),
@@ -351,13 +358,24 @@ fn combine_at_twins_match_on_two_lod_images() {
             ],
             urgba: &[(w, h, &nw), (w, h, &ow)],
         };
-        let got = floats(&run_with(gpu, &probe, &inputs, language, &[]));
+        let got_words = run_with(gpu, &probe, &inputs, language, &[]);
+        for (p, g) in got_words.chunks(12).enumerate() {
+            let px = UVec2::new(p as u32 % w, p as u32 / w);
+            let search = combine_search_texel(&older, 5, px, UVec2::splat(99));
+            let ring = combine_ring_texel(px, UVec2::new(w, h), (px.x * 7 + px.y) % 9);
+            assert_eq!(
+                [g[8], g[9], g[10], g[11]],
+                [search.x, search.y, ring.x, ring.y],
+                "{language:?} combine_search_texel / combine_ring_texel at pixel {p}"
+            );
+        }
+        let got = floats(&got_words);
         for (half, want, what) in [
             (0, &want_still, "combine_at"),
             (1, &want, "combine_at_moved"),
         ] {
             let mut compared = 0;
-            for (p, (g, want)) in got.chunks(8).zip(want).enumerate() {
+            for (p, (g, want)) in got.chunks(12).zip(want).enumerate() {
                 if want.on_texel_edge {
                     continue;
                 }
@@ -385,6 +403,19 @@ fn combine_at_twins_match_on_two_lod_images() {
     assert!(
         differ * 4 > n,
         "the motion changed only {differ} of {n} pixels"
+    );
+    // The search where the moved read misses runs on some pixels and changes what they show.
+    let searched: Vec<usize> = (0..n).filter(|&p| want[p].searched).collect();
+    assert!(
+        searched.len() * 20 > n,
+        "only {} of {n} pixels searched the 3x3 block",
+        searched.len()
+    );
+    assert!(
+        searched
+            .iter()
+            .any(|&p| want[p].color != want_still[p].color),
+        "the search never changed a pixel"
     );
     // The images exercise every rule.
     use lodkit::combine::PixelSource::*;

@@ -3,6 +3,9 @@
 
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
+mod rects;
+pub use rects::{ScreenRect, merge_rects, screen_rect};
+
 /// One texel of a LOD buffer (mirror of WGSL `LodSample`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LodSample {
@@ -155,6 +158,9 @@ pub struct CombinedPixel {
     /// Whether the reprojected position lies within 1e-3 texel of a texel edge, where a GPU may
     /// round to the neighbouring texel.
     pub on_texel_edge: bool,
+    /// Whether the older texel came from [`combine_search_texel`] (the moved read and its side
+    /// texels held another object than the newer pixel's t-instance, and the pixel moved).
+    pub searched: bool,
 }
 
 /// The texel of a `size` texture at texture-space `uv` (clamped to the texture).
@@ -255,6 +261,55 @@ pub fn combine_match_texel(id: u32, ids: UVec4, nearest: UVec2, x: UVec2, y: UVe
     }
 }
 
+/// The `k`-th (0..8) texel of the 3x3 block around `center`: the center, then left, right, up,
+/// down, then the corners (top left, top right, bottom left, bottom right); clamped to a `size`
+/// texture.
+///
+/// ```
+/// # use lodkit::combine::combine_ring_texel;
+/// # use glam::UVec2;
+/// let (c, size) = (UVec2::new(3, 3), UVec2::new(8, 8));
+/// let ring: Vec<_> = (0..9).map(|k| combine_ring_texel(c, size, k)).collect();
+/// assert_eq!(ring[0], c);
+/// assert_eq!((ring[1], ring[4]), (UVec2::new(2, 3), UVec2::new(3, 4)));
+/// assert_eq!((ring[5], ring[8]), (UVec2::new(2, 2), UVec2::new(4, 4)));
+/// assert_eq!(combine_ring_texel(UVec2::ZERO, size, 5), UVec2::ZERO);
+/// ```
+pub fn combine_ring_texel(center: UVec2, size: UVec2, k: u32) -> UVec2 {
+    let offset = if k >= 5 {
+        glam::IVec2::new(((k - 5) % 2) as i32 * 2 - 1, ((k - 5) / 2) as i32 * 2 - 1)
+    } else if k >= 1 {
+        let sign = ((k - 1) % 2) as i32 * 2 - 1;
+        if k <= 2 {
+            glam::IVec2::new(sign, 0)
+        } else {
+            glam::IVec2::new(0, sign)
+        }
+    } else {
+        glam::IVec2::ZERO
+    };
+    let max = size.as_ivec2() - glam::IVec2::ONE;
+    (center.as_ivec2() + offset)
+        .clamp(glam::IVec2::ZERO, max.max(glam::IVec2::ZERO))
+        .as_uvec2()
+}
+
+/// The first texel of the 3x3 block around `center` ([`combine_ring_texel`] order) where
+/// `older` holds instance `id`; `fallback` if none does (the Rust twin of
+/// `combine_search_texel`, which reads the older id texture). Where the LODs of an animated
+/// t-instance move differently, the combine searches the older LOD there, around where the
+/// camera alone puts the pixel.
+pub fn combine_search_texel(older: &LodImage, id: u32, center: UVec2, fallback: UVec2) -> UVec2 {
+    let size = UVec2::new(older.width, older.height);
+    (0..9)
+        .map(|k| combine_ring_texel(center, size, k))
+        .find(|t| {
+            let i = (t.y * older.width + t.x) as usize;
+            older.ids.get(i) == Some(&id)
+        })
+        .unwrap_or(fallback)
+}
+
 /// The object motion of the surface at texture-space `uv` with clip depth `depth` from an
 /// engine's motion vector (uv now minus uv in the previous frame, camera motion included): where
 /// the surface was minus where the camera's reprojection puts it.
@@ -326,8 +381,9 @@ pub fn combine_at(
 }
 
 /// [`combine_at`] for a pixel whose surface moved by itself: the older buffer is read `motion`
-/// (texture-space uv) away from where the camera's reprojection puts it (the Rust twin of
-/// `combine_at_moved`).
+/// (texture-space uv) away from where the camera's reprojection puts it, and where that read and
+/// its side texels miss the newer pixel's t-instance, [`combine_search_texel`] around where the
+/// camera alone puts it (the Rust twin of `combine_at_moved`).
 pub fn combine_at_moved(
     newer: &LodImage,
     older: &LodImage,
@@ -375,6 +431,7 @@ fn combine_pixel(
             color: newer.colors[p],
             source: PixelSource::OutsideOlder,
             on_texel_edge: false,
+            searched: false,
         };
     }
     let first = combine_texel(old.truncate() + motion, size);
@@ -392,7 +449,12 @@ fn combine_pixel(
         id_at(y),
         id_at(UVec2::new(x.x, y.y)),
     );
-    let texel = combine_match_texel(newer.ids[p], ids, nearest, x, y);
+    let id = newer.ids[p];
+    let mut texel = combine_match_texel(id, ids, nearest, x, y);
+    let searched = id != 0 && id_at(texel) != id && motion != Vec2::ZERO;
+    if searched {
+        texel = combine_search_texel(older, id, combine_texel(old.truncate(), size), texel);
+    }
     let o = index(texel);
     let color = combine_texels(
         newer.colors[p],
@@ -419,7 +481,8 @@ fn combine_pixel(
     };
     let on_texel_edge = near_edge(old.truncate() + motion)
         || near_edge(refined.truncate() + motion)
-        || near_center(at);
+        || near_center(at)
+        || (searched && near_edge(old.truncate()));
     let (n, o) = (newer.sample(p), older.sample(o));
     let (n_shown, o_shown) = (
         newer.shown(p, LOD_BUFFER_SHOWN_NOW),
@@ -444,6 +507,7 @@ fn combine_pixel(
         color,
         source,
         on_texel_edge,
+        searched,
     }
 }
 
@@ -467,135 +531,4 @@ pub fn combine_images(
             combine_pixel(newer, older, pixel, new_to_old, motion, convention)
         })
         .collect()
-}
-
-/// A rectangle of pixels (top-left origin), where the combine pass has work to do.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ScreenRect {
-    /// Left column.
-    pub x: u32,
-    /// Top row.
-    pub y: u32,
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-}
-
-impl ScreenRect {
-    /// Pixels covered.
-    pub fn area(&self) -> u64 {
-        u64::from(self.width) * u64::from(self.height)
-    }
-
-    /// The smallest rectangle holding both.
-    pub fn union(&self, other: &ScreenRect) -> ScreenRect {
-        let x = self.x.min(other.x);
-        let y = self.y.min(other.y);
-        let right = (self.x + self.width).max(other.x + other.width);
-        let bottom = (self.y + self.height).max(other.y + other.height);
-        ScreenRect {
-            x,
-            y,
-            width: right - x,
-            height: bottom - y,
-        }
-    }
-
-    /// Whether the two share a pixel.
-    pub fn overlaps(&self, other: &ScreenRect) -> bool {
-        self.x < other.x + other.width
-            && other.x < self.x + self.width
-            && self.y < other.y + other.height
-            && other.y < self.y + self.height
-    }
-}
-
-/// The screen rectangle of a t-instance for the combine pass: the box `bounds` (object-space
-/// min and max, the union of both LODs' boxes) under `model` and each of `view_projs` (this
-/// frame's and the previous frame's view-projection: where the newer and the older buffer hold
-/// it), in a `size` target, dilated by `dilate` pixels and clipped to the target. `None` when it
-/// is off screen; the whole target when a corner is behind a camera.
-///
-/// ```
-/// # use lodkit::combine::{ScreenRect, screen_rect};
-/// # use glam::{Mat4, Vec3};
-/// let vp = glam::camera::rh::proj::directx::perspective(1.0, 1.0, 0.1, 10.0)
-///     * glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y);
-/// let r = screen_rect((Vec3::splat(-0.5), Vec3::splat(0.5)), Mat4::IDENTITY, &[vp], (100, 100), 1)
-///     .unwrap();
-/// assert!(r.x > 30 && r.x + r.width < 70 && r.width == r.height);
-/// let away = Mat4::from_translation(Vec3::new(100.0, 0.0, 0.0));
-/// assert_eq!(screen_rect((Vec3::splat(-0.5), Vec3::splat(0.5)), away, &[vp], (100, 100), 1), None);
-/// ```
-pub fn screen_rect(
-    bounds: (glam::Vec3, glam::Vec3),
-    model: glam::Mat4,
-    view_projs: &[glam::Mat4],
-    size: (u32, u32),
-    dilate: u32,
-) -> Option<ScreenRect> {
-    use glam::{Vec2, Vec3};
-    let (lo, hi) = bounds;
-    let (w, h) = (size.0.max(1), size.1.max(1));
-    let whole = ScreenRect {
-        x: 0,
-        y: 0,
-        width: w,
-        height: h,
-    };
-    let (mut min, mut max) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-    for vp in view_projs {
-        let m = *vp * model;
-        for i in 0..8 {
-            let corner = Vec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            );
-            let clip = m * corner.extend(1.0);
-            if !clip.is_finite() || clip.w <= 0.0 {
-                return Some(whole);
-            }
-            let ndc = clip.truncate().truncate() / clip.w;
-            let pixel = Vec2::new(
-                (ndc.x * 0.5 + 0.5) * w as f32,
-                (0.5 - ndc.y * 0.5) * h as f32,
-            );
-            min = min.min(pixel);
-            max = max.max(pixel);
-        }
-    }
-    let d = dilate as f32;
-    let (x0, y0) = ((min.x - d).floor().max(0.0), (min.y - d).floor().max(0.0));
-    let (x1, y1) = (
-        (max.x + d).ceil().min(w as f32),
-        (max.y + d).ceil().min(h as f32),
-    );
-    (x0 < x1 && y0 < y1 && !view_projs.is_empty()).then_some(ScreenRect {
-        x: x0 as u32,
-        y: y0 as u32,
-        width: (x1 - x0) as u32,
-        height: (y1 - y0) as u32,
-    })
-}
-
-/// Merges overlapping rectangles into their unions until none overlap, so no pixel is
-/// combined twice.
-///
-/// ```
-/// # use lodkit::combine::{ScreenRect, merge_rects};
-/// let r = |x, y| ScreenRect { x, y, width: 10, height: 10 };
-/// assert_eq!(merge_rects(&[r(0, 0), r(5, 5), r(40, 40)]).len(), 2);
-/// ```
-pub fn merge_rects(rects: &[ScreenRect]) -> Vec<ScreenRect> {
-    let mut out: Vec<ScreenRect> = Vec::new();
-    for r in rects.iter().filter(|r| r.area() > 0) {
-        let mut merged = *r;
-        while let Some(i) = out.iter().position(|o| o.overlaps(&merged)) {
-            merged = merged.union(&out.swap_remove(i));
-        }
-        out.push(merged);
-    }
-    out
 }

@@ -14,6 +14,11 @@
 //   lodkit_combine_side_texel(uv, size, axis) -> uvec2   the neighbour on uv's side on an axis
 //   lodkit_combine_match_texel(id, ids, nearest, x, y) -> uvec2   the older texel of the newer
 //       pixel's t-instance among the nearest, its side texels and the diagonal
+//   lodkit_combine_ring_texel(center, size, k) -> uvec2   the k-th (0..8) texel of the 3x3 block
+//       around center: the center, left, right, up, down, then the corners (clamped)
+//   lodkit_combine_search_texel(older_id, id, center, fallback) -> uvec2   the first texel of
+//       the 3x3 block around center holding instance id, else fallback (a macro: older_id a
+//       usampler2D)
 //   lodkit_combine_object_motion(uv, depth, new_to_old, motion_vector) -> vec2   object motion
 //       from an engine's motion vector (uv now minus uv before, camera motion included)
 //   lodkit_combine_texels(newer_color, newer_word, old, older_color, older_word, older_depth)
@@ -23,7 +28,9 @@
 //       usampler2D, or sampler2D(texture, sampler) / usampler2D(texture, sampler) in Vulkan
 //       GLSL, the depths as sampler2D of the depth attachments; pixel a uvec2); nothing moves
 //   lodkit_combine_at_moved(newer_color, ..., older_depth, pixel, new_to_old, motion) -> vec4
-//       the same for a pixel whose surface moved by itself (motion: its object motion, a vec2)
+//       the same for a pixel whose surface moved by itself (motion: its object motion, a vec2);
+//       where the moved read misses the t-instance, lodkit_combine_search_texel where the camera
+//       alone puts the pixel
 //   lodkit_depth_closer(a, b) -> bool
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z).
@@ -126,6 +133,36 @@ uvec2 lodkit_combine_match_texel(uint id, uvec4 ids, uvec2 nearest, uvec2 x, uve
     return ids.w == id ? uvec2(x.x, y.y) : nearest;
 }
 
+/// The k-th (0..8) texel of the 3x3 block around `center`: the center, then left, right, up,
+/// down, then the corners (top left, top right, bottom left, bottom right); clamped to `size`.
+uvec2 lodkit_combine_ring_texel(uvec2 center, uvec2 size, uint k) {
+    ivec2 offset = ivec2(0);
+    if (k >= 5u) {
+        offset = ivec2(int((k - 5u) % 2u) * 2 - 1, int((k - 5u) / 2u) * 2 - 1);
+    } else if (k >= 1u) {
+        int s = int((k - 1u) % 2u) * 2 - 1;
+        offset = k <= 2u ? ivec2(s, 0) : ivec2(0, s);
+    }
+    return uvec2(clamp(ivec2(center) + offset, ivec2(0), ivec2(size) - ivec2(1)));
+}
+
+/// The k-th texel of the 3x3 block around `c` in id texture `oid`.
+#define LODKIT_COMBINE_RING_(oid, c, k) lodkit_combine_ring_texel((c), uvec2(textureSize((oid), 0)), (k))
+/// Whether the k-th texel around `c` holds instance `id`.
+#define LODKIT_COMBINE_HIT_(oid, id, c, k) (LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_RING_(oid, c, k)) == (id))
+/// The first texel of the 3x3 block around `c` (lodkit_combine_ring_texel order) whose id word in
+/// `oid` (usampler2D) holds instance `id`; `fb` if none does.
+#define lodkit_combine_search_texel(oid, id, c, fb) \
+    (LODKIT_COMBINE_HIT_(oid, id, c, 0u) ? LODKIT_COMBINE_RING_(oid, c, 0u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 1u) ? LODKIT_COMBINE_RING_(oid, c, 1u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 2u) ? LODKIT_COMBINE_RING_(oid, c, 2u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 3u) ? LODKIT_COMBINE_RING_(oid, c, 3u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 4u) ? LODKIT_COMBINE_RING_(oid, c, 4u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 5u) ? LODKIT_COMBINE_RING_(oid, c, 5u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 6u) ? LODKIT_COMBINE_RING_(oid, c, 6u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 7u) ? LODKIT_COMBINE_RING_(oid, c, 7u) \
+    : LODKIT_COMBINE_HIT_(oid, id, c, 8u) ? LODKIT_COMBINE_RING_(oid, c, 8u) : (fb))
+
 /// The object motion at uv with clip depth `depth` from an engine's motion vector.
 vec2 lodkit_combine_object_motion(vec2 uv, float depth, mat4 new_to_old, vec2 motion_vector) {
     return uv - motion_vector - lodkit_reproject(uv, depth, new_to_old).xy;
@@ -168,14 +205,23 @@ vec4 lodkit_combine_texels(vec4 newer_color, uint newer_word, vec3 old, vec4 old
     lodkit_combine_side_texel(LODKIT_COMBINE_AT_(nc, nd, od, px, m, mo), LODKIT_COMBINE_SIZE_(nc), (axis))
 /// The older texel read: the one holding the read position, or a side or diagonal texel of the
 /// newer pixel's t-instance (lodkit_combine_match_texel).
-#define LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo) \
-    ivec2(lodkit_combine_match_texel(LODKIT_COMBINE_ID_(nid, px), \
+#define LODKIT_COMBINE_MATCHED_(nc, nid, nd, oid, od, px, m, mo) \
+    (lodkit_combine_match_texel(LODKIT_COMBINE_ID_(nid, px), \
         uvec4(LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 2u)), \
             LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 0u)), \
             LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 1u)), \
             LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 3u))), \
         LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 2u), LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 0u), \
         LODKIT_COMBINE_AROUND_(nc, nd, od, px, m, mo, 1u)))
+/// The older texel read: the matched one, or where it misses the newer pixel's t-instance and
+/// the pixel moved, lodkit_combine_search_texel around where the camera alone puts it.
+#define LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo) \
+    ivec2((LODKIT_COMBINE_ID_(oid, LODKIT_COMBINE_MATCHED_(nc, nid, nd, oid, od, px, m, mo)) != LODKIT_COMBINE_ID_(nid, px) \
+        && LODKIT_COMBINE_ID_(nid, px) != 0u && any(notEqual((mo), vec2(0.0)))) \
+        ? lodkit_combine_search_texel((oid), LODKIT_COMBINE_ID_(nid, px), \
+            lodkit_combine_texel(LODKIT_COMBINE_OLD_(nc, nd, px, m).xy, LODKIT_COMBINE_SIZE_(nc)), \
+            LODKIT_COMBINE_MATCHED_(nc, nid, nd, oid, od, px, m, mo)) \
+        : LODKIT_COMBINE_MATCHED_(nc, nid, nd, oid, od, px, m, mo))
 
 /// The whole per-pixel combine at `px` (uvec2) where nothing moves by itself.
 #define lodkit_combine_at(nc, nid, nd, oc, oid, od, px, m) \

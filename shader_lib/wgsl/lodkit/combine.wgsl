@@ -27,6 +27,13 @@
 //       sample of instance id: the nearest, or where it holds another object, the side or
 //       diagonal texel holding the same t-instance (ids: at nearest, x, y, (x.x, y.y)), so a
 //       silhouette that moved by a fraction of a texel shows no background
+//   combine_ring_texel(center, size, k) -> vec2<u32>   the k-th (0..8) texel of the 3x3 block
+//       around center: the center, left, right, up, down, then the corners (clamped)
+//   combine_search_texel(older_id, id, center, fallback) -> vec2<u32>   the first texel of the
+//       3x3 block around center (combine_ring_texel order) whose id word holds instance id;
+//       fallback if none does. Where a t-instance's LODs move differently (vertex animation that
+//       depends on the surface point: a plant in the wind), the older LOD is searched where the
+//       camera alone puts the pixel
 //   combine_texels(newer_color, newer_word, old, older_color, older_word, older_depth)
 //       -> vec4<f32>   the combined color from the fetched texels (old = reproject(uv, newer
 //       depth); words: lodkit::lod_buffer id words)
@@ -37,7 +44,9 @@
 //       (unfilterable float; a depth view of Depth32Float). Nothing moves by itself.
 //   combine_at_moved(newer_color, ..., older_depth, pixel, new_to_old, motion) -> vec4<f32>
 //       combine_at for a pixel whose surface moved by itself: `motion` is its object motion
-//       (the LOD pass's location 2, or combine_object_motion of the engine's motion vectors)
+//       (the LOD pass's location 2, or combine_object_motion of the engine's motion vectors);
+//       where neither the moved read nor its side texels hold the t-instance, the 3x3 block
+//       where the camera alone puts the pixel is searched (combine_search_texel)
 //   combine_object_motion(uv, depth, new_to_old, motion_vector) -> vec2<f32>   the object
 //       motion of a pixel from an engine's motion vector (uv now minus uv in the previous frame,
 //       camera motion included, as TAA uses): what the camera's reprojection does not explain
@@ -150,6 +159,33 @@ fn combine_match_texel(id: u32, ids: vec4<u32>, nearest: vec2<u32>, x: vec2<u32>
     return select(nearest, vec2<u32>(x.x, y.y), ids.w == id);
 }
 
+/// The k-th (0..8) texel of the 3x3 block around `center`: the center, then left, right, up,
+/// down, then the corners (top left, top right, bottom left, bottom right); clamped to the
+/// texture of size `size`.
+fn combine_ring_texel(center: vec2<u32>, size: vec2<u32>, k: u32) -> vec2<u32> {
+    var offset = vec2<i32>(0);
+    if (k >= 5u) {
+        offset = vec2<i32>(i32((k - 5u) % 2u) * 2 - 1, i32((k - 5u) / 2u) * 2 - 1);
+    } else if (k >= 1u) {
+        let sign = i32((k - 1u) % 2u) * 2 - 1;
+        offset = select(vec2<i32>(0, sign), vec2<i32>(sign, 0), k <= 2u);
+    }
+    return vec2<u32>(clamp(vec2<i32>(center) + offset, vec2<i32>(0), vec2<i32>(size) - vec2<i32>(1)));
+}
+
+/// The first texel of the 3x3 block around `center` (combine_ring_texel order) whose id word in
+/// `older_id` holds instance `id`; `fallback` if none does. Nine id loads at most.
+fn combine_search_texel(older_id: texture_2d<u32>, id: u32, center: vec2<u32>, fallback: vec2<u32>) -> vec2<u32> {
+    let size = textureDimensions(older_id, 0);
+    for (var k = 0u; k < 9u; k++) {
+        let t = combine_ring_texel(center, size, k);
+        if (lod_buffer_id(textureLoad(older_id, t, 0).x) == id) {
+            return t;
+        }
+    }
+    return fallback;
+}
+
 /// The object motion of the surface at texture-space `uv` with clip depth `depth` from an
 /// engine's motion vector `motion_vector` (uv now minus uv in the previous frame, camera motion
 /// included): where the surface was minus where the camera's reprojection puts it.
@@ -195,7 +231,10 @@ fn combine_at(
 /// is read where the surface was, `motion` (its object motion in texture-space uv) away from
 /// where the camera's reprojection puts it. With the motion of the LOD pass's location 2 a
 /// swaying or moving t-instance keeps its older LOD under its newer one: no background shows
-/// through where both cover the pixel.
+/// through where both cover the pixel. Where the moved read and its side texels hold another
+/// object and the pixel moved, the older LOD moved otherwise (its surface at this pixel is
+/// another point of the animated object): up to nine more id loads search the 3x3 block where
+/// the camera alone puts the pixel (combine_search_texel).
 fn combine_at_moved(
     newer_color: texture_2d<f32>,
     newer_id: texture_2d<u32>,
@@ -232,6 +271,12 @@ fn combine_at_moved(
         );
         older = combine_match_texel(id, ids, older, x, y);
         older_word = textureLoad(older_id, older, 0).x;
+        if (lod_buffer_id(older_word) != id && any(motion != vec2<f32>(0.0))) {
+            // The older LOD moved otherwise than the newer one (their surfaces at this pixel are
+            // different points of an animated object): look where the camera alone puts it.
+            older = combine_search_texel(older_id, id, combine_texel(old.xy, size), older);
+            older_word = textureLoad(older_id, older, 0).x;
+        }
     }
     return combine_texels(
         color,
