@@ -17,6 +17,7 @@ mod host_errors;
 mod object_motion;
 mod portability;
 mod robustness;
+mod screen_space;
 mod selection;
 mod single_frame;
 mod webgpu_page;

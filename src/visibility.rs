@@ -1,7 +1,8 @@
-//! Object-space visibility textures for frame-sequential LOD (Scherzer & Wimmer 2008, sec. 3.3):
-//! Rust twins of `lodkit::visibility` and the generators of the textures themselves.
+//! Visibility textures for frame-sequential LOD (Scherzer & Wimmer 2008, sec. 3.3), looked up in
+//! object space or anchored to the screen: Rust twins of `lodkit::visibility` and the generators
+//! of the textures themselves.
 
-use glam::{UVec2, Vec2, Vec3};
+use glam::{IVec2, UVec2, Vec2, Vec3, Vec4};
 
 /// Lookup coordinate of an object-space position: (p.x + p.z, p.y + p.z).
 ///
@@ -167,4 +168,82 @@ pub fn visibility_flags(
     tau_next: f32,
 ) -> u32 {
     visibility_flags_of(vis_tex.lookup(object_pos), tau_now, tau_next)
+}
+
+/// Where a t-instance's visibility pattern is anchored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum VisibilitySpace {
+    /// Tiled over the screen, one texel per pixel, and looked up at the pixel where the fragment
+    /// is displayed ([`visibility_flags_screen`]). The pattern holds still while objects and the
+    /// camera move, as a dither does: under motion a pixel changes only where the threshold
+    /// passes its texel. The default.
+    #[default]
+    Screen,
+    /// At the fragment's object-space position before animation ([`visibility_flags`]), the
+    /// paper's choice: the pattern moves with the object like a texture, and under motion every
+    /// pixel of a blend samples another texel each frame.
+    Object,
+}
+
+/// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
+/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign).
+///
+/// ```
+/// # use lodkit::visibility::visibility_screen_texel;
+/// # use glam::{UVec2, Vec2};
+/// assert_eq!(visibility_screen_texel(UVec2::splat(64), Vec2::new(70.5, 3.5)), UVec2::new(6, 3));
+/// assert_eq!(visibility_screen_texel(UVec2::splat(64), Vec2::new(-0.5, 3.5)), UVec2::new(63, 3));
+/// ```
+pub fn visibility_screen_texel(size: UVec2, frag_coord: Vec2) -> UVec2 {
+    let s = size.max(UVec2::ONE).as_ivec2();
+    let p = IVec2::new(frag_coord.x.floor() as i32, frag_coord.y.floor() as i32);
+    ((p % s + s) % s).as_uvec2()
+}
+
+/// Where a fragment at framebuffer position `frag_coord` is expected in the next frame: as far
+/// again as it moved since the previous one. `then_clip` is its surface point in the previous
+/// frame seen by the previous camera (clip space), `viewport` the framebuffer size in pixels;
+/// `frag_coord` itself when `then_clip` lies behind that camera.
+///
+/// ```
+/// # use lodkit::visibility::visibility_next_coord;
+/// # use glam::{Vec2, Vec4};
+/// // Clip (0, 0) is the center (50, 50) of a 100 x 100 target; now at (52.5, 50.5).
+/// let next = visibility_next_coord(Vec2::new(52.5, 50.5), Vec4::new(0.0, 0.0, 0.5, 1.0), Vec2::splat(100.0));
+/// assert_eq!(next, Vec2::new(55.0, 51.0));
+/// ```
+pub fn visibility_next_coord(frag_coord: Vec2, then_clip: Vec4, viewport: Vec2) -> Vec2 {
+    if then_clip.w <= 0.0 {
+        return frag_coord;
+    }
+    let ndc = Vec2::new(then_clip.x, then_clip.y) / then_clip.w;
+    let then_px = (ndc * Vec2::new(0.5, -0.5) + 0.5) * viewport;
+    2.0 * frag_coord - then_px
+}
+
+impl VisibilityTexture {
+    /// The texel value under framebuffer position `frag_coord` with the texture tiled over the
+    /// screen, as the shader reads it. An empty or short texture reads as 1.
+    pub fn lookup_screen(&self, frag_coord: Vec2) -> f32 {
+        let t = visibility_screen_texel(UVec2::splat(self.size), frag_coord);
+        let index = u64::from(t.y) * u64::from(self.size) + u64::from(t.x);
+        self.texels.get(index as usize).copied().unwrap_or(1.0)
+    }
+}
+
+/// Display-time flags with the pattern anchored to the screen (the Rust twin of
+/// `visibility_flags_screen`): bit 0 when the texel under `frag_coord` is shown at `tau_now`,
+/// bit 1 when the texel under `next_coord` ([`visibility_next_coord`]) is shown at `tau_next`.
+pub fn visibility_flags_screen(
+    vis_tex: &VisibilityTexture,
+    frag_coord: Vec2,
+    next_coord: Vec2,
+    tau_now: f32,
+    tau_next: f32,
+) -> u32 {
+    u32::from(visibility_shown(vis_tex.lookup_screen(frag_coord), tau_now))
+        | (u32::from(visibility_shown(
+            vis_tex.lookup_screen(next_coord),
+            tau_next,
+        )) << 1)
 }

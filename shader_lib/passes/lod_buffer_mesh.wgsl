@@ -3,9 +3,12 @@
 //
 // The vertex stage sways the mesh like a plant in the wind when `draw.sway.x` is not 0 (an
 // engine's own vertex animation goes there) and passes the object-space position on from
-// before the animation, so the visibility pattern sticks to the object. The fragment stage keeps every fragment of a t-instance and
-// flags, in the id word, whether it is shown at tau (this frame) and at tau_next (the next frame,
-// when this buffer is the older one) (lodkit::visibility::visibility_flags): the combine pass
+// before the animation. The fragment stage keeps every fragment of a t-instance and flags, in the
+// id word, whether it is shown at tau (this frame) and at tau_next (the next frame, when this
+// buffer is the older one). With `camera.viewport.z` = 1 the visibility pattern is anchored to
+// the screen (lodkit::visibility::visibility_flags_screen: the texel under the pixel displayed
+// now, and under the pixel the fragment is expected at next frame); with 0 it sticks to the
+// object, looked up at the object-space position (the paper; visibility_flags). The combine pass
 // then shows each LOD with its visibility at the frame displayed, so its share changes every
 // frame, and a sample hidden in its buffer never leaves a hole where the other buffer has none.
 // n-instances use id 0 (always shown). Location 2 gets the fragment's object motion
@@ -25,7 +28,7 @@
 //   2 `alpha_mask: texture_2d<f32>` (r32float, lodkit::alpha_mask);
 //   group 1: 0 `draw: LodDraw` (uniform, dynamic offset).
 // Shader defs: none.
-#import lodkit::visibility::visibility_flags
+#import lodkit::visibility::{visibility_flags, visibility_flags_screen, visibility_next_coord}
 #import lodkit::alpha_mask::alpha_mask_keep
 #import lodkit::lod_buffer::{LodBufferMotionOutput, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT, lod_buffer_output_motion, lod_buffer_motion}
 
@@ -36,6 +39,9 @@ struct LodCamera {
     prev_view_proj: mat4x4<f32>,
     /// World-space direction toward the light (w unused).
     light_dir: vec4<f32>,
+    /// x, y: the framebuffer size in pixels; z: 1 = the visibility pattern anchored to the
+    /// screen, 0 = in object space; w unused.
+    viewport: vec4<f32>,
 }
 
 /// Per-draw data.
@@ -100,7 +106,10 @@ fn fs_main(in: VertexOut) -> LodBufferMotionOutput {
         discard;
     }
     var flags = LOD_BUFFER_SHOWN_NOW | LOD_BUFFER_SHOWN_NEXT;
-    if (draw.instance_id != 0u) {
+    if (draw.instance_id != 0u && camera.viewport.z > 0.5) {
+        let next = visibility_next_coord(in.position.xy, in.then_clip, camera.viewport.xy);
+        flags = visibility_flags_screen(vis_tex, in.position.xy, next, draw.tau, draw.tau_next);
+    } else if (draw.instance_id != 0u) {
         flags = visibility_flags(vis_tex, in.object_pos * draw.vis_scale, draw.tau, draw.tau_next);
     }
     let lambert = max(dot(normalize(in.normal), normalize(camera.light_dir.xyz)), 0.0);

@@ -16,7 +16,7 @@ use crate::alpha_mask::AlphaMask;
 use crate::combine::DepthConvention;
 use crate::frame_sequential::FrameDraw;
 use crate::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
-use crate::visibility::VisibilityTexture;
+use crate::visibility::{VisibilitySpace, VisibilityTexture};
 
 /// Rust mirror of `LodCamera` in `passes/lod_buffer_mesh.wgsl`.
 #[repr(C)]
@@ -28,6 +28,9 @@ pub struct LodCameraUniform {
     pub prev_view_proj: [[f32; 4]; 4],
     /// World-space direction toward the light.
     pub light_dir: [f32; 4],
+    /// Framebuffer width and height in pixels; 1 for the pattern anchored to the screen, 0 for
+    /// object space; padding.
+    pub viewport: [f32; 4],
 }
 
 /// Rust mirror of `LodDraw` in `passes/lod_buffer_mesh.wgsl`.
@@ -140,6 +143,7 @@ pub struct LodBufferRenderer {
     draws: DrawUniforms,
     draw_group: wgpu::BindGroup,
     vis_scale: f32,
+    space: VisibilitySpace,
     color_format: wgpu::TextureFormat,
     depth: DepthConvention,
 }
@@ -224,6 +228,7 @@ impl LodBufferRenderer {
                 draws,
                 draw_group,
                 vis_scale,
+                space: VisibilitySpace::default(),
                 color_format,
                 depth,
             })
@@ -238,6 +243,18 @@ impl LodBufferRenderer {
         self.camera_group =
             masked_view_group(gpu, &self.camera_layout, &self.camera, &views, mask)?;
         Ok(())
+    }
+
+    /// Where the visibility pattern is anchored ([`VisibilitySpace::Screen`] unless set).
+    pub fn visibility_space(&self) -> VisibilitySpace {
+        self.space
+    }
+
+    /// Anchors the visibility pattern to the screen (one texel per pixel, looked up where each
+    /// fragment is displayed; the default) or to the object (at `vis_scale` repeats per
+    /// object-space unit, the paper's choice).
+    pub fn set_visibility_space(&mut self, space: VisibilitySpace) {
+        self.space = space;
     }
 
     /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers` seen by
@@ -267,6 +284,12 @@ impl LodBufferRenderer {
                 view_proj: view.view_proj.to_cols_array_2d(),
                 prev_view_proj: view.prev_view_proj.to_cols_array_2d(),
                 light_dir: Vec3::new(0.4, 0.8, 0.6).extend(0.0).to_array(),
+                viewport: [
+                    buffers.size().0 as f32,
+                    buffers.size().1 as f32,
+                    f32::from(u8::from(self.space == VisibilitySpace::Screen)),
+                    0.0,
+                ],
             };
             gpu.queue
                 .write_buffer(&self.camera, 0, bytemuck::bytes_of(&camera));

@@ -18,40 +18,49 @@ use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::screen_door::DitherPattern;
 use lodkit::unpopping::LodRenderState;
-use lodkit::visibility::{VisibilityPattern, visibility_texture};
+use lodkit::visibility::{VisibilityPattern, VisibilitySpace, visibility_texture};
+
+const SCREEN: VisibilitySpace = VisibilitySpace::Screen;
+const OBJECT: VisibilitySpace = VisibilitySpace::Object;
 
 /// A transition technique of the harness.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Technique {
     /// A single-frame technique.
     Single(SingleFrameTechnique),
-    /// Frame-sequential interpolation with a visibility pattern and schedule.
-    FrameSequential(VisibilityPattern, Schedule),
+    /// Frame-sequential interpolation with a visibility pattern, schedule and pattern space.
+    FrameSequential(VisibilityPattern, Schedule, VisibilitySpace),
 }
 
 impl Technique {
     /// Every technique the harness compares.
-    pub const ALL: [Technique; 8] = [
+    pub const ALL: [Technique; 9] = [
         Technique::Single(SingleFrameTechnique::HardSwitch),
         Technique::Single(SingleFrameTechnique::CrossFade),
         Technique::Single(SingleFrameTechnique::Dither(DitherPattern::Bayer4x4)),
         Technique::Single(SingleFrameTechnique::Dither(DitherPattern::BlueNoise16x16)),
         Technique::Single(SingleFrameTechnique::Unpopping),
-        Technique::FrameSequential(VisibilityPattern::WhiteNoise, Schedule::Paper),
-        Technique::FrameSequential(VisibilityPattern::BlueNoise, Schedule::Paper),
-        Technique::FrameSequential(VisibilityPattern::BlueNoise, Schedule::Complementary),
+        Technique::FrameSequential(VisibilityPattern::WhiteNoise, Schedule::Paper, SCREEN),
+        Technique::FrameSequential(VisibilityPattern::BlueNoise, Schedule::Paper, SCREEN),
+        Technique::FrameSequential(
+            VisibilityPattern::BlueNoise,
+            Schedule::Complementary,
+            SCREEN,
+        ),
+        Technique::FrameSequential(VisibilityPattern::BlueNoise, Schedule::Paper, OBJECT),
     ];
 
     /// Short name for tables and file names.
     pub fn name(self) -> &'static str {
         match self {
             Technique::Single(t) => t.name(),
-            Technique::FrameSequential(p, Schedule::Paper) => match p {
+            Technique::FrameSequential(_, _, OBJECT) => "frame-seq-object-space",
+            Technique::FrameSequential(p, Schedule::Paper, _) => match p {
                 VisibilityPattern::WhiteNoise => "frame-seq-white-noise",
                 VisibilityPattern::BlueNoise => "frame-seq-blue-noise",
                 VisibilityPattern::Radial => "frame-seq-radial",
             },
-            Technique::FrameSequential(p, Schedule::Complementary) => match p {
+            Technique::FrameSequential(p, Schedule::Complementary, _) => match p {
                 VisibilityPattern::WhiteNoise => "frame-seq-compl-white-noise",
                 VisibilityPattern::BlueNoise => "frame-seq-complementary",
                 VisibilityPattern::Radial => "frame-seq-compl-radial",
@@ -110,7 +119,8 @@ pub struct SceneRenderer<'a> {
     alpha_rects: Vec<[Vec4; 2]>,
     single: [MeshRenderer; 2],
     target: RenderTarget,
-    lod_buffer: [LodBufferRenderer; 2],
+    /// White noise on the screen, blue noise on the screen, blue noise on the object.
+    lod_buffer: [LodBufferRenderer; 3],
     buffers: LodBuffers,
     combine: CombinePass,
     combined: wgpu::Texture,
@@ -175,7 +185,9 @@ impl<'a> SceneRenderer<'a> {
         let mut lod_buffer = [
             LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::WhiteNoise), VIS_SCALE)?,
             LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), VIS_SCALE)?,
+            LodBufferRenderer::new(gpu, FORMAT, &vis(VisibilityPattern::BlueNoise), VIS_SCALE)?,
         ];
+        lod_buffer[2].set_visibility_space(OBJECT);
         // A scene has at most one kind of impostor (validated): its mask is every renderer's.
         let impostor = scene
             .objects
@@ -308,8 +320,9 @@ impl<'a> SceneRenderer<'a> {
                 }
                 Ok(())
             }
-            Technique::FrameSequential(p, schedule) => {
-                self.run_frame_sequential(gpu, (p, schedule), spec, wanted, on_frame, on_sources)
+            Technique::FrameSequential(p, schedule, space) => {
+                let variant = (p, schedule, space);
+                self.run_frame_sequential(gpu, variant, spec, wanted, on_frame, on_sources)
             }
         }
     }
@@ -385,13 +398,17 @@ impl<'a> SceneRenderer<'a> {
     fn run_frame_sequential(
         &self,
         gpu: &GpuContext,
-        (pattern, schedule): (VisibilityPattern, Schedule),
+        (pattern, schedule, space): (VisibilityPattern, Schedule, VisibilitySpace),
         spec: RunSpec,
         wanted: &dyn Fn(usize) -> bool,
         on_frame: &mut dyn FnMut(usize, Frame),
         mut on_sources: Option<&mut dyn FnMut(Vec<PixelSource>)>,
     ) -> Result<(), GpuError> {
-        let renderer = &self.lod_buffer[usize::from(pattern == VisibilityPattern::BlueNoise)];
+        let renderer = match (pattern, space) {
+            (_, OBJECT) => &self.lod_buffer[2],
+            (VisibilityPattern::BlueNoise, _) => &self.lod_buffer[1],
+            _ => &self.lod_buffer[0],
+        };
         let mut scheduler = TransitionScheduler::with_schedule(schedule);
         let keys: Vec<_> = self
             .scene

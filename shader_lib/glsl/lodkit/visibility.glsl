@@ -1,5 +1,5 @@
-// lodkit::visibility — object-space visibility textures for frame-sequential LOD
-// (Scherzer & Wimmer 2008, sec. 3.3, eq. 1, Fig. 2).
+// lodkit::visibility — visibility textures for frame-sequential LOD (Scherzer & Wimmer 2008,
+// sec. 3.3, eq. 1, Fig. 2), looked up in object space (the paper) or anchored to the screen.
 //
 // GLSL twin of shader_lib/wgsl/lodkit/visibility.wgsl; same semantics, `lodkit_` prefix. Texel
 // values lie in (0, 1): tau = 0 keeps nothing, tau = 1 everything. Uses texelFetch (no
@@ -18,6 +18,12 @@
 //   lodkit_visibility_flags_of(v, tau_now, tau_next) -> uint   the flags from a texel value
 //   lodkit_visibility_flags(vis_tex, object_pos, tau_now, tau_next) -> uint   bit 0 shown at
 //       tau_now, bit 1 at tau_next (macro)
+//   lodkit_visibility_screen_texel(size, frag_coord) -> uvec2   the texel under a framebuffer
+//       position of the texture tiled over the screen, one texel per pixel
+//   lodkit_visibility_next_coord(frag_coord, then_clip, viewport) -> vec2   where the fragment is
+//       expected in the next frame
+//   lodkit_visibility_flags_screen(vis_tex, frag_coord, next_coord, tau_now, tau_next) -> uint
+//       the flags with the pattern anchored to the screen (macro)
 // Shader defs: none.
 #ifndef LODKIT_VISIBILITY_GLSL
 #define LODKIT_VISIBILITY_GLSL
@@ -74,5 +80,33 @@ uint lodkit_visibility_flags_of(float v, float tau_now, float tau_next) {
 /// Display-time flags of a fragment at `object_pos`: bit 0 shown at tau_now, bit 1 at tau_next.
 #define lodkit_visibility_flags(vis_tex, object_pos, tau_now, tau_next) \
     lodkit_visibility_flags_of(LODKIT_VISIBILITY_VALUE_(vis_tex, object_pos), (tau_now), (tau_next))
+
+/// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
+/// under framebuffer position `frag_coord` (repeat addressing, either sign).
+uvec2 lodkit_visibility_screen_texel(uvec2 size, vec2 frag_coord) {
+    ivec2 s = ivec2(max(size, uvec2(1u)));
+    ivec2 p = ivec2(floor(frag_coord));
+    return uvec2(((p % s) + s) % s);
+}
+
+/// Where a fragment at `frag_coord` is expected in the next frame: as far again as it moved
+/// since the previous one (`then_clip`: its point then, previous camera; `viewport` in pixels).
+vec2 lodkit_visibility_next_coord(vec2 frag_coord, vec4 then_clip, vec2 viewport) {
+    if (then_clip.w <= 0.0) {
+        return frag_coord;
+    }
+    vec2 then_px = (then_clip.xy / then_clip.w * vec2(0.5, -0.5) + 0.5) * viewport;
+    return 2.0 * frag_coord - then_px;
+}
+
+/// The texel value under framebuffer position `c` of the texture tiled over the screen.
+#define LODKIT_VISIBILITY_SCREEN_VALUE_(vis_tex, c) \
+    texelFetch((vis_tex), ivec2(lodkit_visibility_screen_texel(uvec2(textureSize((vis_tex), 0)), (c))), 0).r
+
+/// Display-time flags with the pattern anchored to the screen: bit 0 from the texel under
+/// `frag_coord` at tau_now, bit 1 from the texel under `next_coord` at tau_next.
+#define lodkit_visibility_flags_screen(vis_tex, frag_coord, next_coord, tau_now, tau_next) \
+    (uint(lodkit_visibility_shown(LODKIT_VISIBILITY_SCREEN_VALUE_(vis_tex, frag_coord), (tau_now))) \
+        | (uint(lodkit_visibility_shown(LODKIT_VISIBILITY_SCREEN_VALUE_(vis_tex, next_coord), (tau_next))) << 1u))
 
 #endif // LODKIT_VISIBILITY_GLSL

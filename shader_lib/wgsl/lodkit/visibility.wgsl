@@ -1,5 +1,5 @@
-// lodkit::visibility — object-space visibility textures for frame-sequential LOD
-// (Scherzer & Wimmer 2008, sec. 3.3, eq. 1, Fig. 2).
+// lodkit::visibility — visibility textures for frame-sequential LOD (Scherzer & Wimmer 2008,
+// sec. 3.3, eq. 1, Fig. 2), looked up in object space (the paper) or anchored to the screen.
 //
 // A t-instance's fragments are kept where the visibility texture at the fragment's object-space
 // position is at most tau (eq. 1 discards visTex(p) > tau). Texel values lie in (0, 1), so
@@ -20,6 +20,15 @@
 //   visibility_flags_of(v, tau_now, tau_next) -> u32   the flags from a looked-up texel value
 //   visibility_flags(vis_tex, object_pos, tau_now, tau_next) -> u32   display-time visibility of
 //       a fragment: bit 0 shown at tau_now (the frame rendered), bit 1 at tau_next (the next frame)
+//   visibility_screen_texel(size, frag_coord) -> vec2<u32>   the texel under framebuffer
+//       position frag_coord of the texture tiled over the screen, one texel per pixel
+//   visibility_next_coord(frag_coord, then_clip, viewport) -> vec2<f32>   where the fragment is
+//       expected in the next frame (as far again as it moved since the previous one)
+//   visibility_flags_screen(vis_tex, frag_coord, next_coord, tau_now, tau_next) -> u32
+//       visibility_flags with the pattern anchored to the screen: bit 0 from the texel under the
+//       pixel displayed now, bit 1 from the one under next_coord. The pattern holds still on
+//       screen while objects and camera move, as a dither does; under motion a pixel changes
+//       only where the threshold passes its texel (see docs/frame-sequential.md)
 // The texture repeats once per object-space unit: scale object_pos to change the pattern's size.
 // Shader defs: none.
 #define_import_path lodkit::visibility
@@ -84,4 +93,35 @@ fn check_visibility(vis_tex: texture_2d<f32>, object_pos: vec3<f32>, tau: f32) -
 fn visibility_flags(vis_tex: texture_2d<f32>, object_pos: vec3<f32>, tau_now: f32, tau_next: f32) -> u32 {
     let texel = visibility_texel(textureDimensions(vis_tex, 0), object_pos);
     return visibility_flags_of(textureLoad(vis_tex, texel, 0).r, tau_now, tau_next);
+}
+
+/// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
+/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign).
+fn visibility_screen_texel(size: vec2<u32>, frag_coord: vec2<f32>) -> vec2<u32> {
+    let s = vec2<i32>(max(size, vec2<u32>(1u)));
+    let p = vec2<i32>(floor(frag_coord));
+    return vec2<u32>(((p % s) + s) % s);
+}
+
+/// Where a fragment at framebuffer position `frag_coord` is expected in the next frame: as far
+/// again as it moved since the previous one (constant screen velocity). `then_clip` is its
+/// surface point in the previous frame seen by the previous camera (clip space), `viewport` the
+/// framebuffer size in pixels; `frag_coord` itself when then_clip lies behind that camera.
+fn visibility_next_coord(frag_coord: vec2<f32>, then_clip: vec4<f32>, viewport: vec2<f32>) -> vec2<f32> {
+    if (then_clip.w <= 0.0) {
+        return frag_coord;
+    }
+    let then_px = (then_clip.xy / then_clip.w * vec2<f32>(0.5, -0.5) + 0.5) * viewport;
+    return 2.0 * frag_coord - then_px;
+}
+
+/// Display-time flags with the pattern anchored to the screen: bit 0 set when the texel under
+/// `frag_coord` (the pixel displayed in the frame rendered) is shown at `tau_now`, bit 1 when
+/// the texel under `next_coord` (where the fragment is displayed in the next frame,
+/// visibility_next_coord) is shown at `tau_next`.
+fn visibility_flags_screen(vis_tex: texture_2d<f32>, frag_coord: vec2<f32>, next_coord: vec2<f32>, tau_now: f32, tau_next: f32) -> u32 {
+    let size = textureDimensions(vis_tex, 0);
+    let now = textureLoad(vis_tex, visibility_screen_texel(size, frag_coord), 0).r;
+    let next = textureLoad(vis_tex, visibility_screen_texel(size, next_coord), 0).r;
+    return u32(visibility_shown(now, tau_now)) | (u32(visibility_shown(next, tau_next)) << 1u);
 }
