@@ -5,7 +5,7 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use lodkit::combine::combine_object_motion;
-use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
+use lodkit::frame_sequential::{Drive, FrameDraw, InstanceKey, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
 use lodkit::gpu::lod_buffer_scene::{LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture;
@@ -133,6 +133,28 @@ fn object_motion_twins_match() {
     assert!((still - Vec2::new(-0.1, 0.0)).length() < 1e-6);
 }
 
+/// Frame `f` of a transition to LOD 1 over `frames` frames that begins at frame 2 (progress
+/// driven, next frame's progress given): advances `s` and returns the instance's draw.
+fn transition_frame(
+    s: &mut TransitionScheduler,
+    key: InstanceKey,
+    f: u64,
+    frames: u32,
+) -> FrameDraw {
+    if f > 0 {
+        s.advance(1.0 / 60.0);
+    }
+    if f == 2 {
+        s.begin_transition(key, 1, Drive::Progress).unwrap();
+    }
+    if f >= 2 {
+        let p = |f: u64| ((f - 2) as f32 / frames as f32).min(1.0);
+        s.set_progress(key, p(f)).unwrap();
+        s.set_next_progress(key, p(f + 1)).unwrap();
+    }
+    s.draw(key).unwrap()
+}
+
 /// Pixels of the object (newer id word not 0) that show the black background in the combined
 /// image, and the object's pixels.
 fn holes(ids: &[u8], combined: &[u8]) -> (usize, usize) {
@@ -164,18 +186,7 @@ fn a_moving_t_instance_keeps_its_older_lod_under_it() {
         let (mut worst, mut total, mut center_motion) = (0usize, 0usize, Vec2::ZERO);
         let mut checked = 0;
         for f in 0..u64::from(FRAMES) + 4 {
-            if f > 0 {
-                s.advance(1.0 / 60.0);
-            }
-            if f == 2 {
-                s.begin_transition(key, 1, Drive::Progress).unwrap();
-            }
-            if f >= 2 {
-                let p = |f: u64| ((f - 2) as f32 / FRAMES as f32).min(1.0);
-                s.set_progress(key, p(f)).unwrap();
-                s.set_next_progress(key, p(f + 1)).unwrap();
-            }
-            let d = s.draw(key).unwrap();
+            let d = transition_frame(&mut s, key, f, FRAMES);
             let mut item =
                 LodDrawItem::from_draw(&lods.sphere, model(f), lods.colors[usize::from(d.lod)], &d);
             item.sway = [0.1, phase(f)];
@@ -310,18 +321,7 @@ fn lods_that_sway_apart_keep_each_other_covered() {
     let key = s.insert(0);
     let (mut total, mut worst, mut interior, mut apart) = (0usize, 0usize, 0usize, 0usize);
     for f in 0..u64::from(FRAMES) + 4 {
-        if f > 0 {
-            s.advance(1.0 / 60.0);
-        }
-        if f == 2 {
-            s.begin_transition(key, 1, Drive::Progress).unwrap();
-        }
-        if f >= 2 {
-            let p = |f: u64| ((f - 2) as f32 / FRAMES as f32).min(1.0);
-            s.set_progress(key, p(f)).unwrap();
-            s.set_next_progress(key, p(f + 1)).unwrap();
-        }
-        let d = s.draw(key).unwrap();
+        let d = transition_frame(&mut s, key, f, FRAMES);
         let item_of = |lod: u8| {
             let mut item = LodDrawItem::from_draw(
                 &lods.sphere,

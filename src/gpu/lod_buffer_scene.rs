@@ -153,8 +153,10 @@ impl LodBufferRenderer {
     pub const MAX_DRAWS: usize = 1024;
 
     /// Builds the pipeline for LOD buffers of color format `color_format`, with visibility
-    /// texture `vis` repeating `vis_scale` (finite, > 0) times per object-space unit; standard Z
-    /// (depth test `Less`, cleared to 1).
+    /// texture `vis`: tiled over the screen, one texel per pixel (the default
+    /// [`VisibilitySpace::Screen`]), or repeating `vis_scale` (finite, > 0) times per
+    /// object-space unit once [`set_visibility_space`](Self::set_visibility_space) anchors it to
+    /// the object; standard Z (depth test `Less`, cleared to 1).
     pub fn new(
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,
