@@ -24,7 +24,7 @@ use lodkit::combine::screen_rect;
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
@@ -130,14 +130,20 @@ fn main() -> Result<(), Box<dyn Error>> {
             b: 0.09,
             a: 1.0,
         };
-        renderer.render(&gpu, &buffers, index, proj * view, &items, clear, None)?;
+        // With last frame's camera too: the screen-anchored visibility pattern predicts from it
+        // where each fragment is displayed next frame.
+        let views = [proj * view, proj * previous_view.unwrap_or(view)];
+        let lod_view = LodView {
+            view_proj: views[0],
+            prev_view_proj: views[1],
+        };
+        renderer.render(&gpu, &buffers, index, lod_view, &items, clear, None)?;
 
         // 3. Combine with last frame's buffer, reprojected through the camera motion, where the
         //    t-instances are in this frame's and last frame's view (both LODs fit the unit box).
         let new_to_old = previous_view.map_or(CombinePass::NO_HISTORY, |old| {
             new_to_old_matrix(&view, &proj, &old, &proj)
         });
-        let views = [proj * view, proj * previous_view.unwrap_or(view)];
         let unit_box = (Vec3::splat(-1.0), Vec3::splat(1.0));
         let regions: Vec<_> = keys
             .iter()

@@ -3,8 +3,8 @@
 //! id in bits 0..29 (exact up to 2^30 - 1) and the display-time flags in bits 30 (shown in the
 //! frame rendered) and 31 (shown in the next frame). 8 bytes per pixel beyond the depth
 //! attachment with RGBA8 color. Objects that move by themselves also write their object motion
-//! ([`lod_buffer_motion`]) into one [`MOTION_FORMAT`] target for the frame (4 bytes per pixel,
-//! shared by both buffers), cleared to 0.
+//! ([`lod_buffer_motion`]) into one `MOTION_FORMAT` (`Rg16Float`) target for the frame (4 bytes
+//! per pixel, shared by both buffers), cleared to 0.
 
 use glam::{Vec2, Vec4};
 

@@ -288,7 +288,7 @@ impl CombinePass {
     /// needs `COPY_DST` besides what [`encode`](Self::encode) needs), then runs the combine only
     /// inside `regions`, the screen rectangles of the t-instances
     /// ([`screen_rect`](crate::combine::screen_rect), merged with
-    /// [`merge_rects`](crate::combine::merge_rects); overlapping rectangles are merged here
+    /// [`merge_rects`]; overlapping rectangles are merged here
     /// too). With no region the frame is the copy: no combine, no read of the older buffer.
     /// Returns the pixels combined. An engine that can show the newer buffer's color directly
     /// skips the copy as well (see docs/frame-sequential.md).

@@ -260,8 +260,11 @@ impl LodBufferRenderer {
     }
 
     /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers` seen by
-    /// `view` (a `Mat4` view-projection, or a [`LodView`] with the previous frame's for moving
-    /// objects), cleared to `clear`, counting the pass's fragments with `counter` if given.
+    /// `view`, cleared to `clear`, counting the pass's fragments with `counter` if given. Pass a
+    /// [`LodView`] with the previous frame's view-projection whenever the camera or an object
+    /// moves: the screen-anchored pattern predicts from it where each fragment is displayed next
+    /// frame, and moving objects get their object motion from it. A `Mat4` view-projection means
+    /// no previous frame (a still camera, the first frame, a cut).
     /// Returns the triangles drawn and the count (0 without a counter). A t-instance item shown in neither this frame
     /// nor the next (tau and tau_next 0 or NaN: visibility texels lie strictly between 0 and 1)
     /// is not submitted. Every fragment of a t-instance is kept and flagged (see
