@@ -148,7 +148,11 @@ impl VisibilityTexture {
     /// The texel value an object-space position looks up, as the shader does. An empty or short
     /// texture reads as 1 (every fragment kept).
     pub fn lookup(&self, object_pos: Vec3) -> f32 {
-        let t = visibility_texel(UVec2::splat(self.size), object_pos);
+        self.value(visibility_texel(UVec2::splat(self.size), object_pos))
+    }
+
+    /// The value of texel `t`; 1 outside the texels.
+    fn value(&self, t: UVec2) -> f32 {
         let index = u64::from(t.y) * u64::from(self.size) + u64::from(t.x);
         self.texels.get(index as usize).copied().unwrap_or(1.0)
     }
@@ -186,7 +190,8 @@ pub enum VisibilitySpace {
 }
 
 /// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
-/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign).
+/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign; clamped to
+/// +-2^24 pixels).
 ///
 /// ```
 /// # use lodkit::visibility::visibility_screen_texel;
@@ -196,7 +201,10 @@ pub enum VisibilitySpace {
 /// ```
 pub fn visibility_screen_texel(size: UVec2, frag_coord: Vec2) -> UVec2 {
     let s = size.max(UVec2::ONE).as_ivec2();
-    let p = IVec2::new(frag_coord.x.floor() as i32, frag_coord.y.floor() as i32);
+    let p = frag_coord
+        .floor()
+        .clamp(Vec2::splat(-16_777_216.0), Vec2::splat(16_777_216.0));
+    let p = IVec2::new(p.x as i32, p.y as i32);
     ((p % s + s) % s).as_uvec2()
 }
 
@@ -225,9 +233,7 @@ impl VisibilityTexture {
     /// The texel value under framebuffer position `frag_coord` with the texture tiled over the
     /// screen, as the shader reads it. An empty or short texture reads as 1.
     pub fn lookup_screen(&self, frag_coord: Vec2) -> f32 {
-        let t = visibility_screen_texel(UVec2::splat(self.size), frag_coord);
-        let index = u64::from(t.y) * u64::from(self.size) + u64::from(t.x);
-        self.texels.get(index as usize).copied().unwrap_or(1.0)
+        self.value(visibility_screen_texel(UVec2::splat(self.size), frag_coord))
     }
 }
 

@@ -82,10 +82,10 @@ uint lodkit_visibility_flags_of(float v, float tau_now, float tau_next) {
     lodkit_visibility_flags_of(LODKIT_VISIBILITY_VALUE_(vis_tex, object_pos), (tau_now), (tau_next))
 
 /// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
-/// under framebuffer position `frag_coord` (repeat addressing, either sign).
+/// under framebuffer position `frag_coord` (repeat addressing, either sign; clamped to +-2^24).
 uvec2 lodkit_visibility_screen_texel(uvec2 size, vec2 frag_coord) {
     ivec2 s = ivec2(max(size, uvec2(1u)));
-    ivec2 p = ivec2(floor(frag_coord));
+    ivec2 p = ivec2(clamp(floor(frag_coord), vec2(-16777216.0), vec2(16777216.0)));
     return uvec2(((p % s) + s) % s);
 }
 

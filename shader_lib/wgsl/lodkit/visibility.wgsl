@@ -2,7 +2,8 @@
 // sec. 3.3, eq. 1, Fig. 2), looked up in object space (the paper) or anchored to the screen.
 //
 // A t-instance's fragments are kept where the visibility texture at the fragment's object-space
-// position is at most tau (eq. 1 discards visTex(p) > tau). Texel values lie in (0, 1), so
+// position (or, anchored to the screen, under the pixel where it is displayed) is at most tau
+// (eq. 1 discards visTex(p) > tau). Texel values lie in (0, 1), so
 // tau = 0 keeps nothing and tau = 1 keeps everything. The lookup uses textureLoad (no sampler, no
 // derivatives), so it also works in depth-only and shadow passes.
 //
@@ -96,10 +97,11 @@ fn visibility_flags(vis_tex: texture_2d<f32>, object_pos: vec3<f32>, tau_now: f3
 }
 
 /// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
-/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign).
+/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign; clamped to
+/// +-2^24 pixels).
 fn visibility_screen_texel(size: vec2<u32>, frag_coord: vec2<f32>) -> vec2<u32> {
     let s = vec2<i32>(max(size, vec2<u32>(1u)));
-    let p = vec2<i32>(floor(frag_coord));
+    let p = vec2<i32>(clamp(floor(frag_coord), vec2<f32>(-16777216.0), vec2<f32>(16777216.0)));
     return vec2<u32>(((p % s) + s) % s);
 }
 
