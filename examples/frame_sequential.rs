@@ -54,7 +54,9 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (w, h) = SIZE;
 
     // Made once: the two LOD buffers, the pass that draws into them, the combine, the target.
-    let buffers = LodBuffers::new(&gpu, w, h, FORMAT)?;
+    // Nothing here moves by itself (the camera's motion is the combine's reprojection): no
+    // object motion target, 8 bytes per pixel per LOD buffer beyond its depth.
+    let buffers = LodBuffers::without_motion(&gpu, w, h, FORMAT)?;
     let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 1);
     let renderer = LodBufferRenderer::new(&gpu, FORMAT, &vis, 0.25)?;
     let combine = CombinePass::new(&gpu, FORMAT, false)?;

@@ -5,7 +5,7 @@ use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, PixelSource, combine_images};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::reproject::new_to_old_matrix;
@@ -183,6 +183,83 @@ fn resizing_lod_buffers_does_not_leak_textures() {
         (Some(b), Some(a)) => assert_eq!(a, b, "textures alive before and after 40 resizes"),
         _ => say("this wgpu build gives no resource report; only the final size was checked"),
     }
+    // Without the motion target: two colors, two ids, two depths, and so after a resize.
+    let mut still = LodBuffers::without_motion(gpu, 32, 32, wgpu::TextureFormat::Rgba8Unorm);
+    let still = still.as_mut().unwrap();
+    still.resize(gpu, 40, 30).unwrap();
+    gpu.wait_idle().unwrap();
+    assert!(still.motion().is_none() && buffers.motion().is_some());
+    if let (Some(b), Some(a)) = (before, count()) {
+        assert_eq!(a, b + 6, "LodBuffers::without_motion keeps 6 textures");
+    }
+}
+
+#[test]
+fn lod_buffers_without_motion_combine_a_moving_camera_like_with_it() {
+    let gpu = lodkit_test_gpu!();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 3);
+    let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.5).unwrap();
+    let combine = CombinePass::new(gpu, format, false).unwrap();
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let target = lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, "t").unwrap();
+    let view_of = target.create_view(&Default::default());
+    let meshes = [
+        GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap(),
+        GpuMesh::new(gpu, &Mesh::cube()).unwrap(),
+    ];
+    let proj = glam::camera::rh::proj::directx::perspective(0.9, W as f32 / H as f32, 0.1, 50.0);
+    let eye =
+        |x: f32| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 0.5, 5.0), Vec3::ZERO, Vec3::Y);
+    // Two frames of a t-instance (its two LODs) and an n-instance; only the camera moves.
+    let frame = |buffers: &LodBuffers| -> Vec<u8> {
+        for (i, x) in [0.0f32, 0.3].into_iter().enumerate() {
+            let items: Vec<LodDrawItem> = [(0.0f32, 7), (1.5, 0)]
+                .into_iter()
+                .map(|(dx, id)| {
+                    let model = Mat4::from_translation(Vec3::new(dx, 0.0, 0.0));
+                    LodDrawItem {
+                        mesh: &meshes[i],
+                        model,
+                        color: Vec4::new(0.9, 0.3, 0.2, 1.0),
+                        id,
+                        tau: 0.5,
+                        tau_next: 0.6,
+                        sway: [0.0; 2],
+                        prev_model: model,
+                        prev_sway_phase: 0.0,
+                        alpha_rect: Vec4::ZERO,
+                    }
+                })
+                .collect();
+            let view = LodView {
+                view_proj: proj * eye(x),
+                prev_view_proj: proj * eye(0.0),
+            };
+            let clear = wgpu::Color::BLACK;
+            renderer
+                .render(gpu, buffers, i, view, &items, clear, None)
+                .unwrap();
+        }
+        let m = new_to_old_matrix(&eye(0.3), &proj, &eye(0.0), &proj);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        combine
+            .encode(gpu, &mut encoder, buffers, 1, m, &view_of)
+            .unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        read_texture_rgba8(gpu, &target).unwrap()
+    };
+    let with = frame(&LodBuffers::new(gpu, W, H, format).unwrap());
+    let without = frame(&LodBuffers::without_motion(gpu, W, H, format).unwrap());
+    let lit = with.chunks(4).filter(|p| p[..3] != [0, 0, 0]).count();
+    assert!(lit > 1000, "the objects cover {lit} pixels");
+    assert_eq!(
+        with, without,
+        "nothing moved by itself: the motion target changes nothing"
+    );
+    say(&format!(
+        "{lit} lit pixels, identical with and without the motion target"
+    ));
 }
 
 /// Coverage of the object (pixels not of the clear color) in an RGBA8 image.

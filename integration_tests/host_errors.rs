@@ -117,6 +117,16 @@ fn every_allocating_call_reports_sizes_past_the_limits() {
                 LodBuffers::new(gpu, w, h, RGBA8)
             });
             check_sized("LodBuffers::new", (w, h), limit, r, LodBuffers::size);
+            let r = no_panic(&what("LodBuffers::without_motion"), || {
+                LodBuffers::without_motion(gpu, w, h, RGBA8)
+            });
+            check_sized(
+                "LodBuffers::without_motion",
+                (w, h),
+                limit,
+                r,
+                LodBuffers::size,
+            );
             let r = no_panic(&what("LowResBuffer::new"), || {
                 LowResBuffer::new(gpu, w, h, RGBA8)
             });

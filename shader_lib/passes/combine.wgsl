@@ -15,7 +15,8 @@
 //   fs_main   @location(0) combined color
 // Bindings (group 0): 0 newer_color texture_2d<f32>, 1 newer_id texture_2d<u32>, 2 newer_depth
 //   texture_2d<f32> (the depth attachment), 3 older_color, 4 older_id, 5 older_depth,
-//   6 object_motion texture_2d<f32> (the LOD pass's location 2, this frame), 7 params:
+//   6 object_motion texture_2d<f32> (the LOD pass's location 2, this frame; a 1x1 texture
+//   holding 0 for buffers without a motion target: every pixel reads its one texel), 7 params:
 //   CombineParams.
 // Shader defs: LODKIT_REVERSE_Z (bool, default off) — passed on to lodkit::combine.
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
@@ -46,6 +47,6 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 @fragment
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(v.position.xy);
-    let motion = textureLoad(object_motion, pixel, 0).xy;
+    let motion = textureLoad(object_motion, min(pixel, textureDimensions(object_motion, 0) - 1u), 0).xy;
     return combine_at_moved(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel, params.new_to_old, motion);
 }

@@ -9,7 +9,7 @@
 
 use glam::Mat4;
 
-use super::error::{check_color_format, has_usage, texture_matches};
+use super::error::{check_color_format, has_usage, target_extent, texture_matches};
 use super::resources::{
     TextureSet, begin_color_pass, begin_load_pass, begin_targets_pass, fullscreen_pipeline_with,
     new_set, one_group_layout, resize_set, texture_2d, texture_entry, textures_and_uniform,
@@ -23,8 +23,9 @@ use crate::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
 pub const LOD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
 /// Two LOD buffers, each a color target, an id target and the depth attachment it is rendered
-/// with (read by the combine pass as the fragments' clip depth), and one object motion target
-/// for the frame being rendered (`MOTION_FORMAT`, location 2, see `lodkit::lod_buffer`).
+/// with (read by the combine pass as the fragments' clip depth), and, unless built
+/// [`without_motion`](Self::without_motion), one object motion target for the frame being
+/// rendered (`MOTION_FORMAT`, location 2, see `lodkit::lod_buffer`).
 #[derive(Debug)]
 pub struct LodBuffers {
     color_format: wgpu::TextureFormat,
@@ -32,7 +33,7 @@ pub struct LodBuffers {
     colors: [wgpu::Texture; 2],
     ids: [wgpu::Texture; 2],
     depths: [wgpu::Texture; 2],
-    motion: wgpu::Texture,
+    motion: Option<wgpu::Texture>,
 }
 
 impl TextureSet for LodBuffers {
@@ -44,6 +45,39 @@ impl TextureSet for LodBuffers {
         gpu: &GpuContext,
         size: (u32, u32),
         color_format: wgpu::TextureFormat,
+    ) -> Result<Self, GpuError> {
+        Self::allocate_with(gpu, size, color_format, true)
+    }
+
+    fn allocate_like(&self, gpu: &GpuContext, size: (u32, u32)) -> Result<Self, GpuError> {
+        Self::allocate_with(gpu, size, self.color_format, self.motion.is_some())
+    }
+
+    fn extent(&self) -> (u32, u32) {
+        self.size
+    }
+
+    fn format(&self) -> wgpu::TextureFormat {
+        self.color_format
+    }
+
+    fn textures(&self) -> Vec<&wgpu::Texture> {
+        self.colors
+            .iter()
+            .chain(&self.ids)
+            .chain(&self.depths)
+            .chain(&self.motion)
+            .collect()
+    }
+}
+
+impl LodBuffers {
+    /// Every texture at `size` (already checked), the motion target if `motion`.
+    fn allocate_with(
+        gpu: &GpuContext,
+        size: (u32, u32),
+        color_format: wgpu::TextureFormat,
+        motion: bool,
     ) -> Result<Self, GpuError> {
         let texture = |format, usage, label| texture_2d(gpu, size, format, usage, label);
         let usage = Self::USAGE;
@@ -62,31 +96,17 @@ impl TextureSet for LodBuffers {
                 texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 0")?,
                 texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 1")?,
             ],
-            motion: texture(MOTION_FORMAT, usage, "lod buffer object motion")?,
+            motion: match motion {
+                true => Some(texture(MOTION_FORMAT, usage, "lod buffer object motion")?),
+                false => None,
+            },
         })
     }
 
-    fn extent(&self) -> (u32, u32) {
-        self.size
-    }
-
-    fn format(&self) -> wgpu::TextureFormat {
-        self.color_format
-    }
-
-    fn textures(&self) -> Vec<&wgpu::Texture> {
-        self.colors
-            .iter()
-            .chain(&self.ids)
-            .chain(&self.depths)
-            .chain([&self.motion])
-            .collect()
-    }
-}
-
-impl LodBuffers {
     /// Allocates both buffers at `width` x `height` (a zero side is taken as 1) with color format
-    /// `color_format`, a floating-point color format the device can render to, sample and copy.
+    /// `color_format`, a floating-point color format the device can render to, sample and copy,
+    /// and the object motion target: 8 bytes per pixel per buffer with an RGBA8 color, 4 more for
+    /// the motion, beyond the two depth attachments.
     pub fn new(
         gpu: &GpuContext,
         width: u32,
@@ -96,7 +116,24 @@ impl LodBuffers {
         new_set(gpu, "LodBuffers::new", (width, height), color_format)
     }
 
-    /// Reallocates at a new size (a no-op at the same size; a zero side is taken as 1). The old
+    /// [`new`](Self::new) without the object motion target, for scenes where nothing moves by
+    /// itself (the camera's motion is the combine's reprojection) or engines that pass motion
+    /// vectors of their own to `combine_at_moved`: 8 bytes per pixel per buffer with an RGBA8
+    /// color beyond its depth attachment, nothing else. The reference LOD pass writes no motion
+    /// into them and the combine pass reads none (a t-instance that moves by itself is read
+    /// where it is now).
+    pub fn without_motion(
+        gpu: &GpuContext,
+        width: u32,
+        height: u32,
+        color_format: wgpu::TextureFormat,
+    ) -> Result<Self, GpuError> {
+        const CALL: &str = "LodBuffers::without_motion";
+        let size = target_extent(gpu, CALL, (width, height), color_format, Self::USAGE)?;
+        gpu.guarded(CALL, || Self::allocate_with(gpu, size, color_format, false))
+    }
+
+    /// Reallocates at a new size (with or without the motion target, as before) (a no-op at the same size; a zero side is taken as 1). The old
     /// textures are destroyed once the new ones exist; on an error the buffers are unchanged.
     pub fn resize(&mut self, gpu: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
         resize_set(gpu, "LodBuffers::resize", self, (width, height))
@@ -128,14 +165,14 @@ impl LodBuffers {
     }
 
     /// The object motion target (`MOTION_FORMAT`): written by the frame rendered last, read by
-    /// its combine.
-    pub fn motion(&self) -> &wgpu::Texture {
-        &self.motion
+    /// its combine; `None` for buffers built [`without_motion`](Self::without_motion).
+    pub fn motion(&self) -> Option<&wgpu::Texture> {
+        self.motion.as_ref()
     }
 
     /// Begins a render pass into buffer `index` that clears color to `clear`, the id and the
-    /// object motion (location 2) to 0 and the depth attachment to `far_depth` (1 for standard
-    /// Z, 0 for reversed).
+    /// object motion (location 2, when there is a target) to 0 and the depth attachment to
+    /// `far_depth` (1 for standard Z, 0 for reversed).
     /// `occlusion_query_set` is passed on to the pass (see
     /// [`FragmentCounter`](super::counters::FragmentCounter)).
     pub fn begin_pass<'e>(
@@ -149,11 +186,16 @@ impl LodBuffers {
         let color = self.colors[index % 2].create_view(&Default::default());
         let id = self.ids[index % 2].create_view(&Default::default());
         let depth = self.depths[index % 2].create_view(&Default::default());
-        let motion = self.motion.create_view(&Default::default());
+        let motion = self
+            .motion
+            .as_ref()
+            .map(|m| m.create_view(&Default::default()));
         let zero = wgpu::Color::TRANSPARENT;
+        let mut targets = vec![(&color, clear), (&id, zero)];
+        targets.extend(motion.as_ref().map(|m| (m, zero)));
         begin_targets_pass(
             encoder,
-            &[(&color, clear), (&id, zero), (&motion, zero)],
+            &targets,
             &depth,
             far_depth,
             occlusion_query_set,
@@ -176,6 +218,8 @@ pub struct CombineParams {
 pub struct CombinePass {
     pipeline: wgpu::RenderPipeline,
     params: wgpu::Buffer,
+    /// 1x1, zero: the object motion of buffers without a motion target.
+    still: wgpu::Texture,
     target_format: wgpu::TextureFormat,
 }
 
@@ -218,6 +262,13 @@ impl CombinePass {
                     label,
                 )?,
                 params: uniform_buffer(gpu, size, "combine params")?,
+                still: texture_2d(
+                    gpu,
+                    (1, 1),
+                    MOTION_FORMAT,
+                    wgpu::TextureUsages::TEXTURE_BINDING,
+                    "combine: no object motion",
+                )?,
                 target_format,
             })
         })
@@ -384,7 +435,7 @@ impl CombinePass {
                 buffers.color(newer + 1),
                 buffers.id(newer + 1),
                 buffers.depth(newer + 1),
-                buffers.motion(),
+                buffers.motion().unwrap_or(&self.still),
             ];
             let layout = self.pipeline.get_bind_group_layout(0);
             let bind_group = textures_and_uniform(
@@ -416,7 +467,7 @@ impl CombinePass {
 }
 
 /// Reads buffer `index` of `buffers` back to the CPU, with the object motion target (which holds
-/// the motion of the buffer rendered last). Its color format must be RGBA8, unorm or sRGB
+/// the motion of the buffer rendered last; none for buffers without one). Its color format must be RGBA8, unorm or sRGB
 /// ([`GpuError::UnsupportedFormat`] otherwise).
 pub fn read_lod_image(
     gpu: &GpuContext,
@@ -439,7 +490,10 @@ pub fn read_lod_image(
             read_texture_rgba8(gpu, buffers.color(index))?,
             read_texture(gpu, buffers.id(index), 4)?,
             read_depth32(gpu, buffers.depth(index))?,
-            read_texture(gpu, buffers.motion(), 4)?,
+            match buffers.motion() {
+                Some(m) => read_texture(gpu, m, 4)?,
+                None => Vec::new(),
+            },
         ))
     })?;
     let words = |bytes: Vec<u8>| -> Vec<u32> {

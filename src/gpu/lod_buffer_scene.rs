@@ -136,6 +136,8 @@ impl<'a> LodDrawItem<'a> {
 #[derive(Debug)]
 pub struct LodBufferRenderer {
     pipeline: wgpu::RenderPipeline,
+    /// The same for LOD buffers without the object motion target.
+    still_pipeline: wgpu::RenderPipeline,
     camera: wgpu::Buffer,
     camera_layout: wgpu::BindGroupLayout,
     vis_view: wgpu::TextureView,
@@ -196,18 +198,23 @@ impl LodBufferRenderer {
             ];
             let (view_layout, draw_layout, layout) =
                 camera_draw_layouts(gpu, "lod_buffer_mesh", &extra)?;
-            let pipeline = mesh_pipeline(
-                gpu,
-                &module,
-                &layout,
-                &[
-                    Some(color_format.into()),
-                    Some(ID_FORMAT.into()),
-                    Some(MOTION_FORMAT.into()),
-                ],
-                depth_write_state(LOD_DEPTH_FORMAT, depth_compare(depth)),
-                "lod_buffer_mesh",
-            )?;
+            let targets = [
+                Some(color_format.into()),
+                Some(ID_FORMAT.into()),
+                Some(MOTION_FORMAT.into()),
+            ];
+            let depth_state = depth_write_state(LOD_DEPTH_FORMAT, depth_compare(depth));
+            let pipeline = |targets: &[Option<wgpu::ColorTargetState>]| {
+                mesh_pipeline(
+                    gpu,
+                    &module,
+                    &layout,
+                    targets,
+                    depth_state.clone(),
+                    "lod_buffer_mesh",
+                )
+            };
+            let (with_motion, still) = (pipeline(&targets)?, pipeline(&targets[..2])?);
             let size = std::mem::size_of::<LodCameraUniform>();
             let camera = uniform_buffer(gpu, size, "lod camera")?;
             let draws = DrawUniforms::new(
@@ -222,7 +229,8 @@ impl LodBufferRenderer {
                 masked_view_group(gpu, &view_layout, &camera, &[&vis_view], &opaque)?;
             let draw_group = draws.bind_group(gpu, &draw_layout)?;
             Ok(Self {
-                pipeline,
+                pipeline: with_motion,
+                still_pipeline: still,
                 camera,
                 camera_layout: view_layout,
                 vis_view,
@@ -325,7 +333,10 @@ impl LodBufferRenderer {
                 if let Some(c) = counter {
                     c.begin(&mut pass);
                 }
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(match buffers.motion() {
+                    Some(_) => &self.pipeline,
+                    None => &self.still_pipeline,
+                });
                 pass.set_bind_group(0, &self.camera_group, &[]);
                 for (i, item) in items
                     .iter()

@@ -563,6 +563,10 @@ pub(crate) trait TextureSet: Sized {
     fn format(&self) -> wgpu::TextureFormat;
     /// Every texture, to destroy when replaced.
     fn textures(&self) -> Vec<&wgpu::Texture>;
+    /// A set like this one at `size` (already checked): what a resize allocates.
+    fn allocate_like(&self, gpu: &GpuContext, size: (u32, u32)) -> Result<Self, GpuError> {
+        Self::allocate(gpu, size, self.format())
+    }
 }
 
 /// A [`TextureSet`] at `width` x `height` in `color_format`, checked and allocated as `call`.
@@ -588,7 +592,7 @@ pub(crate) fn resize_set<T: TextureSet>(
     if size == set.extent() {
         return gpu.check(call);
     }
-    let new = gpu.guarded(call, || T::allocate(gpu, size, set.format()))?;
+    let new = gpu.guarded(call, || set.allocate_like(gpu, size))?;
     let old = std::mem::replace(set, new);
     for t in old.textures() {
         t.destroy();

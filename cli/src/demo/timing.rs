@@ -279,7 +279,8 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     let copy7 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "copy7")?;
     let textures = [1, 0].map(|i| [buffers.color(i), buffers.id(i), buffers.depth(i)]);
     let mut textures = textures.as_flattened().to_vec();
-    textures.push(buffers.motion());
+    // LodBuffers::new has the motion target.
+    textures.extend(buffers.motion());
     let group = textures_and_uniform(gpu, &layout, &textures, None, "copy7")?;
     let run_combine = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
