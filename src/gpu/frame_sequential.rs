@@ -133,8 +133,9 @@ impl LodBuffers {
         gpu.guarded(CALL, || Self::allocate_with(gpu, size, color_format, false))
     }
 
-    /// Reallocates at a new size (with or without the motion target, as before) (a no-op at the same size; a zero side is taken as 1). The old
-    /// textures are destroyed once the new ones exist; on an error the buffers are unchanged.
+    /// Reallocates at a new size, with or without the motion target as before (a no-op at the
+    /// same size; a zero side is taken as 1). The old textures are destroyed once the new ones
+    /// exist; on an error the buffers are unchanged.
     pub fn resize(&mut self, gpu: &GpuContext, width: u32, height: u32) -> Result<(), GpuError> {
         resize_set(gpu, "LodBuffers::resize", self, (width, height))
     }
@@ -467,8 +468,8 @@ impl CombinePass {
 }
 
 /// Reads buffer `index` of `buffers` back to the CPU, with the object motion target (which holds
-/// the motion of the buffer rendered last; none for buffers without one). Its color format must be RGBA8, unorm or sRGB
-/// ([`GpuError::UnsupportedFormat`] otherwise).
+/// the motion of the buffer rendered last; none for buffers without one). Its color format must
+/// be RGBA8, unorm or sRGB ([`GpuError::UnsupportedFormat`] otherwise).
 pub fn read_lod_image(
     gpu: &GpuContext,
     buffers: &LodBuffers,
