@@ -158,8 +158,9 @@ pub struct CombinedPixel {
     /// Whether the reprojected position lies within 1e-3 texel of a texel edge, where a GPU may
     /// round to the neighbouring texel.
     pub on_texel_edge: bool,
-    /// Whether the older texel came from [`combine_search_texel`] (the moved read and its side
-    /// texels held another object than the newer pixel's t-instance, and the pixel moved).
+    /// Whether the older texel came from [`combine_search_texel`]: the moved read and its side
+    /// texels held another object than the newer pixel's t-instance, the pixel moved, and the
+    /// search found the t-instance.
     pub searched: bool,
 }
 
@@ -274,6 +275,8 @@ pub fn combine_match_texel(id: u32, ids: UVec4, nearest: UVec2, x: UVec2, y: UVe
 /// assert_eq!((ring[1], ring[4]), (UVec2::new(2, 3), UVec2::new(3, 4)));
 /// assert_eq!((ring[5], ring[8]), (UVec2::new(2, 2), UVec2::new(4, 4)));
 /// assert_eq!(combine_ring_texel(UVec2::ZERO, size, 5), UVec2::ZERO);
+/// let far = UVec2::splat(u32::MAX); // clamped, no overflow
+/// assert_eq!(combine_ring_texel(far, far, 2), UVec2::splat(u32::MAX - 1));
 /// ```
 pub fn combine_ring_texel(center: UVec2, size: UVec2, k: u32) -> UVec2 {
     let offset = if k >= 5 {
@@ -288,9 +291,10 @@ pub fn combine_ring_texel(center: UVec2, size: UVec2, k: u32) -> UVec2 {
     } else {
         glam::IVec2::ZERO
     };
-    let max = size.as_ivec2() - glam::IVec2::ONE;
-    (center.as_ivec2() + offset)
-        .clamp(glam::IVec2::ZERO, max.max(glam::IVec2::ZERO))
+    // In i64: no overflow whatever the center.
+    let max = size.max(UVec2::ONE).as_i64vec2() - glam::I64Vec2::ONE;
+    (center.as_i64vec2() + offset.as_i64vec2())
+        .clamp(glam::I64Vec2::ZERO, max)
         .as_uvec2()
 }
 
@@ -304,8 +308,8 @@ pub fn combine_search_texel(older: &LodImage, id: u32, center: UVec2, fallback: 
     (0..9)
         .map(|k| combine_ring_texel(center, size, k))
         .find(|t| {
-            let i = (t.y * older.width + t.x) as usize;
-            older.ids.get(i) == Some(&id)
+            let i = u64::from(t.y) * u64::from(older.width) + u64::from(t.x);
+            usize::try_from(i).is_ok_and(|i| older.ids.get(i) == Some(&id))
         })
         .unwrap_or(fallback)
 }
@@ -451,10 +455,13 @@ fn combine_pixel(
     );
     let id = newer.ids[p];
     let mut texel = combine_match_texel(id, ids, nearest, x, y);
-    let searched = id != 0 && id_at(texel) != id && motion != Vec2::ZERO;
-    if searched {
+    let search = id != 0 && id_at(texel) != id && motion != Vec2::ZERO;
+    let matched = texel;
+    if search {
         texel = combine_search_texel(older, id, combine_texel(old.truncate(), size), texel);
     }
+    // The texel the search found holds the id, the one it started from does not.
+    let searched = texel != matched;
     let o = index(texel);
     let color = combine_texels(
         newer.colors[p],
@@ -482,7 +489,7 @@ fn combine_pixel(
     let on_texel_edge = near_edge(old.truncate() + motion)
         || near_edge(refined.truncate() + motion)
         || near_center(at)
-        || (searched && near_edge(old.truncate()));
+        || (search && near_edge(old.truncate()));
     let (n, o) = (newer.sample(p), older.sample(o));
     let (n_shown, o_shown) = (
         newer.shown(p, LOD_BUFFER_SHOWN_NOW),

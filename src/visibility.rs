@@ -190,22 +190,29 @@ pub enum VisibilitySpace {
 }
 
 /// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
-/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign; clamped to
-/// +-2^24 pixels).
+/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign; the position
+/// clamped to +-2^24 pixels, the size to 1..2^24).
 ///
 /// ```
 /// # use lodkit::visibility::visibility_screen_texel;
 /// # use glam::{UVec2, Vec2};
 /// assert_eq!(visibility_screen_texel(UVec2::splat(64), Vec2::new(70.5, 3.5)), UVec2::new(6, 3));
 /// assert_eq!(visibility_screen_texel(UVec2::splat(64), Vec2::new(-0.5, 3.5)), UVec2::new(63, 3));
+/// // Sizes past 2^24 count as 2^24; nothing overflows.
+/// let huge = visibility_screen_texel(UVec2::splat(u32::MAX), Vec2::new(-3.5, 2.5));
+/// assert_eq!(huge, UVec2::new((1 << 24) - 4, 2)); // floor(-3.5) = -4
 /// ```
 pub fn visibility_screen_texel(size: UVec2, frag_coord: Vec2) -> UVec2 {
-    let s = size.max(UVec2::ONE).as_ivec2();
+    const LIMIT: i32 = 1 << 24;
+    let s = size
+        .clamp(UVec2::ONE, UVec2::splat(LIMIT as u32))
+        .as_ivec2();
     let p = frag_coord
         .floor()
         .clamp(Vec2::splat(-16_777_216.0), Vec2::splat(16_777_216.0));
     let p = IVec2::new(p.x as i32, p.y as i32);
-    ((p % s + s) % s).as_uvec2()
+    // Shifted by a multiple of s to non-negative first, as the shaders do.
+    ((p + s * (IVec2::splat(LIMIT) / s + 1)) % s).as_uvec2()
 }
 
 /// Where a fragment at framebuffer position `frag_coord` is expected in the next frame: as far

@@ -57,9 +57,12 @@ pub struct LodDrawUniform {
     pub alpha_rect: [f32; 4],
 }
 
-/// The cameras of a LOD buffer frame. The previous frame's view-projection only matters for
-/// objects that move by themselves (their object motion is measured in its view); a `Mat4`
-/// converts to a view with no previous frame.
+/// The cameras of a LOD buffer frame. The previous frame's view-projection matters whenever the
+/// camera or an object moves: the screen-anchored visibility pattern predicts from it where each
+/// fragment is displayed next frame, and objects that move by themselves have their object
+/// motion measured in its view. A `Mat4` converts to a view with no previous frame (a still
+/// camera, the first frame, a cut); under a moving camera it leaves the older buffer's flags
+/// looked up under the wrong pixels, and those pixels show both LODs' average.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LodView {
     /// Projection x view of this frame.

@@ -143,7 +143,7 @@ uvec2 lodkit_combine_ring_texel(uvec2 center, uvec2 size, uint k) {
         int s = int((k - 1u) % 2u) * 2 - 1;
         offset = k <= 2u ? ivec2(s, 0) : ivec2(0, s);
     }
-    return uvec2(clamp(ivec2(center) + offset, ivec2(0), ivec2(size) - ivec2(1)));
+    return uvec2(clamp(ivec2(center) + offset, ivec2(0), ivec2(max(size, uvec2(1u))) - ivec2(1)));
 }
 
 /// The k-th texel of the 3x3 block around `c` in id texture `oid`.

@@ -82,11 +82,13 @@ uint lodkit_visibility_flags_of(float v, float tau_now, float tau_next) {
     lodkit_visibility_flags_of(LODKIT_VISIBILITY_VALUE_(vis_tex, object_pos), (tau_now), (tau_next))
 
 /// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
-/// under framebuffer position `frag_coord` (repeat addressing, either sign; clamped to +-2^24).
+/// under framebuffer position `frag_coord` (repeat addressing, either sign; the position clamped
+/// to +-2^24, the size to 1..2^24). The modulo runs on non-negative integers only (GLSL leaves %
+/// of negative operands undefined).
 uvec2 lodkit_visibility_screen_texel(uvec2 size, vec2 frag_coord) {
-    ivec2 s = ivec2(max(size, uvec2(1u)));
+    ivec2 s = ivec2(clamp(size, uvec2(1u), uvec2(16777216u)));
     ivec2 p = ivec2(clamp(floor(frag_coord), vec2(-16777216.0), vec2(16777216.0)));
-    return uvec2(((p % s) + s) % s);
+    return uvec2((p + s * (ivec2(16777216) / s + 1)) % s);
 }
 
 /// Where a fragment at `frag_coord` is expected in the next frame: as far again as it moved

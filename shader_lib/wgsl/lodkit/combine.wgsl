@@ -170,7 +170,7 @@ fn combine_ring_texel(center: vec2<u32>, size: vec2<u32>, k: u32) -> vec2<u32> {
         let sign = i32((k - 1u) % 2u) * 2 - 1;
         offset = select(vec2<i32>(0, sign), vec2<i32>(sign, 0), k <= 2u);
     }
-    return vec2<u32>(clamp(vec2<i32>(center) + offset, vec2<i32>(0), vec2<i32>(size) - vec2<i32>(1)));
+    return vec2<u32>(clamp(vec2<i32>(center) + offset, vec2<i32>(0), vec2<i32>(max(size, vec2<u32>(1u))) - vec2<i32>(1)));
 }
 
 /// The first texel of the 3x3 block around `center` (combine_ring_texel order) whose id word in

@@ -97,12 +97,12 @@ fn visibility_flags(vis_tex: texture_2d<f32>, object_pos: vec3<f32>, tau_now: f3
 }
 
 /// The texel of a `size` visibility texture tiled over the framebuffer, one texel per pixel,
-/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign; clamped to
-/// +-2^24 pixels).
+/// under framebuffer position `frag_coord` (pixels; repeat addressing, either sign; the position
+/// clamped to +-2^24 pixels, the size to 1..2^24). The modulo runs on non-negative integers only.
 fn visibility_screen_texel(size: vec2<u32>, frag_coord: vec2<f32>) -> vec2<u32> {
-    let s = vec2<i32>(max(size, vec2<u32>(1u)));
+    let s = vec2<i32>(clamp(size, vec2<u32>(1u), vec2<u32>(16777216u)));
     let p = vec2<i32>(clamp(floor(frag_coord), vec2<f32>(-16777216.0), vec2<f32>(16777216.0)));
-    return vec2<u32>(((p % s) + s) % s);
+    return vec2<u32>((p + s * (vec2<i32>(16777216) / s + 1)) % s);
 }
 
 /// Where a fragment at framebuffer position `frag_coord` is expected in the next frame: as far
