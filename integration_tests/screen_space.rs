@@ -6,7 +6,7 @@
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
+use lodkit::gpu::lod_buffer_scene::{LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture;
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::shaders::SourceLanguage;
@@ -144,7 +144,8 @@ struct Agreement {
 fn a_screen_anchored_pattern_holds_still_while_the_object_slides() {
     const W: u32 = 96;
     let gpu = lodkit_test_gpu!();
-    let lods = SphereLods::new(gpu, W);
+    let mut lods = SphereLods::new(gpu, W);
+    // The texture SphereLods' renderer draws with.
     let tex = visibility_texture(VisibilityPattern::BlueNoise, 64, 2);
     let look = glam::camera::rh::view::look_at_mat4(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y);
     let view_proj = lods.proj * look;
@@ -154,9 +155,8 @@ fn a_screen_anchored_pattern_holds_still_while_the_object_slides() {
     let mut rows = Vec::new();
     let mut results = Vec::new();
     for space in [VisibilitySpace::Screen, VisibilitySpace::Object] {
-        let mut renderer = LodBufferRenderer::new(gpu, SphereLods::FORMAT, &tex, 1.0).unwrap();
-        renderer.set_visibility_space(space);
-        assert_eq!(renderer.visibility_space(), space);
+        lods.renderer.set_visibility_space(space);
+        assert_eq!(lods.renderer.visibility_space(), space);
         let buffers = LodBuffers::new(gpu, W, W, SphereLods::FORMAT).unwrap();
         let mut s = TransitionScheduler::with_schedule(Schedule::Complementary);
         let key = s.insert(0);
@@ -189,16 +189,7 @@ fn a_screen_anchored_pattern_holds_still_while_the_object_slides() {
                 0 => CombinePass::NO_HISTORY,
                 _ => new_to_old_matrix(&look, &lods.proj, &look, &lods.proj),
             };
-            let combined = frame_with(
-                gpu,
-                &lods,
-                &renderer,
-                &buffers,
-                s.buffer_index(),
-                view,
-                item,
-                m,
-            );
+            let combined = lods.frame(gpu, &buffers, s.buffer_index(), view, item, m);
             if f < 3 {
                 // Both buffers hold the transition from frame 2 on.
                 previous = Some(combined);
@@ -254,34 +245,4 @@ fn a_screen_anchored_pattern_holds_still_while_the_object_slides() {
         "anchored to the object, the pattern should slide: {}",
         rows[1]
     );
-}
-
-/// [`SphereLods::frame`] through another LOD buffer renderer.
-#[allow(clippy::too_many_arguments)]
-fn frame_with(
-    gpu: &lodkit::gpu::GpuContext,
-    lods: &SphereLods,
-    renderer: &LodBufferRenderer,
-    buffers: &LodBuffers,
-    index: usize,
-    view: LodView,
-    item: LodDrawItem,
-    new_to_old: Mat4,
-) -> Vec<u8> {
-    renderer
-        .render(gpu, buffers, index, view, &[item], wgpu::Color::BLACK, None)
-        .unwrap();
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    lods.combine
-        .encode(
-            gpu,
-            &mut encoder,
-            buffers,
-            index,
-            new_to_old,
-            &lods.target_view,
-        )
-        .unwrap();
-    gpu.queue.submit([encoder.finish()]);
-    lodkit::gpu::readback::read_texture_rgba8(gpu, &lods.target).unwrap()
 }
