@@ -4,7 +4,8 @@
 //! inside the file it names.
 
 use lodkit::shaders::{
-    ComposeDescriptor, DiagnosticKind, ShaderError, ShaderLibrary, SourceLanguage, naga,
+    ComposeDescriptor, DiagnosticKind, ExportOptions, ExportTarget, ShaderError, ShaderLibrary,
+    SourceLanguage, naga,
 };
 use proptest::prelude::*;
 
@@ -170,6 +171,95 @@ fn wgsl_nested_twenty_thousand_deep_is_an_error() {
     assert_reportable(&e, &source);
 }
 
+#[test]
+fn glsl_chains_under_the_expression_limit_parse_on_the_parser_thread() {
+    // The limit counts every chained operator; just under it naga's parser and its lowering
+    // recurse about that deep, and the parser thread's stack holds it in a debug build.
+    let n = lodkit::shaders::MAX_EXPRESSION_DEPTH - 64;
+    // `unit` adds `per` to the count (its operators and keywords) and one recursion level.
+    let chain = |prefix: &str, unit: &str, per: usize, suffix: &str| {
+        format!(
+            "#version 450\nlayout(location = 0) out vec4 o;\nvoid main() {{ float v = 0.0; {prefix}{}{suffix} o = vec4(v); }}\n",
+            unit.repeat(n / per)
+        )
+    };
+    for (what, source) in [
+        ("sum", chain("v = ", "1.0 + ", 1, "1.0;")),
+        ("negation", chain("v = ", "- ", 1, "1.0;")),
+        ("ternary", chain("v = ", "true ? 1.0 : ", 2, "1.0;")),
+        ("assignment", chain("", "v = ", 1, "1.0;")),
+        (
+            "else if",
+            chain("", "if (v > 0.0) v = 1.0; else ", 1, "v = 2.0;"),
+        ),
+        ("nested if", chain("", "if (v > 0.0) ", 1, "v = 2.0;")),
+    ] {
+        let stage = SourceLanguage::Glsl(naga::ShaderStage::Fragment);
+        let mut library = ShaderLibrary::new().expect("the library composes");
+        let composed = library.compose(&ComposeDescriptor {
+            source: &source,
+            file_path: "chain.frag",
+            language: stage,
+            ..Default::default()
+        });
+        match composed {
+            // Every back end writes it too (they recurse as deep).
+            Ok(composed) => {
+                for target in [ExportTarget::SpirV, ExportTarget::Glsl, ExportTarget::Wgsl] {
+                    let options = ExportOptions::default();
+                    lodkit::shaders::export(&composed, target, &options)
+                        .unwrap_or_else(|e| panic!("{what} to {target:?}: {e}"));
+                }
+            }
+            Err(e) => {
+                let d = e.diagnostic().expect("a source diagnostic");
+                assert_ne!(d.kind, DiagnosticKind::Limit, "{what} is under the limit");
+            }
+        }
+    }
+}
+
+/// A tower of function-like macros, each wrapping the one below `fan` times, with `unit` (a
+/// bracket pair, a doubling, or an unbalanced opener) at the bottom.
+fn macro_tower(levels: usize, fan: usize, unit: usize) -> String {
+    let bottom = match unit {
+        0 => "#define M0(x) (x)\n".to_owned(),
+        1 => "#define M0(x) x + x\n".to_owned(),
+        _ => "#define O (\n#define M0(x) O x\n".to_owned(),
+    };
+    let mut src = format!("#version 450\n{bottom}");
+    for i in 1..=levels {
+        let below = format!("M{}(", i - 1);
+        src += &format!(
+            "#define M{i}(x) {}x{}\n",
+            below.repeat(fan),
+            ")".repeat(fan)
+        );
+    }
+    src + &format!(
+        "layout(location = 0) out vec4 o;\nvoid main() {{ float v = M{levels}(1.0); o = vec4(v); }}\n"
+    )
+}
+
+/// An identifier with non-ASCII letters in it (WGSL and GLSL identifiers are Unicode).
+fn identifier() -> impl Strategy<Value = String> {
+    let first = prop::sample::select(vec!['g', 'ä', 'ß', 'é', 'λ', '中', 'ñ', 'Ж', '_']);
+    let rest = prop::sample::select(vec!['a', 'ö', 'ß', '1', '_', 'ê', '字', 'ø', 'x']);
+    (first, prop::collection::vec(rest, 1..6))
+        .prop_map(|(f, r)| std::iter::once(f).chain(r).collect::<String>())
+        .prop_filter("not a reserved word's shape", |s| s != "_")
+}
+
+/// A user module folder holding `module` as `my/m.wgsl`, and a library that imports it.
+fn library_with_module(module: &str) -> Result<ShaderLibrary, ShaderError> {
+    let dir = crate::support::scratch("mods");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("m.wgsl"), module).unwrap();
+    let mut library = ShaderLibrary::new().expect("the library composes");
+    library.add_import_dirs(&[dir])?;
+    Ok(library)
+}
+
 /// A character a user may type by accident, non-ASCII ones included.
 fn noise() -> impl Strategy<Value = String> {
     let chars = prop::sample::select(vec![
@@ -222,6 +312,55 @@ proptest! {
     fn mutated_glsl_never_panics(anchor in 0usize..6, at in any::<usize>(), text in noise(), delete in 0usize..3) {
         let source = mutate(GLSL, anchor, at, &text, delete);
         if let Err(e) = compose(&source, "user.frag", SourceLanguage::Glsl(naga::ShaderStage::Fragment)) {
+            assert_reportable(&e, &source);
+        }
+    }
+
+    #[test]
+    fn macro_towers_end_in_a_module_or_a_limit_error(levels in 1usize..7, fan in 1usize..13, unit in 0usize..3) {
+        let source = macro_tower(levels, fan, unit);
+        let stage = SourceLanguage::Glsl(naga::ShaderStage::Fragment);
+        if let Err(e) = compose(&source, "user.frag", stage) {
+            assert_reportable(&e, &source);
+        }
+    }
+
+    #[test]
+    fn non_ascii_identifiers_in_user_modules_never_panic(name in identifier(), broken in any::<bool>()) {
+        // A parse error (a missing `;`) or a validation error (a vec2 where an f32 goes), or none.
+        let body = if broken { "return vec2(x);" } else { "return x * 2.0" };
+        let module = format!("#define_import_path my::m\nfn {name}(x: f32) -> f32 {{ {body} }}\n");
+        let shader = format!(
+            "#import my::m::{name}\n@fragment fn main() -> @location(0) vec4<f32> {{ return vec4<f32>({name}(1.0)); }}\n"
+        );
+        match library_with_module(&module) {
+            Ok(mut library) => {
+                let composed = library.compose(&ComposeDescriptor {
+                    source: &shader,
+                    file_path: "user.wgsl",
+                    ..Default::default()
+                });
+                if let Err(e) = composed {
+                    assert_reportable(&e, &shader);
+                }
+            }
+            Err(e) => assert_reportable(&e, &module),
+        }
+    }
+
+    #[test]
+    fn non_ascii_identifiers_in_user_shaders_never_panic(name in identifier(), error in 0usize..3, wesl in any::<bool>()) {
+        // Valid, a validation error (an f32 where a u32 goes), or a parse error (a stray `)`).
+        let value = ["1.0", "1u", "1.0)"][error];
+        let (head, language, file) = if wesl {
+            ("import lodkit::unpopping::unpopping_alpha;", SourceLanguage::Wesl, "user.wesl")
+        } else {
+            ("#import lodkit::unpopping::unpopping_alpha", SourceLanguage::Wgsl, "user.wgsl")
+        };
+        let source = format!(
+            "{head}\n@fragment fn main() -> @location(0) vec4<f32> {{\n    let {name}: f32 = {value};\n    return vec4<f32>(unpopping_alpha({name}, true));\n}}\n"
+        );
+        if let Err(e) = compose(&source, file, language) {
             assert_reportable(&e, &source);
         }
     }

@@ -173,6 +173,48 @@ fn non_utf8_file_names_the_byte() {
 }
 
 #[test]
+fn non_ascii_names_in_a_user_module_are_an_error_not_a_crash() {
+    // naga_oil refuses identifiers that need substitution under naga's writeback rules; mapping
+    // that error back once panicked on the multibyte character before the decorated name.
+    let module = "#define_import_path my::maß\nfn größe(x: f32) -> f32 { return x * 2.0; }\n";
+    let main = "#import my::maß::größe\n@fragment fn main() -> @location(0) vec4<f32> { return vec4<f32>(größe(1.0)); }\n";
+    let dir = fixture(&[
+        ("mods/m.wgsl", module.as_bytes()),
+        ("main.wgsl", main.as_bytes()),
+    ]);
+    let (code, _, stderr) = run(&dir, &["check", "-I", "mods", "main.wgsl"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("error["), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn macros_nested_a_hundred_thousand_deep_are_a_limit_error() {
+    // Eight lines that stand for 10^5 nested parentheses (and 10^6 with one more level).
+    let mut defs = String::from("#version 450\n#define A(x) ((((((((((x))))))))))\n");
+    for (name, inner) in [("B", "A"), ("C", "B"), ("D", "C"), ("E", "D"), ("F", "E")] {
+        defs += &format!(
+            "#define {name}(x) {}x{}\n",
+            format!("{inner}(").repeat(10),
+            ")".repeat(10)
+        );
+    }
+    for top in ["E", "F"] {
+        let src = format!(
+            "{defs}layout(location = 0) out vec4 o;\nvoid main() {{ float v = {top}(1.0); o = vec4(v); }}\n"
+        );
+        let dir = fixture(&[("deep.frag", src.as_bytes())]);
+        let (code, _, stderr) = run(&dir, &["check", "deep.frag"]);
+        assert_eq!(code, 1, "{top}: {stderr}");
+        assert!(
+            stderr.contains("error[limit]") && stderr.contains("after macro expansion"),
+            "{top}: {stderr}"
+        );
+        assert!(stderr.contains("deep.frag:9:"), "{top}: {stderr}");
+    }
+}
+
+#[test]
 fn import_cycle_among_user_modules_is_named() {
     let a = b"#define_import_path my::a\n#import my::b::fb\nfn fa() -> f32 { return fb(); }\n";
     let b = b"#define_import_path my::b\n#import my::a::fa\nfn fb() -> f32 { return fa(); }\n";

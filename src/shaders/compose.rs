@@ -373,16 +373,7 @@ impl ShaderLibrary {
         stage: naga::ShaderStage,
     ) -> Result<Composed, ShaderError> {
         let expanded = glsl::expand_includes(desc.file_path, desc.source, &self.include_dirs)?;
-        // naga's GLSL front end recurses once per nesting level with no limit of its own.
-        if let Some(nesting) = super::limits::too_deep(&expanded.text) {
-            let message = nesting.message();
-            let d = expanded.diagnostic(DiagnosticKind::Limit, nesting.at, message);
-            return Err(ShaderError::Source(Box::new(
-                d.with_label("nested too deep")
-                    .with_hint("split the expression into `let`/local variables"),
-            )));
-        }
-        let defines = desc
+        let defines: Vec<(String, String)> = desc
             .shader_defs
             .iter()
             .map(|(k, v)| {
@@ -394,29 +385,44 @@ impl ShaderLibrary {
                 (k.clone(), v)
             })
             .collect();
-        let options = naga::front::glsl::Options { stage, defines };
-        // naga's GLSL parser recurses once per nesting level and macros can nest past the
-        // bracket count checked above, so it runs on a thread with a deep stack.
+        // naga's GLSL front end recurses once per nesting level with no limit of its own, and
+        // macros can stand for any nesting: the brackets as written, then bounds on what the
+        // macros expand to, then the expanded tokens themselves (see `limits`).
         let text = expanded.text.as_str();
-        let parse = || naga::front::glsl::Frontend::default().parse(&options, text);
-        let parsed = std::thread::scope(|scope| {
-            match std::thread::Builder::new()
-                .name("lodkit-glsl-parser".into())
-                .stack_size(super::limits::GLSL_PARSER_STACK)
-                .spawn_scoped(scope, parse)
-            {
-                Ok(handle) => handle.join().map_err(|_| ()),
-                Err(_) => Ok(parse()),
-            }
-        })
-        .map_err(|()| {
+        let too_deep = super::limits::too_deep(text)
+            .or_else(|| super::macros::too_large(text, &defines))
+            .or_else(|| super::limits::expression_too_deep(text, &defines));
+        if let Some(nesting) = too_deep {
+            let message = nesting.message();
+            let d = expanded.diagnostic(DiagnosticKind::Limit, nesting.at, message);
+            return Err(ShaderError::Source(Box::new(
+                d.with_label("nested too deep")
+                    .with_hint("split the expression into local variables"),
+            )));
+        }
+        let options = naga::front::glsl::Options {
+            stage,
+            defines: defines.into_iter().collect(),
+        };
+        // Within the limits above naga's parser still recurses thousands of levels deep, and the
+        // validator recurses once per nested block (a `?:` chain nests as deep): both run on a
+        // thread with a deep stack.
+        let capabilities = self.capabilities;
+        let parse_and_validate = || {
+            let module = naga::front::glsl::Frontend::default().parse(&options, text)?;
+            let info =
+                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
+                    .validate(&module);
+            Ok((module, info))
+        };
+        let parsed = super::limits::on_deep_stack(parse_and_validate).map_err(|()| {
             ShaderError::Source(Box::new(expanded.diagnostic(
                 DiagnosticKind::Parse,
                 0..0,
                 "naga's GLSL front end failed on this file (it panicked)".into(),
             )))
         })?;
-        let module = parsed.map_err(|e| {
+        let (module, info) = parsed.map_err(|e: naga::front::glsl::ParseErrors| {
             let first = e.errors.first();
             let span = first.and_then(|e| e.meta.to_range()).unwrap_or(0..0);
             let message = first.map(|e| e.kind.to_string()).unwrap_or_default();
@@ -426,23 +432,20 @@ impl ShaderLibrary {
             }
             ShaderError::Source(Box::new(d))
         })?;
-        let info =
-            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), self.capabilities)
-                .validate(&module)
-                .map_err(|e| {
-                    let span = e
-                        .spans()
-                        .next()
-                        .and_then(|(s, _)| s.to_range())
-                        .unwrap_or(0..0);
-                    let (file, source, range) = expanded.locate(span.clone()).unwrap_or((
-                        desc.file_path.to_owned(),
-                        Arc::from(""),
-                        0..0,
-                    ));
-                    let d = validation_diagnostic(&e, file, source, |_| range.clone());
-                    ShaderError::Source(Box::new(d))
-                })?;
+        let info = info.map_err(|e| {
+            let span = e
+                .spans()
+                .next()
+                .and_then(|(s, _)| s.to_range())
+                .unwrap_or(0..0);
+            let (file, source, range) = expanded.locate(span.clone()).unwrap_or((
+                desc.file_path.to_owned(),
+                Arc::from(""),
+                0..0,
+            ));
+            let d = validation_diagnostic(&e, file, source, |_| range.clone());
+            ShaderError::Source(Box::new(d))
+        })?;
         Ok(Composed { module, info })
     }
 }

@@ -204,9 +204,13 @@ pub(crate) fn undecorate(text: &str) -> String {
     let mut rest = text;
     while let Some(i) = rest.find(PRE) {
         let head = &rest[..i];
+        // The item is the identifier run before the marker; the character that ends it may be
+        // multibyte, so the run starts after that whole character, not one byte after it.
         let item_start = head
-            .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
-            .map_or(0, |j| j + 1);
+            .char_indices()
+            .rev()
+            .find(|&(_, c)| !is_identifier_char(c))
+            .map_or(0, |(j, c)| j + c.len_utf8());
         let tail = &rest[i + PRE.len()..];
         let end = tail
             .find(|c: char| !(c.is_ascii_uppercase() || ('2'..='7').contains(&c)))
@@ -216,7 +220,8 @@ pub(crate) fn undecorate(text: &str) -> String {
         let decoded = data_encoding::BASE32_NOPAD
             .decode(encoded.as_bytes())
             .ok()
-            .and_then(|b| String::from_utf8(b).ok());
+            .and_then(|b| String::from_utf8(b).ok())
+            .filter(|module| !module.is_empty());
         match decoded {
             Some(module) => {
                 out.push_str(&head[..item_start]);
@@ -235,6 +240,12 @@ pub(crate) fn undecorate(text: &str) -> String {
     out
 }
 
+/// Whether `c` may stand in an identifier (WGSL and GLSL identifiers are Unicode XID runs; naga_oil
+/// refuses the non-ASCII ones, but its messages quote them).
+fn is_identifier_char(c: char) -> bool {
+    c.is_alphanumeric() || c == '_'
+}
+
 /// Masks naga_oil's module index out of a span and makes it relative to the module's source.
 fn local_span(range: Range<usize>, offset: usize) -> Range<usize> {
     const SPAN_MASK: usize = (1 << 21) - 1;
@@ -246,7 +257,7 @@ fn path_token(source: &str, pos: usize) -> Range<usize> {
     let len = source
         .get(pos..)
         .map(|s| {
-            s.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == ':'))
+            s.find(|c: char| !(is_identifier_char(c) || c == ':'))
                 .unwrap_or(s.len())
         })
         .unwrap_or(0);
@@ -410,6 +421,21 @@ mod tests {
         // A module path whose base32 form itself ends in `X`.
         let name = naga_oil::compose::Composer::decorated_name(Some("mesh::draw"), "f");
         assert_eq!(undecorate(&format!("`{name}`")), "`mesh::draw::f`");
+    }
+
+    #[test]
+    fn undecorate_steps_over_whole_multibyte_characters() {
+        let name = naga_oil::compose::Composer::decorated_name(Some("my::mod"), "f");
+        // The character before the name ends the identifier run: 2, 3 and 4 bytes long.
+        assert_eq!(undecorate(&format!("·{name}")), "·my::mod::f");
+        assert_eq!(undecorate(&format!("€{name}")), "€my::mod::f");
+        assert_eq!(undecorate(&format!("😀{name}")), "😀my::mod::f");
+        // Non-ASCII letters are identifier characters and stay with the item.
+        assert_eq!(undecorate(&format!("`größe{name}`")), "`my::mod::größef`");
+        assert_eq!(
+            undecorate("`größe` X_naga_oil_mod_X"),
+            "`größe` X_naga_oil_mod_X"
+        );
     }
 
     #[test]

@@ -97,8 +97,22 @@ impl Exported {
     }
 }
 
-/// Writes `composed` with the back end `target`.
+/// Writes `composed` with the back end `target`. The back ends recurse once per nested block
+/// and expression, which composed GLSL may nest thousands deep: they run on a deep-stack thread.
 pub fn export(
+    composed: &Composed,
+    target: ExportTarget,
+    options: &ExportOptions,
+) -> Result<Exported, ShaderError> {
+    super::limits::on_deep_stack(|| write(composed, target, options)).unwrap_or_else(|()| {
+        Err(ShaderError::Export {
+            target,
+            message: "naga's back end panicked on this module".into(),
+        })
+    })
+}
+
+fn write(
     composed: &Composed,
     target: ExportTarget,
     options: &ExportOptions,

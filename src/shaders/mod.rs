@@ -29,6 +29,8 @@ mod imports;
 mod limits;
 #[cfg(feature = "compose")]
 mod loading;
+#[cfg(feature = "compose")]
+mod macros;
 mod registry;
 mod wesl;
 #[cfg(feature = "wesl")]
@@ -51,7 +53,7 @@ pub use diagnostic::{Diagnostic, DiagnosticKind, Location};
 #[cfg(feature = "compose")]
 pub use export::{ExportOptions, ExportTarget, Exported, export};
 #[cfg(feature = "compose")]
-pub use limits::MAX_NESTING;
+pub use limits::{MAX_EXPANDED_TOKENS, MAX_EXPRESSION_DEPTH, MAX_MACRO_CALL_NESTING, MAX_NESTING};
 #[cfg(feature = "compose")]
 pub use naga;
 #[cfg(feature = "compose")]
