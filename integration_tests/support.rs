@@ -6,7 +6,7 @@
 //! stderr (past the test harness's capture), so a skip is never silent. Browser checks follow the
 //! same rule with `LODKIT_REQUIRE_BROWSER=1`.
 
-#![allow(dead_code)] // each test crate uses its own part
+#![allow(dead_code, unused_macros)] // each test crate uses its own part
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -102,11 +102,47 @@ pub fn gpu() -> Result<&'static GpuContext, String> {
     gpu.as_ref().map_err(Clone::clone)
 }
 
+/// On wgpu's GL backend, GPU tests run one at a time: each takes this lock in `gpu_or_skip` and
+/// holds it until its thread ends. lodkit's own calls pass through the context's GL gate, but
+/// the tests also drive the device directly (probes, fixtures), and a GL driver can hold wgpu's
+/// GL context lock for seconds (a cold shader link): another test waiting in that lock would
+/// panic after 6 s. `gl_threads` tests what lodkit promises to threads sharing a GL device.
+static GL_TESTS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+thread_local! {
+    /// The calling GPU test's hold of [`GL_TESTS`], released when the test's thread ends. (Only
+    /// the lock: wgpu cannot be called from a thread-local destructor, its own thread-locals
+    /// may be gone by then.)
+    static GL_TEST_HOLD: std::cell::RefCell<Option<std::sync::MutexGuard<'static, ()>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Serializes the calling test with the other GPU tests when the device is GL (see
+/// [`GL_TESTS`]); already held when this thread has it.
+fn serialize_on_gl(gpu: &GpuContext) {
+    if gpu.adapter.get_info().backend != wgpu::Backend::Gl {
+        return;
+    }
+    GL_TEST_HOLD.with(|hold| {
+        let mut hold = hold.borrow_mut();
+        if hold.is_none() {
+            *hold = Some(
+                GL_TESTS
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner),
+            );
+        }
+    });
+}
+
 /// The shared GPU; with none, panics under `LODKIT_REQUIRE_GPU=1`, else returns `None` after
 /// saying the calling test was skipped.
 pub fn gpu_or_skip() -> Option<&'static GpuContext> {
     match gpu() {
-        Ok(g) => Some(g),
+        Ok(g) => {
+            serialize_on_gl(g);
+            Some(g)
+        }
         Err(e) if strict() => panic!("LODKIT_REQUIRE_GPU=1 but there is no GPU adapter: {e}"),
         Err(e) => {
             say(&format!(

@@ -1,6 +1,14 @@
 //! A headless wgpu device: Vulkan first (a real GPU or lavapipe), OpenGL (llvmpipe) as fallback,
 //! with the error handling every lodkit call goes through: error scopes around the call, a handler
 //! that records errors raised outside them, and device-loss tracking.
+//!
+//! On wgpu's GL backend every GL call takes one context lock, and a thread that waits more than
+//! 6 s for it panics ("Could not lock adapter context"). A GL driver can hold that lock for
+//! seconds in one call: llvmpipe links a large shader in several seconds when its shader cache is
+//! cold, and a fence wait holds it while the GPU works. So on GL a [`GpuContext`] also has a gate:
+//! every lodkit call passes through it one at a time, and waits there without a time limit
+//! instead of in wgpu's lock. Engine code that uses the same device from several threads runs its
+//! own device work through [`GpuContext::exclusive`].
 
 use std::borrow::Cow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -37,6 +45,8 @@ pub struct GpuContext {
     /// Its queue.
     pub queue: wgpu::Queue,
     state: Arc<DeviceState>,
+    /// On GL: taken by every lodkit call, so that two never meet in wgpu's timed context lock.
+    gate: Option<Mutex<()>>,
 }
 
 /// What the device callbacks recorded.
@@ -142,6 +152,7 @@ impl GpuContext {
         device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
             recorder.record_error(error.to_string());
         }));
+        let gl = adapter.get_info().backend == wgpu::Backend::Gl;
         let recorder = Arc::clone(&state);
         device.set_device_lost_callback(move |reason, message| {
             let message = if message.is_empty() {
@@ -157,17 +168,42 @@ impl GpuContext {
             device,
             queue,
             state,
+            gate: gl.then(|| Mutex::new(())),
         }
+    }
+
+    /// Runs `f` (work on this context's device) while no lodkit call runs on it. On wgpu's GL
+    /// backend lodkit's calls pass one at a time through a gate, and this takes the same gate:
+    /// an engine that uses the device from several threads besides lodkit's calls runs its
+    /// device work through it, so that no thread waits in wgpu's GL context lock, which panics
+    /// after 6 s (a cold shader link can hold it longer). On other backends it just runs `f`.
+    /// Calls nest: lodkit calls made inside `f` do not wait for the gate again.
+    pub fn exclusive<T>(&self, f: impl FnOnce() -> T) -> T {
+        let _gate = self.gate();
+        f()
+    }
+
+    /// This thread's hold of the GL gate; `None` off GL or when this thread holds it already.
+    fn gate(&self) -> Option<GateHold<'_>> {
+        let gate = self.gate.as_ref()?;
+        if GATE_HELD.with(|held| held.replace(true)) {
+            return None;
+        }
+        let guard = gate.lock().unwrap_or_else(PoisonError::into_inner);
+        Some(GateHold(guard))
     }
 
     /// `Ok` while the device is alive and no error was recorded outside lodkit's calls;
     /// otherwise [`GpuError::DeviceLost`], or [`GpuError::Uncaptured`] with the recorded errors
     /// (which it clears). `call` names the caller in the error. Every lodkit call runs it first.
     pub fn check(&self, call: &'static str) -> Result<(), GpuError> {
+        let _gate = self.gate();
         // wgpu notices a destroyed device, and calls the lost callback, when it is polled. A
         // device the driver lost makes wgpu 30's poll panic instead of returning an error; that
         // panic is caught here and reported as a lost device.
-        self.poll(wgpu::PollType::Poll);
+        if self.poll(wgpu::PollType::Poll) == Polled::ContextTimeout {
+            return Err(GpuError::ContextTimeout { call });
+        }
         if let Some((reason, message)) = self.state.lost() {
             return Err(GpuError::DeviceLost {
                 call,
@@ -196,6 +232,7 @@ impl GpuContext {
         let Some(_outermost) = Outermost::enter() else {
             return f();
         };
+        let _gate = self.gate();
         self.check(call)?;
         let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -211,16 +248,29 @@ impl GpuContext {
         }
     }
 
-    /// Polls the device; a panic inside wgpu's poll (its answer to a driver-lost device) is
-    /// caught and recorded as a lost device.
-    fn poll(&self, poll_type: wgpu::PollType) {
-        let polled = catch_unwind(AssertUnwindSafe(|| self.device.poll(poll_type)));
-        if polled.is_err() {
-            self.state.record_lost(
-                "Unknown".into(),
-                "wgpu panicked while polling the device".into(),
-            );
+    /// Polls the device. A panic inside wgpu's poll is caught: wgpu's GL backend panics when
+    /// another thread held the GL context for more than 6 s, which loses nothing (this call
+    /// timed out; the next may go through); any other panic is wgpu's answer to a driver-lost
+    /// device and is recorded as one.
+    fn poll(&self, poll_type: wgpu::PollType) -> Polled {
+        let panic = match catch_unwind(AssertUnwindSafe(|| self.device.poll(poll_type))) {
+            Ok(Err(wgpu::PollError::Timeout)) => return Polled::WaitTimedOut,
+            Ok(_) => return Polled::Done,
+            Err(panic) => panic,
+        };
+        let message = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        if message.contains(GL_LOCK_TIMEOUT) {
+            return Polled::ContextTimeout;
         }
+        self.state.record_lost(
+            "Unknown".into(),
+            format!("wgpu panicked while polling the device: {message}"),
+        );
+        Polled::Lost
     }
 
     /// What the device can do with `format`: the adapter's own answer when the device has
@@ -290,15 +340,51 @@ impl GpuContext {
     /// hang or a panic.
     pub fn wait_idle(&self) -> Result<(), GpuError> {
         const CALL: &str = "GpuContext::wait_idle";
+        let _gate = self.gate();
         self.check(CALL)?;
-        self.poll(wgpu::PollType::wait_indefinitely());
+        // wgpu's GL backend waits at most about 4.3 s per fence wait and then reports a
+        // timeout, though the work goes on: wait again until it is done.
+        loop {
+            match self.poll(wgpu::PollType::wait_indefinitely()) {
+                Polled::WaitTimedOut => continue,
+                Polled::ContextTimeout => return Err(GpuError::ContextTimeout { call: CALL }),
+                Polled::Done | Polled::Lost => break,
+            }
+        }
         self.check(CALL)
+    }
+}
+
+/// How a poll went.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Polled {
+    Done,
+    /// A wait ended before the work it waited for.
+    WaitTimedOut,
+    /// wgpu's GL backend gave up waiting for its context lock.
+    ContextTimeout,
+    /// wgpu panicked otherwise: the device is lost.
+    Lost,
+}
+
+/// What wgpu-hal's GL backend panics with when it waited too long for its context lock.
+const GL_LOCK_TIMEOUT: &str = "Could not lock adapter context";
+
+/// This thread's hold of a context's GL gate (see [`GpuContext::exclusive`]).
+struct GateHold<'a>(#[allow(dead_code)] std::sync::MutexGuard<'a, ()>);
+
+impl Drop for GateHold<'_> {
+    fn drop(&mut self) {
+        GATE_HELD.with(|held| held.set(false));
     }
 }
 
 thread_local! {
     /// Whether this thread is inside a guarded lodkit call.
     static GUARDED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Whether this thread holds a context's GL gate (one context's at a time: an engine with two
+    /// GL contexts on one thread nests their gates by hand).
+    static GATE_HELD: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 /// Marks this thread as inside a guarded call until dropped (also when unwinding).

@@ -138,6 +138,30 @@ pub enum GpuError {
         /// wgpu's message.
         message: String,
     },
+    /// More draw items than one call of a renderer takes (its `MAX_DRAWS`). Nothing was drawn:
+    /// split the items over several calls (the later ones loading what the first drew), or
+    /// merge meshes.
+    #[error("{call}: {count} draw items, but one call draws at most {max} (MAX_DRAWS)")]
+    TooManyDraws {
+        /// The lodkit call.
+        call: &'static str,
+        /// The items given.
+        count: usize,
+        /// The most one call takes.
+        max: usize,
+    },
+    /// wgpu's GL backend gave up waiting for its GL context lock (6 s): another thread held the
+    /// context, outside lodkit's calls (they pass one at a time, see
+    /// [`GpuContext::exclusive`]). Nothing is lost: the call did nothing and may be retried.
+    #[error(
+        "{call}: wgpu's GL backend waited more than 6 s for the GL context, which another \
+         thread held; nothing was lost, retry, and run that thread's device work through \
+         GpuContext::exclusive"
+    )]
+    ContextTimeout {
+        /// The lodkit call.
+        call: &'static str,
+    },
     /// Copying data back to the CPU failed.
     #[error("{call}: reading back from the GPU failed: {reason}")]
     Readback {

@@ -142,7 +142,8 @@ impl GBufferRenderer {
         self.shading_work = n;
     }
 
-    /// Renders `items` into `target` at resize factor `r` (the viewport shrinks with r; the
+    /// Renders `items` (at most [`Self::MAX_DRAWS`]: more is [`GpuError::TooManyDraws`]) into
+    /// `target` at resize factor `r` (the viewport shrinks with r; the
     /// textures do not change), cleared to `clear` with geometry (`far_view_depth`, +z).
     /// `target` must have the color format the renderer was built for.
     #[allow(clippy::too_many_arguments)]
@@ -159,6 +160,7 @@ impl GBufferRenderer {
     ) -> Result<(), GpuError> {
         const CALL: &str = "GBufferRenderer::render";
         same_color_format(CALL, "target", target.color_format(), self.color_format)?;
+        self.draws.check_count(CALL, items.len())?;
         gpu.guarded(CALL, || {
             let camera = GCameraUniform {
                 view_proj: (proj * view).to_cols_array_2d(),
@@ -176,13 +178,13 @@ impl GBufferRenderer {
                     color: i.color.to_array(),
                 })
                 .collect();
-            let n = self.draws.write(gpu, &uniforms)?;
+            self.draws.write(gpu, &uniforms)?;
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = target.begin_pass(&mut encoder, r, clear, far_view_depth);
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &self.camera_group, &[]);
-                for (i, item) in items[..n].iter().enumerate() {
+                for (i, item) in items.iter().enumerate() {
                     pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                     item.mesh.draw(&mut pass);
                 }

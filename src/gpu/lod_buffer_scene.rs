@@ -270,7 +270,8 @@ impl LodBufferRenderer {
         self.space = space;
     }
 
-    /// Renders `items` (at most [`Self::MAX_DRAWS`]) into buffer `index` of `buffers` seen by
+    /// Renders `items` (at most [`Self::MAX_DRAWS`]: more is [`GpuError::TooManyDraws`] and
+    /// draws nothing) into buffer `index` of `buffers` seen by
     /// `view`, cleared to `clear`, counting the pass's fragments with `counter` if given. Pass a
     /// [`LodView`] with the previous frame's view-projection whenever the camera or an object
     /// moves: the screen-anchored pattern predicts from it where each fragment is displayed next
@@ -293,9 +294,9 @@ impl LodBufferRenderer {
     ) -> Result<(u64, u64), GpuError> {
         const CALL: &str = "LodBufferRenderer::render";
         same_color_format(CALL, "buffers", buffers.color_format(), self.color_format)?;
+        self.draws.check_count(CALL, items.len())?;
         let view = view.into();
         gpu.guarded(CALL, || {
-            let items = &items[..items.len().min(self.draws.capacity())];
             let camera = LodCameraUniform {
                 view_proj: view.view_proj.to_cols_array_2d(),
                 prev_view_proj: view.prev_view_proj.to_cols_array_2d(),

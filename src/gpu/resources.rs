@@ -181,11 +181,24 @@ impl DrawUniforms {
         self.capacity
     }
 
-    /// Writes `items` (at most [`capacity`](Self::capacity); the rest are dropped) and returns
-    /// how many were written. An item larger than the item size the buffer was made for is
-    /// [`GpuError::Mismatch`].
+    /// `Ok` when `count` items fit, else [`GpuError::TooManyDraws`] naming `call`.
+    pub fn check_count(&self, call: &'static str, count: usize) -> Result<(), GpuError> {
+        if count > self.capacity {
+            return Err(GpuError::TooManyDraws {
+                call,
+                count,
+                max: self.capacity,
+            });
+        }
+        Ok(())
+    }
+
+    /// Writes `items` and returns how many were written. More than
+    /// [`capacity`](Self::capacity) items is [`GpuError::TooManyDraws`] (nothing is written); an
+    /// item larger than the item size the buffer was made for is [`GpuError::Mismatch`].
     pub fn write<T: Pod>(&self, gpu: &GpuContext, items: &[T]) -> Result<usize, GpuError> {
         const CALL: &str = "DrawUniforms::write";
+        self.check_count(CALL, items.len())?;
         let size = std::mem::size_of::<T>();
         if size as u64 > self.item_size {
             return Err(GpuError::Mismatch {
@@ -195,9 +208,9 @@ impl DrawUniforms {
                 expected: format!("the buffer was made for items of {} bytes", self.item_size),
             });
         }
-        let n = items.len().min(self.capacity);
+        let n = items.len();
         let mut data = vec![0u8; self.stride as usize * n];
-        for (item, slot) in items[..n].iter().zip(data.chunks_mut(self.stride as usize)) {
+        for (item, slot) in items.iter().zip(data.chunks_mut(self.stride as usize)) {
             slot[..size].copy_from_slice(bytemuck::bytes_of(item));
         }
         if !data.is_empty() {

@@ -349,8 +349,8 @@ impl MeshRenderer {
         Ok(())
     }
 
-    /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]; the
-    /// rest are dropped), lit from `light_dir`, counting the pass's fragments with `counter` if
+    /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]: more is
+    /// [`GpuError::TooManyDraws`] and draws nothing), lit from `light_dir`, counting the pass's fragments with `counter` if
     /// given. Returns the count (0 without a counter).
     ///
     /// The meshes and the counter must come from `gpu`'s device.
@@ -365,8 +365,9 @@ impl MeshRenderer {
         items: &[DrawItem],
         counter: Option<&FragmentCounter>,
     ) -> Result<u64, GpuError> {
-        gpu.guarded("MeshRenderer::render", || {
-            let items = &items[..items.len().min(self.draws.capacity())];
+        const CALL: &str = "MeshRenderer::render";
+        self.draws.check_count(CALL, items.len())?;
+        gpu.guarded(CALL, || {
             let camera = CameraUniform {
                 view_proj: view_proj.to_cols_array_2d(),
                 light_dir: light_dir.extend(0.0).to_array(),
