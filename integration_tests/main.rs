@@ -8,6 +8,7 @@ mod support;
 mod alpha_tested;
 mod composition;
 mod display_time;
+mod draw_limits;
 mod frame_sequential;
 mod frame_sequential_render;
 mod framebuffer_lod;

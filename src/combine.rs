@@ -4,7 +4,7 @@
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
 mod rects;
-pub use rects::{ScreenRect, merge_rects, screen_rect};
+pub use rects::{ScreenRect, displaced_bounds, merge_rects, screen_rect};
 
 /// One texel of a LOD buffer (mirror of WGSL `LodSample`).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -201,6 +201,36 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     };
     let scenes = DemoScene::built_in();
     let report = run_on(gpu, &options, &scenes).unwrap();
+    for t in &report.transitions {
+        say(&format!(
+            "demo figure {} {}: pop {:.3}/{:.3} see-through {:.4} silhouette {:.4} outside {}",
+            t.scene,
+            t.technique,
+            t.pop_static,
+            t.pop_moving,
+            t.see_through,
+            t.silhouette_error,
+            t.outside_rects
+        ));
+    }
+    for u in &report.upsampling {
+        say(&format!(
+            "demo figure upsampling r={}: psnr {:?} ssim {:?}",
+            u.r, u.psnr, u.ssim
+        ));
+    }
+    for c in &report.controllers {
+        say(&format!(
+            "demo figure controller {}: {:?}",
+            c.name, c.settling_frames
+        ));
+    }
+    for run in &report.closed_loop.runs {
+        say(&format!(
+            "demo figure closed loop {}: settled {:?} within {:.2} overshoot {:.2} spread {:.2}",
+            run.name, run.settling_frames, run.frames_within, run.overshoot, run.spread
+        ));
+    }
     // wgpu's GL backend answers occlusion queries with any-samples-passed, not a count: the
     // fragment ratios are measured on every other backend, and their absence there is a failure.
     let counts = gpu.adapter.get_info().backend != wgpu::Backend::Gl;
@@ -251,7 +281,15 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             let r = row(name);
             assert_eq!(r.see_through, 0.0, "{name} in {}", scene.name);
             assert_eq!(r.silhouette_error, 0.0, "{name} in {}", scene.name);
-            assert!(r.pop_static < 0.6, "{name} pops: {}", r.pop_static);
+            // At this size and length (96x64, 8 frames) the dithers measured 0.126-0.141 and
+            // unpopping 0.171-0.285 over the three scenes: limits about 12 % above.
+            let limit = if name == "unpopping" { 0.32 } else { 0.16 };
+            assert!(
+                r.pop_static < limit,
+                "{name} in {} pops: {}",
+                scene.name,
+                r.pop_static
+            );
         }
         for name in [
             "frame-seq-white-noise",
@@ -263,9 +301,14 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             // The combine follows the object motion, and where an animated object's LODs moved
             // differently it searches the older LOD where the camera alone puts the pixel.
             assert_eq!(r.see_through, 0.0, "{name} in {}", scene.name);
-            // Reprojecting last frame's buffer misplaces a thin band of silhouette at most.
+            // The combine's rectangles hold every pixel of an object in transition (they take
+            // the swaying tree's whole reach), so see-through is measured everywhere it can be.
+            assert_eq!(r.outside_rects, 0, "{name} in {}", scene.name);
+            // Reprojecting last frame's buffer misplaces a thin band of silhouette at most:
+            // measured 0.11-1.0 % here; with the first estimate alone (no `reproject_refine`)
+            // 0.71-2.36 %, 1.96 % on `simple`.
             assert!(
-                r.silhouette_error < 0.03,
+                r.silhouette_error < 0.015,
                 "{name} in {}: silhouette error {}",
                 scene.name,
                 r.silhouette_error
@@ -290,7 +333,35 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
                 "{name}: {} not in {lo}..={hi}",
                 r.triangles
             );
-            assert!(r.pop_static < 0.6, "{name} pops: {}", r.pop_static);
+            // Frame-sequential LOD pops less than unpopping (measured 0.64-0.88x static), and the
+            // complementary schedule as little as the blue-noise dither (0.91-1.02x).
+            let unpopping = row("unpopping");
+            assert!(
+                r.pop_static < 0.95 * unpopping.pop_static,
+                "{name} in {}: pop {} against unpopping's {}",
+                scene.name,
+                r.pop_static,
+                unpopping.pop_static
+            );
+            if name != "frame-seq-object-space" {
+                // With the screen anchor also under a moving camera (0.82-0.90x).
+                assert!(
+                    r.pop_moving < unpopping.pop_moving,
+                    "{name} in {}: moving pop {} against unpopping's {}",
+                    scene.name,
+                    r.pop_moving,
+                    unpopping.pop_moving
+                );
+            }
+            if name == "frame-seq-complementary" {
+                let dither = row("dither-blue-noise").pop_static;
+                assert!(
+                    r.pop_static <= 1.1 * dither,
+                    "{name} in {}: pop {} against the dither's {dither}",
+                    scene.name,
+                    r.pop_static
+                );
+            }
         }
     }
     for u in &report.upsampling {
@@ -334,13 +405,22 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
         last,
         first
     );
+    // Each controller answers the doubled shading work with a larger r: its mean r over the
+    // last 20 frames is above its mean over the 10 frames before the step. (A controller that
+    // ignores the measured times keeps r where it was and fails this, whatever the noise.)
     let closed = &report.closed_loop;
     assert_eq!(closed.runs.len(), 3);
+    let step = lodkit_cli::demo::closed_loop::STEP_FRAME;
+    let mean = |r: &[f32]| r.iter().sum::<f32>() / r.len() as f32;
     for run in &closed.runs {
         assert_eq!(run.ms.len(), lodkit_cli::demo::closed_loop::FRAMES);
+        let (before, after) = (
+            mean(&run.r[step - 10..step]),
+            mean(&run.r[run.r.len() - 20..]),
+        );
         assert!(
-            run.r.iter().all(|r| (1.0..=4.0).contains(r)),
-            "{}",
+            after > before * 1.1,
+            "{}: r {before:.2} before the step, {after:.2} at the end",
             run.name
         );
     }
@@ -465,68 +545,4 @@ fn fragment_counter_counts_every_pixel_of_a_fullscreen_triangle() {
             assert!(count >= 1, "{kind:?}: {count}");
         }
     }
-}
-
-#[test]
-fn a_baked_impostor_mask_is_its_trees_silhouette() {
-    use lodkit::alpha_mask::alpha_mask_keep;
-    use lodkit::gpu::scene::MeshRenderer;
-    use lodkit_cli::demo::impostor::{MASK_SIZE, bake};
-    use lodkit_cli::demo::scene::Shape;
-    let gpu = lodkit_test_gpu!();
-    let renderer = MeshRenderer::new(gpu, false).unwrap();
-    let impostor = Shape::Impostor { puffs: 7, rings: 8 };
-    let mask = bake(gpu, &renderer, impostor).unwrap().unwrap();
-    assert_eq!(mask.texels.len(), (MASK_SIZE * MASK_SIZE) as usize);
-    assert!(bake(gpu, &renderer, Shape::Cube).unwrap().is_none());
-    // Independent check: a point of the tree's front extent is covered when a ray along -z
-    // through it hits the trunk box (x, z within 0.12 of 0, y from -1 to -0.2), and not where it
-    // misses the tree's bounding box; the top corners of the card are empty.
-    let rect = impostor.alpha_rect();
-    let (min, max) = impostor.card_rect();
-    let keep = |x: f32, y: f32| alpha_mask_keep(&mask, glam::Vec3::new(x, y, 0.0), rect);
-    assert!(keep(0.0, -0.7) && keep(0.05, -0.5), "the trunk is covered");
-    assert!(!keep(min.x + 0.01, max.y - 0.01) && !keep(max.x - 0.01, max.y - 0.01));
-    assert!(
-        !keep(min.x + 0.01, min.y + 0.01),
-        "beside the trunk's foot is empty"
-    );
-    let covered = mask.texels.iter().filter(|&&t| t >= 0.5).count();
-    let share = covered as f32 / mask.texels.len() as f32;
-    assert!(
-        (0.3..0.9).contains(&share),
-        "the silhouette covers {share:.2} of the card"
-    );
-    say(&format!("impostor mask: {share:.2} of the card covered"));
-}
-
-#[test]
-fn an_impostor_scene_reads_from_ron() {
-    use lodkit_cli::demo::scene::Shape;
-    let text = "(name: \"card\", camera: (eye: (0.0, 1.0, 6.0), target: (0.0, 0.0, 0.0), \
-        moving_eye: (1.0, 1.0, 5.0)), objects: [(fine: Tree(puffs: 5, rings: 6), \
-        coarse: Impostor(puffs: 5, rings: 6), fine_color: (0.2, 0.6, 0.2), \
-        coarse_color: (0.2, 0.5, 0.3), position: (0.0, 0.0, 0.0))])";
-    let scene = DemoScene::from_ron(text, "card.ron").unwrap();
-    assert_eq!(
-        scene.objects[0].coarse,
-        Shape::Impostor { puffs: 5, rings: 6 }
-    );
-    assert_eq!(scene.objects[0].coarse.mesh().triangles(), 2);
-    let bad = text.replace("Impostor(puffs: 5", "Impostor(puffs: 50");
-    let err = DemoScene::from_ron(&bad, "card.ron")
-        .unwrap_err()
-        .to_string();
-    assert!(err.contains("objects[0].coarse: puffs = 50"), "{err}");
-}
-
-#[test]
-fn a_scene_with_two_kinds_of_impostor_is_refused() {
-    use lodkit_cli::demo::scene::Shape;
-    let mut scene = DemoScene::field();
-    assert_eq!(scene.check(), Ok(()));
-    let last = scene.objects.len() - 1;
-    scene.objects[last].coarse = Shape::Impostor { puffs: 3, rings: 4 };
-    let err = scene.check().unwrap_err();
-    assert!(err.contains("kinds of Impostor"), "{err}");
 }

@@ -5,6 +5,8 @@
 #[path = "../../integration_tests/support.rs"]
 mod support;
 mod cli;
+mod combine_regions;
 mod demo;
 mod engine_tree;
+mod impostor;
 mod wesl_check;

@@ -33,6 +33,11 @@ impl ScreenRect {
         }
     }
 
+    /// Whether pixel (`x`, `y`) lies inside.
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        (self.x..self.x + self.width).contains(&x) && (self.y..self.y + self.height).contains(&y)
+    }
+
     /// Whether the two share a pixel.
     pub fn overlaps(&self, other: &ScreenRect) -> bool {
         self.x < other.x + other.width
@@ -42,8 +47,30 @@ impl ScreenRect {
     }
 }
 
+/// `bounds` (object-space min and max) grown by `displacement` on each axis, both ways: the box
+/// that holds every vertex of an animated object whose vertex stage moves its vertices at most
+/// that far from the rest pose (wind sway, skinning, morph targets). Pass it to [`screen_rect`]
+/// for such an object: the combine pass only works inside the rectangles, and a t-instance
+/// pixel outside them would show the newer buffer alone.
+///
+/// ```
+/// # use lodkit::combine::displaced_bounds;
+/// # use glam::Vec3;
+/// // A unit box whose top sways up to 0.3 along x.
+/// let (lo, hi) = displaced_bounds((Vec3::splat(-0.5), Vec3::splat(0.5)), Vec3::new(0.3, 0.0, 0.0));
+/// assert_eq!((lo.x, hi.x, hi.y), (-0.8, 0.8, 0.5));
+/// ```
+pub fn displaced_bounds(
+    bounds: (glam::Vec3, glam::Vec3),
+    displacement: glam::Vec3,
+) -> (glam::Vec3, glam::Vec3) {
+    let d = displacement.abs();
+    (bounds.0 - d, bounds.1 + d)
+}
+
 /// The screen rectangle of a t-instance for the combine pass: the box `bounds` (object-space
-/// min and max, the union of both LODs' boxes) under `model` and each of `view_projs` (this
+/// min and max, the union of both LODs' boxes, holding every vertex the vertex stage may move:
+/// see [`displaced_bounds`]) under `model` and each of `view_projs` (this
 /// frame's and the previous frame's view-projection: where the newer and the older buffer hold
 /// it), in a `size` target, dilated by `dilate` pixels and clipped to the target. `None` when it
 /// is off screen; the whole target when a corner is behind a camera.

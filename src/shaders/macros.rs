@@ -493,7 +493,7 @@ mod tests {
         // The combine twin is a macro over macros, called here with a large matrix argument.
         let matrix = format!(
             "mat4({})",
-            vec!["vec4(f(0u), f(1u), f(2u), f(3u))"; 4].join(", ")
+            ["vec4(f(0u), f(1u), f(2u), f(3u))"; 4].join(", ")
         );
         for m in crate::shaders::modules() {
             if m.language != crate::shaders::Language::Glsl {

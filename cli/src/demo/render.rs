@@ -5,7 +5,10 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::impostor::bake;
 use super::scene::DemoScene;
-use lodkit::combine::{DepthConvention, PixelSource, ScreenRect, combine_images, screen_rect};
+use lodkit::combine::{
+    DepthConvention, PixelSource, ScreenRect, combine_images, displaced_bounds, merge_rects,
+    screen_rect,
+};
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::counters::FragmentCounter;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
@@ -125,6 +128,8 @@ pub struct SceneRenderer<'a> {
     combine: CombinePass,
     combined: wgpu::Texture,
     counter: FragmentCounter,
+    /// See [`take_outside_rects`](Self::take_outside_rects).
+    outside_rects: std::cell::Cell<u64>,
 }
 
 /// Visibility texture repeats per object-space unit: at the demo's sizes a texel covers about
@@ -225,6 +230,7 @@ impl<'a> SceneRenderer<'a> {
             combine: CombinePass::new(gpu, FORMAT, false)?,
             combined: texture_2d(gpu, size, FORMAT, usage, "combined")?,
             counter: FragmentCounter::new(gpu)?,
+            outside_rects: Default::default(),
         })
     }
 
@@ -272,6 +278,20 @@ impl<'a> SceneRenderer<'a> {
     /// Sway of object `i` at `frame`: its amplitude, a phase advancing 0.35 radians per frame.
     fn sway(&self, i: usize, frame: usize) -> [f32; 2] {
         [self.scene.objects[i].sway, frame as f32 * 0.35]
+    }
+
+    /// Object `i`'s box holding every vertex its sway moves (`sway_offset` in
+    /// `passes/lod_buffer_mesh.wgsl`: up to the amplitude times the height above y = -1, along x).
+    fn animated_bounds(&self, i: usize) -> Option<(Vec3, Vec3)> {
+        let bounds = self.bounds[i]?;
+        let reach = self.scene.objects[i].sway.abs() * (bounds.1.y + 1.0).max(0.0);
+        Some(displaced_bounds(bounds, Vec3::new(reach, 0.0, 0.0)))
+    }
+
+    /// Pixels of objects in transition, in either LOD buffer, outside the combine's rectangles,
+    /// summed over the frame-sequential frames since the last call (0: the rectangles held all).
+    pub fn take_outside_rects(&self) -> u64 {
+        self.outside_rects.take()
     }
 
     fn camera(&self, frame: usize, moving: bool) -> (Mat4, Mat4) {
@@ -485,10 +505,27 @@ impl<'a> SceneRenderer<'a> {
                 .enumerate()
                 .filter(|(_, key)| scheduler.in_transition(**key))
                 .filter_map(|(i, _)| {
-                    let bounds = self.bounds[i]?;
+                    let bounds = self.animated_bounds(i)?;
                     screen_rect(bounds, self.scene.model(i), &views, self.size, 2)
                 })
                 .collect();
+            // Every pixel of either buffer that holds an object in transition must lie inside
+            // them: outside, the output is the newer buffer alone.
+            let t_ids: Vec<u32> = keys
+                .iter()
+                .filter(|key| scheduler.in_transition(**key))
+                .filter_map(|key| scheduler.draw(*key).ok().map(|d| d.id))
+                .collect();
+            let merged = merge_rects(&regions);
+            for buffer in [index, 1 - index] {
+                let image = read_lod_image(gpu, &self.buffers, buffer)?;
+                let outside = image.ids.iter().enumerate().filter(|&(p, id)| {
+                    let (x, y) = (p as u32 % image.width, p as u32 / image.width);
+                    *id != 0 && t_ids.contains(id) && !merged.iter().any(|r| r.contains(x, y))
+                });
+                let count = outside.count() as u64;
+                self.outside_rects.set(self.outside_rects.get() + count);
+            }
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let target = self.combined.create_view(&Default::default());
             let combined = self.combine.encode_regions(

@@ -30,6 +30,10 @@ pub struct TransitionMetrics {
     /// show the background, plus pixels neither covers that show a transitioning object, as a
     /// share of the pixels either covers.
     pub silhouette_error: f32,
+    /// Pixels of objects in transition, in either LOD buffer, outside the combine pass's
+    /// rectangles, summed over the frames of both runs (frame-sequential; 0 otherwise). Pixels
+    /// there show the newer buffer alone, so the see-through figure holds only when this is 0.
+    pub outside_rects: u64,
     /// Triangles submitted over the transition, relative to a hard switch.
     pub triangles_vs_hard: f64,
     /// Counted fragments over the transition, relative to a hard switch (None when the
@@ -380,6 +384,7 @@ pub fn measure_scene(
         };
         let mut changes = Vec::new();
         let mut cost = (0, 0, 0);
+        renderer.take_outside_rects(); // the reference runs' count is not this technique's
         for (moving, reference) in [false, true].into_iter().zip(reference) {
             let run = transition_run(gpu, renderer, technique, moving, reference, size)?;
             let camera = if moving { "moving" } else { "static" };
@@ -397,6 +402,7 @@ pub fn measure_scene(
             }
             changes.push(run.change);
         }
+        let outside_rects = renderer.take_outside_rects();
         let (share, map) = see_through(gpu, renderer, technique, &masks, size)?;
         let silhouette = silhouette_error(gpu, renderer, technique, &moving_masks)?;
         super::save(&map, &out.join(format!("see-through/{scene}-{name}.png")))?;
@@ -408,6 +414,7 @@ pub fn measure_scene(
             pop_static: pop(&static_change),
             pop_moving: pop(&moving_change),
             see_through: share,
+            outside_rects,
             silhouette_error: silhouette,
             triangles_vs_hard: 0.0,
             fragments_vs_hard: None,
