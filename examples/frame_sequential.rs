@@ -95,6 +95,9 @@ fn main() -> Result<(), Box<dyn Error>> {
     let mut previous_view: Option<Mat4> = None;
     let mut strip = image::RgbaImage::new(w * COLUMNS as u32, h);
     let mut transitions = 0;
+    // Triangles drawn over the frames with an instance in transition, against a hard switch
+    // at each transition's midpoint (the outgoing LOD before progress 0.5, the incoming after).
+    let (mut drawn, mut hard, mut per_frame) = (0u64, 0u64, Vec::new());
     for frame in 0..FRAMES {
         let dt = 1.0 / 60.0;
         if frame > 0 {
@@ -125,6 +128,22 @@ fn main() -> Result<(), Box<dyn Error>> {
                 Ok(LodDrawItem::from_draw(mesh, model(p), *color, &d))
             })
             .collect::<Result<Vec<_>, Box<dyn Error>>>()?;
+        let mut hard_frame = 0;
+        for key in &keys {
+            let d = scheduler.draw(*key)?;
+            let (this, other) = (usize::from(d.lod.min(1)), 1 - usize::from(d.lod.min(1)));
+            let (outgoing, incoming) = if d.incoming {
+                (other, this)
+            } else {
+                (this, other)
+            };
+            let level = match scheduler.in_transition(*key) {
+                true if d.progress < 0.5 => outgoing,
+                true => incoming,
+                false => this,
+            };
+            hard_frame += u64::from(lods[level].0.triangles());
+        }
         let index = scheduler.buffer_index();
         let clear = wgpu::Color {
             r: 0.05,
@@ -139,7 +158,12 @@ fn main() -> Result<(), Box<dyn Error>> {
             view_proj: views[0],
             prev_view_proj: views[1],
         };
-        renderer.render(&gpu, &buffers, index, lod_view, &items, clear, None)?;
+        let (triangles, _) =
+            renderer.render(&gpu, &buffers, index, lod_view, &items, clear, None)?;
+        if keys.iter().any(|key| scheduler.in_transition(*key)) {
+            (drawn, hard) = (drawn + triangles, hard + hard_frame);
+            per_frame.push(triangles);
+        }
 
         // 3. Combine with last frame's buffer, reprojected through the camera motion, where the
         //    t-instances are in this frame's and last frame's view (both LODs fit the unit box).
@@ -175,6 +199,17 @@ fn main() -> Result<(), Box<dyn Error>> {
         }
     }
     println!("{transitions} transitions over {FRAMES} frames");
+    let (lo, hi) = (per_frame.iter().min(), per_frame.iter().max());
+    println!(
+        "frames with a transition: {} triangles each ({} per sphere, {} per box); \
+         {drawn} in all, against {hard} for a hard switch at each transition's midpoint",
+        match (lo, hi) {
+            (Some(lo), Some(hi)) => format!("{lo} to {hi}"),
+            _ => "no frame".to_owned(),
+        },
+        lods[0].0.triangles(),
+        lods[1].0.triangles(),
+    );
     std::fs::create_dir_all(&out)?;
     let path = std::path::Path::new(&out).join("frame_sequential.png");
     strip.save(&path)?;

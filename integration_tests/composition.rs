@@ -6,7 +6,7 @@ use std::path::Path;
 
 use lodkit::shaders::{
     self, ComposeDescriptor, Composed, ExportOptions, ExportTarget, Exported, Language, ModuleInfo,
-    ModuleKind, ShaderLibrary, SourceLanguage,
+    ModuleKind, ShaderDefValue, ShaderLibrary, SourceLanguage,
 };
 
 use crate::harness::{render, tool};
@@ -198,6 +198,19 @@ fn every_pass_composes_validates_and_exports() {
             pass.path
         );
         export_everywhere(&composed, pass.path);
+        // And with each of its shader defs switched on.
+        for def in &pass.shader_defs {
+            let composed = ShaderLibrary::new()
+                .unwrap()
+                .compose(&ComposeDescriptor {
+                    source: pass.source,
+                    file_path: pass.path,
+                    shader_defs: [(def.name.clone(), ShaderDefValue::Bool(true))].into(),
+                    ..Default::default()
+                })
+                .unwrap_or_else(|e| panic!("{} with {}:\n{}", pass.path, def.name, render(&e)));
+            export_everywhere(&composed, &format!("{} with {}", pass.path, def.name));
+        }
     }
 }
 

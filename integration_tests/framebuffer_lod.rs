@@ -357,6 +357,7 @@ mod controller {
 
 mod rendered {
     use lodkit::framebuffer_lod::{multiply_rgba8, psnr_rgba8};
+    use lodkit::gpu::GpuError;
     use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
     use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
     use lodkit::gpu::readback::read_texture_rgba8;
@@ -378,9 +379,18 @@ mod rendered {
         let low = LowResBuffer::new(gpu, W, H, format).unwrap();
         let albedo = LowResBuffer::new(gpu, W, H, format).unwrap();
         let upsample = UpsamplePass::new(gpu, format).unwrap();
+        let fine_pass = UpsamplePass::fine_grained(gpu, format).unwrap();
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let target = texture_2d(gpu, (W, H), format, usage, "upsampled").unwrap();
         let view = target.create_view(&Default::default());
+        // Each pass records only with its own encode call.
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let (g, a) = (full.geometry(), albedo.color());
+        let wrong = fine_pass.encode(gpu, &mut encoder, &low, 2.0, g, 0.25, 0.4, &view);
+        assert!(matches!(wrong, Err(GpuError::Mismatch { .. })), "{wrong:?}");
+        let wrong =
+            upsample.encode_fine_grained(gpu, &mut encoder, &low, 2.0, g, a, 0.25, 0.4, &view);
+        assert!(matches!(wrong, Err(GpuError::Mismatch { .. })), "{wrong:?}");
         let mut rows = Vec::new();
         let mut gain_at_2 = 0.0;
         for r in [2.0f32, 4.0] {
@@ -420,7 +430,26 @@ mod rendered {
                 .render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)
                 .unwrap();
             let albedo_pixels = read_texture_rgba8(gpu, albedo.color()).unwrap();
-            let fine = psnr_rgba8(&multiply_rgba8(&lighting, &albedo_pixels), &reference);
+            // The fine-grained pass multiplies in the upsample: within 1 of the product of the
+            // two RGBA8 images (it multiplies before the lighting is quantized).
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let (g, a) = (full.geometry(), albedo.color());
+            fine_pass
+                .encode_fine_grained(gpu, &mut encoder, &low, r, g, a, 0.25, 0.4, &view)
+                .unwrap();
+            gpu.queue.submit([encoder.finish()]);
+            let composite = read_texture_rgba8(gpu, &target).unwrap();
+            let product = multiply_rgba8(&lighting, &albedo_pixels);
+            let worst = composite
+                .iter()
+                .zip(&product)
+                .map(|(a, b)| a.abs_diff(*b))
+                .max();
+            assert!(
+                worst <= Some(1),
+                "composite vs product: {worst:?} at r = {r}"
+            );
+            let fine = psnr_rgba8(&composite, &reference);
             rows.push(format!(
                 "r = {r}: bilinear {:.2} dB, bilateral {:.2} dB, gain {:+.2} dB; fine-grained {fine:.2} dB",
                 psnr[0],

@@ -7,6 +7,7 @@ mod support;
 mod cli;
 mod combine_regions;
 mod demo;
+mod docs_figures;
 mod engine_tree;
 mod impostor;
 mod wesl_check;

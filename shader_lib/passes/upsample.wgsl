@@ -3,15 +3,18 @@
 //
 // For each full-res pixel: the full-res depth and normal from the prepass, then
 // bilateral_upsample_at (its 2x2 nearest L samples, clamped to the viewport, and eq. 1).
-// sigma_z = sigma_n = +inf gives plain bilinear upsampling through the same pass.
+// sigma_z = sigma_n = +inf gives plain bilinear upsampling through the same pass. With
+// LODKIT_UPSAMPLE_MODULATE the upsampled color is multiplied by the full-resolution albedo: the
+// composite of fine-grained resizing (sec. 4), where only the lighting went through L.
 // Built only from lodkit::fullscreen, lodkit::gbuffer, lodkit::bilateral.
 //
 // Entry points:
 //   vs_main   fullscreen triangle, draw(0..3)
 //   fs_main   @location(0) upsampled color
 // Bindings (group 0): 0 low_color texture_2d<f32>, 1 low_geometry texture_2d<f32>,
-//   2 full_geometry texture_2d<f32> (the prepass, gbuffer layout), 3 params: UpsampleParams.
-// Shader defs: none.
+//   2 full_geometry texture_2d<f32> (the prepass, gbuffer layout), 3 params: UpsampleParams;
+//   with LODKIT_UPSAMPLE_MODULATE: 3 full_albedo texture_2d<f32>, 4 params.
+// Shader defs: LODKIT_UPSAMPLE_MODULATE (bool).
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 #import lodkit::gbuffer::{gbuffer_depth, gbuffer_normal}
 #import lodkit::bilateral::bilateral_upsample_at
@@ -32,7 +35,12 @@ struct UpsampleParams {
 @group(0) @binding(0) var low_color: texture_2d<f32>;
 @group(0) @binding(1) var low_geometry: texture_2d<f32>;
 @group(0) @binding(2) var full_geometry: texture_2d<f32>;
+#ifdef LODKIT_UPSAMPLE_MODULATE
+@group(0) @binding(3) var full_albedo: texture_2d<f32>;
+@group(0) @binding(4) var<uniform> params: UpsampleParams;
+#else
 @group(0) @binding(3) var<uniform> params: UpsampleParams;
+#endif
 
 /// Fullscreen triangle.
 @vertex
@@ -40,11 +48,13 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
     return fullscreen_vertex(vertex_index);
 }
 
-/// Reconstructs the full-res pixel from L.
+/// Reconstructs the full-res pixel from L (times the full-res albedo with
+/// LODKIT_UPSAMPLE_MODULATE).
 @fragment
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
-    let full = textureLoad(full_geometry, vec2<u32>(v.position.xy), 0);
-    return bilateral_upsample_at(
+    let pixel = vec2<u32>(v.position.xy);
+    let full = textureLoad(full_geometry, pixel, 0);
+    let color = bilateral_upsample_at(
         low_color,
         low_geometry,
         params.low_viewport,
@@ -55,4 +65,9 @@ fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
         params.sigma_z,
         params.sigma_n,
     );
+#ifdef LODKIT_UPSAMPLE_MODULATE
+    return vec4<f32>(color.rgb * textureLoad(full_albedo, pixel, 0).rgb, color.a);
+#else
+    return color;
+#endif
 }

@@ -159,28 +159,55 @@ pub struct UpsampleParams {
 }
 
 /// The upsample pass (`passes/upsample.wgsl`): full-res color from L and a full-res depth/normal
-/// prepass. With both sigmas +inf it is a plain bilinear upsample.
+/// prepass. With both sigmas +inf it is a plain bilinear upsample. Built with
+/// [`fine_grained`](Self::fine_grained), it also multiplies by a full-resolution albedo: the
+/// composite of fine-grained resizing, in the same pass.
 #[derive(Debug)]
 pub struct UpsamplePass {
     pipeline: wgpu::RenderPipeline,
     params: wgpu::Buffer,
     target_format: wgpu::TextureFormat,
+    modulate: bool,
 }
 
 impl UpsamplePass {
     /// Builds the pipeline for targets of `target_format` (a floating-point color format the
     /// device can render to).
     pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat) -> Result<Self, GpuError> {
-        const CALL: &str = "UpsamplePass::new";
+        Self::build(gpu, "UpsamplePass::new", target_format, false)
+    }
+
+    /// [`new`](Self::new) for fine-grained resizing (the paper's sec. 4): L holds only the
+    /// expensive term (lighting), and [`encode_fine_grained`](Self::encode_fine_grained)
+    /// multiplies its upsampling by a full-resolution albedo in the same pass.
+    pub fn fine_grained(
+        gpu: &GpuContext,
+        target_format: wgpu::TextureFormat,
+    ) -> Result<Self, GpuError> {
+        Self::build(gpu, "UpsamplePass::fine_grained", target_format, true)
+    }
+
+    fn build(
+        gpu: &GpuContext,
+        call: &'static str,
+        target_format: wgpu::TextureFormat,
+        modulate: bool,
+    ) -> Result<Self, GpuError> {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        check_color_format(gpu, CALL, "target_format", target_format, usage)?;
-        gpu.guarded(CALL, || {
-            let module = gpu.pass_module("upsample", &[])?;
+        check_color_format(gpu, call, "target_format", target_format, usage)?;
+        gpu.guarded(call, || {
+            let defs: &[&str] = if modulate {
+                &["LODKIT_UPSAMPLE_MODULATE"]
+            } else {
+                &[]
+            };
+            let module = gpu.pass_module("upsample", defs)?;
             let size = std::mem::size_of::<UpsampleParams>();
             Ok(Self {
                 pipeline: fullscreen_pipeline(gpu, &module, target_format, "lodkit upsample")?,
                 params: uniform_buffer(gpu, size, "upsample params")?,
                 target_format,
+                modulate,
             })
         })
     }
@@ -189,7 +216,9 @@ impl UpsamplePass {
     /// full-resolution geometry `full_geometry` (gbuffer layout) and range sigmas (each > 0;
     /// +inf drops its term). `target` must have the format the pass was built for and, like
     /// `full_geometry` (in `GEOMETRY_FORMAT`), L's full size: [`GpuError::Mismatch`] otherwise.
-    /// The parameters go through one uniform buffer: record one `encode` per submit.
+    /// The parameters go through one uniform buffer: record one `encode` per submit. A pass
+    /// built with [`fine_grained`](Self::fine_grained) takes
+    /// [`encode_fine_grained`](Self::encode_fine_grained) instead ([`GpuError::Mismatch`]).
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -203,10 +232,76 @@ impl UpsamplePass {
         target: &wgpu::TextureView,
     ) -> Result<(), GpuError> {
         const CALL: &str = "UpsamplePass::encode";
+        let textures = [low.color(), low.geometry(), full_geometry];
+        let sigmas = (sigma_z, sigma_n);
+        self.record(gpu, CALL, encoder, low, r, &textures, sigmas, target)
+    }
+
+    /// [`encode`](Self::encode) for a pass built with [`fine_grained`](Self::fine_grained):
+    /// the upsampled L (the lighting) times `full_albedo`, a texture of L's full size and L's
+    /// color format (the albedo pass that also wrote `full_geometry`). [`GpuError::Mismatch`]
+    /// on a pass built with [`new`](Self::new), or for an albedo of another size or format.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_fine_grained(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        low: &LowResBuffer,
+        r: f32,
+        full_geometry: &wgpu::Texture,
+        full_albedo: &wgpu::Texture,
+        sigma_z: f32,
+        sigma_n: f32,
+        target: &wgpu::TextureView,
+    ) -> Result<(), GpuError> {
+        const CALL: &str = "UpsamplePass::encode_fine_grained";
+        let format = low.color().format();
+        let what = "L's color (size and format)";
+        texture_matches(
+            CALL,
+            "full_albedo",
+            full_albedo,
+            low.full_size(),
+            format,
+            what,
+        )?;
+        let textures = [low.color(), low.geometry(), full_geometry, full_albedo];
+        let sigmas = (sigma_z, sigma_n);
+        self.record(gpu, CALL, encoder, low, r, &textures, sigmas, target)
+    }
+
+    /// Checks and records one upsampling with `textures` bound in order (L's color and
+    /// geometry, the full geometry, and the albedo when the pass modulates).
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &self,
+        gpu: &GpuContext,
+        call: &'static str,
+        encoder: &mut wgpu::CommandEncoder,
+        low: &LowResBuffer,
+        r: f32,
+        textures: &[&wgpu::Texture],
+        (sigma_z, sigma_n): (f32, f32),
+        target: &wgpu::TextureView,
+    ) -> Result<(), GpuError> {
+        // The albedo is the fourth texture: the encode call must match how the pass was built.
+        if (textures.len() == 4) != self.modulate {
+            let (built, wanted) = match self.modulate {
+                true => ("fine_grained", "encode_fine_grained"),
+                false => ("new", "encode"),
+            };
+            return Err(GpuError::Mismatch {
+                call,
+                parameter: "self",
+                found: format!("a pass built with UpsamplePass::{built}"),
+                expected: format!("record it with UpsamplePass::{wanted}"),
+            });
+        }
+        let full_geometry = textures[2];
         for (parameter, value) in [("sigma_z", sigma_z), ("sigma_n", sigma_n)] {
             if value.is_nan() || value <= 0.0 {
                 return Err(GpuError::Invalid {
-                    call: CALL,
+                    call,
                     parameter,
                     value: value.to_string(),
                     rule: "must be positive (+inf: no range term)",
@@ -216,7 +311,7 @@ impl UpsamplePass {
         let size = low.full_size();
         let what = "the full-resolution geometry of L";
         texture_matches(
-            CALL,
+            call,
             "full_geometry",
             full_geometry,
             size,
@@ -225,14 +320,14 @@ impl UpsamplePass {
         )?;
         let what = "the pass (built for its format, drawing L's full size)";
         texture_matches(
-            CALL,
+            call,
             "target",
             target.texture(),
             size,
             self.target_format,
             what,
         )?;
-        gpu.guarded(CALL, || {
+        gpu.guarded(call, || {
             let (vw, vh) = low.viewport(r);
             let (w, h) = low.full_size();
             let params = UpsampleParams {
@@ -245,11 +340,10 @@ impl UpsamplePass {
             gpu.queue
                 .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
             let layout = self.pipeline.get_bind_group_layout(0);
-            let textures = [low.color(), low.geometry(), full_geometry];
             let bind_group = textures_and_uniform(
                 gpu,
                 &layout,
-                &textures,
+                textures,
                 Some(&self.params),
                 "lodkit upsample",
             )?;

@@ -36,6 +36,8 @@ pub const TARGET_R: f32 = 1.6;
 pub const SMOOTHING: usize = 5;
 /// Frames timed to calibrate the target, K and the noise.
 const CALIBRATION: usize = 9;
+/// Runs of each controller (interleaved); the table gives their median and range.
+pub const REPEATS: usize = 3;
 
 /// One controller's run.
 #[derive(Clone, Debug, Serialize)]
@@ -69,8 +71,10 @@ pub struct ClosedLoop {
     /// Relative standard deviation of the calibration frames at [`TARGET_R`]: the noise lodkit's
     /// controller is told to expect.
     pub noise: f32,
-    /// The runs.
+    /// The first run of each controller (the plots show these).
     pub runs: Vec<ClosedLoopRun>,
+    /// Every run of each controller: [`REPEATS`] per controller, in the order of `runs`.
+    pub repeats: Vec<Vec<ClosedLoopRun>>,
 }
 
 /// Runs lodkit's controller, the paper's and the step heuristic on the edge scene at `size`.
@@ -95,78 +99,122 @@ pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedL
     let (t1, t2) = (times(&scene, 1.0)?, times(&scene, 2.0)?);
     let paper_k = ((t1[CALIBRATION / 2] - t2[CALIBRATION / 2]) / 0.75).max(1e-3);
     let limits = ResizeLimits::default();
-    let mut lodkit = RlsController::new(target_ms, limits);
-    lodkit.noise = noise;
-    let controllers: [(&str, Box<dyn ResizeController>); 3] = [
-        ("lodkit (online K, C)", Box::new(lodkit)),
-        (
-            "paper (calibrated K)",
-            Box::new(PaperController::new(target_ms, paper_k, limits)),
-        ),
-        (
-            "step heuristic",
-            Box::new(StepController::new(target_ms, limits)),
-        ),
+    let lodkit = move || {
+        let mut c = RlsController::new(target_ms, limits);
+        c.noise = noise;
+        Box::new(c) as Box<dyn ResizeController>
+    };
+    let paper = move || {
+        Box::new(PaperController::new(target_ms, paper_k, limits)) as Box<dyn ResizeController>
+    };
+    let step =
+        move || Box::new(StepController::new(target_ms, limits)) as Box<dyn ResizeController>;
+    let controllers: [(&str, MakeController); 3] = [
+        ("lodkit (online K, C)", &lodkit),
+        ("paper (calibrated K)", &paper),
+        ("step heuristic", &step),
     ];
-    let mut runs = Vec::new();
-    for (name, mut controller) in controllers {
-        let (mut ms, mut rs) = (Vec::new(), Vec::new());
-        for f in 0..FRAMES {
-            let work = if f < STEP_FRAME {
-                BASE_WORK
-            } else {
-                2 * BASE_WORK
-            };
-            scene.set_shading_work(work);
-            let r = controller.r();
-            let t = frame(&scene, r)?;
-            controller.update(t);
-            ms.push(t);
-            rs.push(r);
+    // Repetitions interleaved, so a slow patch of the machine does not hit one controller only.
+    let mut repeats: Vec<Vec<ClosedLoopRun>> = vec![Vec::new(); controllers.len()];
+    for _ in 0..REPEATS {
+        for (k, (name, controller)) in controllers.iter().enumerate() {
+            let mut run = run_controller(&mut scene, &frame, controller(), target_ms)?;
+            run.name = (*name).to_owned();
+            repeats[k].push(run);
         }
-        // The noise-free time of the simulation becomes the median of the last SMOOTHING frames
-        // (what a frame-time monitor sees), not reaching back across the step.
-        let frames: Vec<SimulatedFrame> = (0..FRAMES)
-            .map(|i| {
-                let first = if i < STEP_FRAME { 0 } else { STEP_FRAME };
-                let window = (i + 1).saturating_sub(SMOOTHING).max(first)..i + 1;
-                let mut w = ms[window].to_vec();
-                w.sort_by(f32::total_cmp);
-                SimulatedFrame {
-                    r: rs[i],
-                    measured: ms[i],
-                    expected: w[w.len() / 2],
-                }
-            })
-            .collect();
-        let response = step_response(&frames, STEP_FRAME, target_ms, BAND);
-        let settled = STEP_FRAME + response.settling_frames.unwrap_or(FRAMES);
-        let tail = ms.get(settled..).unwrap_or_default();
-        let within = tail
-            .iter()
-            .filter(|t| (*t - target_ms).abs() <= BAND * target_ms)
-            .count();
-        runs.push(ClosedLoopRun {
-            name: name.to_owned(),
-            settling_frames: response.settling_frames,
-            frames_within: within as f32 / tail.len().max(1) as f32,
-            overshoot: response.overshoot,
-            spread: response.spread,
-            ms,
-            r: rs,
-        });
     }
+    let runs = repeats.iter().map(|r| r[0].clone()).collect();
     Ok(ClosedLoop {
         size,
         target_ms,
         paper_k,
         noise,
         runs,
+        repeats,
     })
 }
 
-/// The runs as a table.
+/// Makes a fresh controller for one run.
+type MakeController<'a> = &'a dyn Fn() -> Box<dyn ResizeController>;
+
+/// One closed-loop run of `controller` (its name left empty): the shading work doubles at
+/// [`STEP_FRAME`].
+fn run_controller(
+    scene: &mut EdgeScene,
+    frame: &dyn Fn(&EdgeScene, f32) -> Result<f32, GpuError>,
+    mut controller: Box<dyn ResizeController>,
+    target_ms: f32,
+) -> Result<ClosedLoopRun, DemoError> {
+    let (mut ms, mut rs) = (Vec::new(), Vec::new());
+    for f in 0..FRAMES {
+        let work = if f < STEP_FRAME {
+            BASE_WORK
+        } else {
+            2 * BASE_WORK
+        };
+        scene.set_shading_work(work);
+        let r = controller.r();
+        let t = frame(scene, r)?;
+        controller.update(t);
+        ms.push(t);
+        rs.push(r);
+    }
+    // The noise-free time of the simulation becomes the median of the last SMOOTHING frames
+    // (what a frame-time monitor sees), not reaching back across the step.
+    let frames: Vec<SimulatedFrame> = (0..FRAMES)
+        .map(|i| {
+            let first = if i < STEP_FRAME { 0 } else { STEP_FRAME };
+            let window = (i + 1).saturating_sub(SMOOTHING).max(first)..i + 1;
+            let mut w = ms[window].to_vec();
+            w.sort_by(f32::total_cmp);
+            SimulatedFrame {
+                r: rs[i],
+                measured: ms[i],
+                expected: w[w.len() / 2],
+            }
+        })
+        .collect();
+    let response = step_response(&frames, STEP_FRAME, target_ms, BAND);
+    let settled = STEP_FRAME + response.settling_frames.unwrap_or(FRAMES);
+    let tail = ms.get(settled..).unwrap_or_default();
+    let within = tail
+        .iter()
+        .filter(|t| (*t - target_ms).abs() <= BAND * target_ms)
+        .count();
+    Ok(ClosedLoopRun {
+        name: String::new(),
+        settling_frames: response.settling_frames,
+        frames_within: within as f32 / tail.len().max(1) as f32,
+        overshoot: response.overshoot,
+        spread: response.spread,
+        ms,
+        r: rs,
+    })
+}
+
+/// The median of `values` and their range, formatted by `f` (`"6 (5-9)"`).
+fn median_range(mut values: Vec<f32>, f: &dyn Fn(f32) -> String) -> String {
+    values.sort_by(f32::total_cmp);
+    match (values.first(), values.get(values.len() / 2), values.last()) {
+        (Some(lo), Some(mid), Some(hi)) if lo == hi => f(*mid),
+        (Some(lo), Some(mid), Some(hi)) => format!("{} ({}-{})", f(*mid), f(*lo), f(*hi)),
+        _ => "-".to_owned(),
+    }
+}
+
+/// The runs as a table: per controller the median over its [`REPEATS`] runs and, in brackets,
+/// their range.
 pub(super) fn table(closed: &ClosedLoop) -> Table {
+    let settle = |s: f32| {
+        if s.is_finite() {
+            format!("{s:.0}")
+        } else {
+            "never".to_owned()
+        }
+    };
+    let percent = |p: f32| format!("{:.0} %", p * 100.0);
+    let percent1 = |p: f32| format!("{:.1} %", p * 100.0);
+    let r = |r: f32| format!("{r:.2}");
     Table {
         header: &[
             "controller",
@@ -177,17 +225,20 @@ pub(super) fn table(closed: &ClosedLoop) -> Table {
             "r at the end",
         ],
         rows: closed
-            .runs
+            .repeats
             .iter()
-            .map(|run| {
+            .map(|runs| {
+                let of = |v: &dyn Fn(&ClosedLoopRun) -> f32| runs.iter().map(v).collect();
+                let settled =
+                    |run: &ClosedLoopRun| run.settling_frames.map_or(f32::INFINITY, |s| s as f32);
+                let end = |run: &ClosedLoopRun| run.r.last().copied().unwrap_or(f32::NAN);
                 vec![
-                    run.name.clone(),
-                    run.settling_frames
-                        .map_or("never".to_owned(), |s| s.to_string()),
-                    format!("{:.0} %", run.frames_within * 100.0),
-                    format!("{:.1} %", run.overshoot * 100.0),
-                    format!("{:.1} %", run.spread * 100.0),
-                    format!("{:.2}", run.r.last().copied().unwrap_or(f32::NAN)),
+                    runs.first().map_or(String::new(), |run| run.name.clone()),
+                    median_range(of(&settled), &settle),
+                    median_range(of(&|run| run.frames_within), &percent),
+                    median_range(of(&|run| run.overshoot), &percent1),
+                    median_range(of(&|run| run.spread), &percent1),
+                    median_range(of(&end), &r),
                 ]
             })
             .collect(),
@@ -204,8 +255,10 @@ pub fn summary(closed: &ClosedLoop) -> String {
          work doubles from {BASE_WORK} to {} sky directions at frame {STEP_FRAME}; the paper's K \
          calibrated from frames at r = 1 and r = 2: {:.1} ms; lodkit's controller is told the \
          noise measured in the calibration frames ({:.1} %). Settling: frames after the step until \
-         the median of the last {SMOOTHING} frame times stays within 10 % of the target for the \
-         rest of the run; single frames scatter around it by the noise.",
+         the median of the last {SMOOTHING} frame times stays within 10 % of the target in every \
+         frame to the end of the run; single frames scatter around it by the noise. Each \
+         controller ran {REPEATS} times, interleaved: the table gives the median and, in \
+         brackets, the range.",
         closed.target_ms,
         2 * BASE_WORK,
         closed.paper_k,

@@ -6,7 +6,8 @@
 //! A framebuffer-LOD frame is the full-resolution geometry prepass the upsampling needs (depth
 //! and normal, with the cheap albedo term), the low-resolution shading pass at r, and the
 //! upsample pass. The fine-grained route shades only the lighting at low resolution; its
-//! full-resolution albedo pass writes the geometry, so it is the same pass as the prepass.
+//! full-resolution albedo pass writes the geometry, so it is the same pass as the prepass, and its
+//! upsample multiplies by that albedo (the composite, inside the pass).
 
 use std::path::Path;
 
@@ -109,6 +110,8 @@ pub(super) struct Frame<'a> {
     low: LowResBuffer,
     prepass: LowResBuffer,
     upsample: UpsamplePass,
+    /// The fine-grained route's upsample, which multiplies by the prepass's albedo.
+    fine: UpsamplePass,
     view: wgpu::TextureView,
 }
 
@@ -126,6 +129,7 @@ impl<'a> Frame<'a> {
             low: LowResBuffer::new(gpu, w, h, format)?,
             prepass: LowResBuffer::new(gpu, w, h, format)?,
             upsample: UpsamplePass::new(gpu, format)?,
+            fine: UpsamplePass::fine_grained(gpu, format)?,
             view: texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default()),
         };
         Ok((frame, scene))
@@ -142,18 +146,26 @@ impl<'a> Frame<'a> {
         })
     }
 
-    fn record_upsample(&self, r: f32) -> Result<(), GpuError> {
+    /// Records the upsample at `r`; `term` is what L holds (the lighting alone: fine-grained).
+    fn record_upsample(&self, r: f32, term: ShadingTerm) -> Result<(), GpuError> {
         let gpu = self.gpu;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let (low, g, view) = (&self.low, self.prepass.geometry(), &self.view);
-        self.upsample
-            .encode(gpu, &mut encoder, low, r, g, SIGMA_Z, SIGMA_N, view)?;
+        let (sz, sn) = (SIGMA_Z, SIGMA_N);
+        if term == ShadingTerm::Lighting {
+            let albedo = self.prepass.color();
+            self.fine
+                .encode_fine_grained(gpu, &mut encoder, low, r, g, albedo, sz, sn, view)?;
+        } else {
+            self.upsample
+                .encode(gpu, &mut encoder, low, r, g, sz, sn, view)?;
+        }
         gpu.queue.submit([encoder.finish()]);
         Ok(())
     }
 
-    fn upsample(&self, r: f32) -> Result<f64, GpuError> {
-        timed(self.gpu, || self.record_upsample(r))
+    fn upsample(&self, r: f32, term: ShadingTerm) -> Result<f64, GpuError> {
+        timed(self.gpu, || self.record_upsample(r, term))
     }
 
     /// A whole frame at `r`, waited for once at its end; its wall time in ms.
@@ -161,7 +173,7 @@ impl<'a> Frame<'a> {
         timed(self.gpu, || {
             scene.render_term(self.gpu, &self.prepass, 1.0, ShadingTerm::Albedo)?;
             scene.render_term(self.gpu, &self.low, r, ShadingTerm::Full)?;
-            self.record_upsample(r)
+            self.record_upsample(r, ShadingTerm::Full)
         })
     }
 
@@ -170,7 +182,7 @@ impl<'a> Frame<'a> {
         Ok([
             self.prepass(scene)?,
             self.shade(scene, r, term)?,
-            self.upsample(r)?,
+            self.upsample(r, term)?,
         ])
     }
 }

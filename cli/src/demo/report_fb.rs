@@ -77,7 +77,7 @@ pub fn benchmarks_markdown(report: &DemoReport) -> String {
 pub fn quality_markdown(report: &DemoReport) -> String {
     let closed = &report.closed_loop;
     let mut s = format!(
-        "\n## Controllers on the real frame\n\n{}\n\n",
+        "\n## Framerate control on the real frame\n\n{}\n\n",
         closed_loop::summary(closed)
     );
     s.push_str(&closed_loop::table(closed).markdown());

@@ -10,7 +10,7 @@ use super::DemoError;
 use super::timing::{median, wall_ms};
 use lodkit::framebuffer_lod::{
     FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
-    RlsController, StepController, multiply_rgba8, psnr_rgba8, simulate, ssim_rgba8, step_response,
+    RlsController, StepController, psnr_rgba8, simulate, ssim_rgba8, step_response,
 };
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
@@ -80,12 +80,21 @@ pub fn measure_upsampling(
     let low = LowResBuffer::new(gpu, w, h, format)?;
     let albedo = LowResBuffer::new(gpu, w, h, format)?;
     let upsample = UpsamplePass::new(gpu, format)?;
+    let fine_pass = UpsamplePass::fine_grained(gpu, format)?;
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = texture_2d(gpu, size, format, usage, "upsampled")?;
     let view = target.create_view(&Default::default());
     let upsample_with = |r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         upsample.encode(gpu, &mut encoder, &low, r, geometry, sz, sn, &view)?;
+        gpu.queue.submit([encoder.finish()]);
+        Ok::<(), GpuError>(())
+    };
+    // Fine-grained: the upsampled lighting times the full-resolution albedo, in the upsample.
+    let fine_with = |r: f32| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let (g, a, (sz, sn)) = (albedo.geometry(), albedo.color(), (SIGMA_Z, SIGMA_N));
+        fine_pass.encode_fine_grained(gpu, &mut encoder, &low, r, g, a, sz, sn, &view)?;
         gpu.queue.submit([encoder.finish()]);
         Ok::<(), GpuError>(())
     };
@@ -96,12 +105,12 @@ pub fn measure_upsampling(
         let bilinear = read_texture_rgba8(gpu, &target)?;
         upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N)?;
         let bilateral = read_texture_rgba8(gpu, &target)?;
-        // Fine-grained: only the lighting goes through the low-res buffer; albedo at full res.
-        scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
-        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N)?;
-        let lighting = read_texture_rgba8(gpu, &target)?;
+        // Fine-grained: only the lighting goes through the low-res buffer; the upsample pass
+        // multiplies it by the full-res albedo (the frame the timing below measures).
         scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
-        let fine = multiply_rgba8(&lighting, &read_texture_rgba8(gpu, albedo.color())?);
+        scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
+        fine_with(r)?;
+        let fine = read_texture_rgba8(gpu, &target)?;
         let images = [bilinear, bilateral, fine];
         let psnr = images.clone().map(|i| psnr_rgba8(&i, &reference));
         let ssim = images.clone().map(|i| ssim_rgba8(&i, &reference, w));
@@ -127,7 +136,8 @@ pub fn measure_upsampling(
     }
     // Whole frames, interleaved round by round: full-res shading against a full-res geometry
     // prepass (with the cheap albedo) + low-res shading + upsample, and against the fine-grained
-    // route (low-res lighting + full-res albedo, which writes the geometry too, + upsample).
+    // route (full-res albedo, which writes the geometry too, + low-res lighting + the upsample
+    // that multiplies them: the frame whose image is measured above).
     let prepass = LowResBuffer::new(gpu, w, h, format)?;
     let time = |f: &dyn Fn() -> Result<(), GpuError>| {
         wall_ms(&|| {
@@ -149,7 +159,7 @@ pub fn measure_upsampling(
             let b = time(&|| {
                 scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
                 scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
-                upsample_with(r, albedo.geometry(), SIGMA_Z, SIGMA_N)
+                fine_with(r)
             })?;
             ts.push([a, b]);
         }
