@@ -219,6 +219,36 @@ fn glsl_chains_under_the_expression_limit_parse_on_the_parser_thread() {
     }
 }
 
+#[test]
+fn wgsl_and_wesl_chains_are_bounded_and_compose_under_the_limit() {
+    // A 200,000-term sum or negation chain overflowed naga's WGSL front end and wesl-rs (8 MiB
+    // main thread); 4,000 overflowed wesl-rs there too.
+    let limit = lodkit::shaders::MAX_EXPRESSION_DEPTH;
+    for (language, file) in [
+        (SourceLanguage::Wgsl, "chain.wgsl"),
+        (SourceLanguage::Wesl, "chain.wesl"),
+    ] {
+        for (what, unit) in [("sum", "1.0 + "), ("negation", "- ")] {
+            let source = |n: usize| format!("fn f() -> f32 {{ return {}1.0; }}\n", unit.repeat(n));
+            let deep = source(200_000);
+            let e = compose(&deep, file, language).expect_err("past the limit");
+            assert_reportable(&e, &deep);
+            let d = e.diagnostic().expect("a source diagnostic");
+            assert_eq!(d.kind, DiagnosticKind::Limit, "{what} in {file}");
+            // Just under the limit it composes, on this 2 MiB test thread's behalf. (wesl-rs
+            // 0.4 prints `- -x` back as `--x`, which naga reads as a decrement: an error, not
+            // a limit.)
+            match compose(&source(limit - 64), file, language) {
+                Err(e) if language == SourceLanguage::Wesl && what == "negation" => {
+                    let d = e.diagnostic().expect("a source diagnostic");
+                    assert_ne!(d.kind, DiagnosticKind::Limit, "{what} in {file}");
+                }
+                r => r.unwrap_or_else(|e| panic!("{what} in {file} under the limit: {e}")),
+            }
+        }
+    }
+}
+
 /// A tower of function-like macros, each wrapping the one below `fan` times, with `unit` (a
 /// bracket pair, a doubling, or an unbalanced opener) at the bottom.
 fn macro_tower(levels: usize, fan: usize, unit: usize) -> String {

@@ -183,17 +183,24 @@ impl ShaderLibrary {
         let mut sources = Vec::new();
         for file in files {
             let text = read_source(&file)?;
+            if let Some(e) = super::limits::wgsl_too_deep(&text) {
+                return Err(super::limits::limit_error(
+                    &file.display().to_string(),
+                    &text,
+                    e,
+                ));
+            }
             if registry::define_import_path(&text).is_some() {
                 sources.push((file.display().to_string(), Arc::from(text)));
             }
         }
         split_duplicates(&mut sources, &mut self.unavailable);
-        add_modules(
-            &mut self.composer,
-            sources,
-            false,
-            Some(&mut self.unavailable),
-        )?;
+        // naga_oil parses each module: on a deep stack, as `compose` does.
+        let (composer, unavailable) = (&mut self.composer, &mut self.unavailable);
+        super::limits::on_deep_stack_once(|| {
+            add_modules(composer, sources, false, Some(unavailable))
+        })
+        .unwrap_or_else(|()| Err(deep_stack_failed("the user modules")))?;
         // What the composer gained: the modules that were added (others are unavailable).
         let mut names: Vec<String> = self
             .composer
@@ -216,12 +223,13 @@ impl ShaderLibrary {
                 "a module needs a `#define_import_path` line",
             ))));
         };
-        add_modules(
-            &mut self.composer,
-            vec![(file_path.to_owned(), Arc::from(source))],
-            false,
-            None,
-        )?;
+        if let Some(e) = super::limits::wgsl_too_deep(source) {
+            return Err(super::limits::limit_error(file_path, source, e));
+        }
+        let composer = &mut self.composer;
+        let sources = vec![(file_path.to_owned(), Arc::from(source))];
+        super::limits::on_deep_stack_once(|| add_modules(composer, sources, false, None))
+            .unwrap_or_else(|()| Err(deep_stack_failed(file_path)))?;
         self.user_modules.push(name.clone());
         Ok(name)
     }
@@ -229,6 +237,20 @@ impl ShaderLibrary {
     /// Composes a top-level shader against the library and validates it. A shader def set to
     /// `Bool(false)` is left out, so `#ifdef` sees it as off in WGSL and GLSL alike.
     pub fn compose(&mut self, desc: &ComposeDescriptor) -> Result<Composed, ShaderError> {
+        // The front ends recurse once per nesting level of an expression, and so do validation
+        // and the lowering of long operator chains: within the limits (`limits`) they run on a
+        // thread with a deep stack, whatever thread the engine calls from.
+        // (GLSL is checked after its includes and macros, WESL with its modules when linked.)
+        if desc.language == SourceLanguage::Wgsl
+            && let Some(e) = super::limits::wgsl_too_deep(desc.source)
+        {
+            return Err(super::limits::limit_error(desc.file_path, desc.source, e));
+        }
+        super::limits::on_deep_stack_once(|| self.compose_here(desc))
+            .unwrap_or_else(|()| Err(deep_stack_failed(desc.file_path)))
+    }
+
+    fn compose_here(&mut self, desc: &ComposeDescriptor) -> Result<Composed, ShaderError> {
         let mut defs = desc.shader_defs.clone();
         defs.retain(|_, v| *v != ShaderDefValue::Bool(false));
         let desc = &ComposeDescriptor {
@@ -448,6 +470,15 @@ impl ShaderLibrary {
         })?;
         Ok(Composed { module, info })
     }
+}
+
+/// The error when the deep-stack thread that parses `what` panicked or could not start.
+fn deep_stack_failed(what: &str) -> ShaderError {
+    ShaderError::Source(Box::new(Diagnostic::new(
+        DiagnosticKind::Parse,
+        what,
+        "naga or naga_oil failed on this file (it panicked, or no thread could be started)",
+    )))
 }
 
 /// Parses a list of naga validator capabilities, as `lodkit check --capabilities` takes it:

@@ -51,6 +51,30 @@ pub(crate) fn on_deep_stack<T: Send>(f: impl Fn() -> T + Sync) -> Result<T, ()> 
     })
 }
 
+/// [`on_deep_stack`] for work that runs once (it may borrow mutably); `Err` when it panicked
+/// or no thread could be started.
+pub(crate) fn on_deep_stack_once<T: Send>(f: impl FnOnce() -> T + Send) -> Result<T, ()> {
+    std::thread::scope(|scope| {
+        std::thread::Builder::new()
+            .name("lodkit-deep-stack".into())
+            .stack_size(GLSL_PARSER_STACK)
+            .spawn_scoped(scope, f)
+            .map_err(|_| ())?
+            .join()
+            .map_err(|_| ())
+    })
+}
+
+/// The `limit` error for `source` (the file `file`) at `e`.
+pub(crate) fn limit_error(file: &str, source: &str, e: TooDeep) -> super::ShaderError {
+    use super::diagnostic::{Diagnostic, DiagnosticKind};
+    let d = Diagnostic::new(DiagnosticKind::Limit, file, e.what)
+        .with_span(std::sync::Arc::from(source), e.at)
+        .with_label("nested too deep")
+        .with_hint("split the expression into local variables");
+    super::ShaderError::Source(Box::new(d))
+}
+
 /// Where a limit was passed, and which.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct TooDeep {
@@ -71,6 +95,116 @@ impl TooDeep {
     }
 }
 
+/// A token as the nesting count sees it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Tok {
+    /// `(`, `[` or `{`.
+    Open,
+    /// `)`, `]`, or `}` (`brace`).
+    Close { brace: bool },
+    /// `;` or `,`: ends an expression at its level.
+    Separator,
+    /// An operator the parser or its lowering recurses on (`+`, `-`, `!`, `?`, `=`, `<`, ...).
+    Operator,
+    /// `else`: an `else if` chain nests one level per `else`.
+    Else,
+    /// `if`, `for`, `while`, `do`, `loop`, `switch`: a statement that nests the next.
+    Keyword,
+    /// Anything else.
+    Other,
+}
+
+/// The nesting of an expression or statement: its brackets, the operators and keywords chained
+/// at each bracket level since that level's last `;` or `,`, and the `else`s of the `else if`
+/// chain going on at each level (a chain goes on while the token after a statement is `else`).
+#[derive(Default)]
+struct Nesting {
+    levels: Vec<Level>,
+    /// Open brackets plus every level's chained tokens and elses.
+    depth: usize,
+}
+
+#[derive(Default)]
+struct Level {
+    chained: usize,
+    elses: usize,
+    statement_ended: bool,
+}
+
+impl Nesting {
+    fn new() -> Self {
+        Self {
+            levels: vec![Level::default()],
+            depth: 0,
+        }
+    }
+
+    /// Counts `tok` (at bytes `at`); where a limit is passed, which.
+    fn token(&mut self, tok: Tok, at: Range<usize>) -> Option<TooDeep> {
+        let top = self
+            .levels
+            .last_mut()
+            .expect("the file level is never closed");
+        if std::mem::take(&mut top.statement_ended) && tok != Tok::Else {
+            self.depth -= top.elses;
+            top.elses = 0;
+        }
+        match tok {
+            Tok::Open => {
+                if self.levels.len() > MAX_NESTING {
+                    return Some(TooDeep::brackets(at));
+                }
+                self.levels.push(Level::default());
+                self.depth += 1;
+            }
+            Tok::Close { brace } => {
+                if self.levels.len() > 1 {
+                    let closed = self.levels.pop().expect("more than one level");
+                    self.depth -= 1 + closed.chained + closed.elses;
+                    // A block is a statement: it ends what was chained before it, and an
+                    // `else` may follow it.
+                    let parent = self.levels.last_mut().expect("the file level stays");
+                    if brace {
+                        self.depth -= parent.chained;
+                        parent.chained = 0;
+                    }
+                    parent.statement_ended = brace;
+                }
+            }
+            Tok::Separator => {
+                self.depth -= top.chained;
+                top.chained = 0;
+                top.statement_ended = true;
+            }
+            Tok::Operator | Tok::Keyword => {
+                top.chained += 1;
+                self.depth += 1;
+            }
+            Tok::Else => {
+                top.elses += 1;
+                self.depth += 1;
+            }
+            Tok::Other => {}
+        }
+        (self.depth > MAX_EXPRESSION_DEPTH).then(|| {
+            let what = format!(
+                "an expression or statement nests more than {MAX_EXPRESSION_DEPTH} levels deep \
+                 (brackets, chained operators, `else if`s)"
+            );
+            TooDeep { at, what }
+        })
+    }
+}
+
+/// What a word is to the nesting count.
+fn word_tok(word: &str) -> Tok {
+    match word {
+        "else" => Tok::Else,
+        "if" | "for" | "while" | "do" | "loop" | "switch" => Tok::Keyword,
+        _ => Tok::Other,
+    }
+}
+
 /// The first token of `text`, expanded by naga's own preprocessor with `defines`, at which an
 /// expression or statement nests past [`MAX_NESTING`] brackets or [`MAX_EXPRESSION_DEPTH`]
 /// (see there), or past [`MAX_EXPANDED_TOKENS`] tokens in all. Run it after
@@ -78,90 +212,97 @@ impl TooDeep {
 /// left to the parser, which reports them.
 pub(crate) fn expression_too_deep(text: &str, defines: &[(String, String)]) -> Option<TooDeep> {
     use pp_rs::token::{Punct, TokenValue};
-    /// One open bracket: the operators and keywords chained inside it since its last `;` or
-    /// `,`, and the `else`s of the `else if` chain going on in it (a chain spans statements:
-    /// it goes on while the token after a statement is `else`).
-    #[derive(Default)]
-    struct Level {
-        chained: usize,
-        elses: usize,
-        statement_ended: bool,
-    }
     let mut pp = pp_rs::pp::Preprocessor::new(text);
     for (name, value) in defines {
         let _ = pp.add_define(name, value);
     }
-    let mut levels = vec![Level::default()];
-    let mut depth = 0usize; // levels.len() - 1 + every level's chained + elses
-    let mut brackets = 0usize;
-    let mut count = 0u64;
-    for token in pp {
+    let mut nesting = Nesting::new();
+    for (count, token) in pp.enumerate() {
         let Ok(token) = token else { continue };
         let at = token.location.start as usize..token.location.end as usize;
-        count += 1;
-        if count > MAX_EXPANDED_TOKENS {
+        if count as u64 >= MAX_EXPANDED_TOKENS {
             let what = format!("macros expand the file past {MAX_EXPANDED_TOKENS} tokens");
             return Some(TooDeep { at, what });
         }
-        let top = levels.last_mut().expect("the file level is never closed");
-        let is_else = matches!(&token.value, TokenValue::Ident(w) if w == "else");
-        if std::mem::take(&mut top.statement_ended) && !is_else {
-            depth -= top.elses;
-            top.elses = 0;
-        }
-        match token.value {
+        let tok = match token.value {
             TokenValue::Punct(Punct::LeftParen | Punct::LeftBracket | Punct::LeftBrace) => {
-                brackets += 1;
-                if brackets > MAX_NESTING {
-                    let mut e = TooDeep::brackets(at);
-                    e.what += " after macro expansion";
-                    return Some(e);
-                }
-                levels.push(Level::default());
-                depth += 1;
+                Tok::Open
             }
-            TokenValue::Punct(
-                p @ (Punct::RightParen | Punct::RightBracket | Punct::RightBrace),
-            ) => {
-                if levels.len() > 1 {
-                    let closed = levels.pop().expect("more than one level");
-                    depth -= 1 + closed.chained + closed.elses;
-                    brackets -= 1;
-                    // A block is a statement: an `else` may follow it.
-                    let parent = levels.last_mut().expect("the file level stays");
-                    parent.statement_ended = p == Punct::RightBrace;
-                }
-                continue;
+            TokenValue::Punct(Punct::RightParen | Punct::RightBracket) => {
+                Tok::Close { brace: false }
             }
-            TokenValue::Punct(Punct::Semicolon | Punct::Comma) => {
-                depth -= top.chained;
-                top.chained = 0;
-                top.statement_ended = true;
-                continue;
+            TokenValue::Punct(Punct::RightBrace) => Tok::Close { brace: true },
+            TokenValue::Punct(Punct::Semicolon | Punct::Comma) => Tok::Separator,
+            TokenValue::Punct(Punct::Dot) => Tok::Other,
+            TokenValue::Punct(_) => Tok::Operator,
+            TokenValue::Ident(ref word) => word_tok(word),
+            _ => Tok::Other,
+        };
+        if let Some(mut e) = nesting.token(tok, at) {
+            if tok == Tok::Open {
+                e.what += " after macro expansion";
             }
-            TokenValue::Punct(Punct::Dot) => continue,
-            TokenValue::Punct(_) => {
-                top.chained += 1;
-                depth += 1;
-            }
-            TokenValue::Ident(_) if is_else => {
-                top.elses += 1;
-                depth += 1;
-            }
-            TokenValue::Ident(ref word)
-                if matches!(word.as_str(), "if" | "for" | "while" | "do") =>
-            {
-                top.chained += 1;
-                depth += 1;
-            }
-            _ => continue,
+            return Some(e);
         }
-        if depth > MAX_EXPRESSION_DEPTH {
-            let what = format!(
-                "an expression or statement nests more than {MAX_EXPRESSION_DEPTH} levels deep \
-                 (brackets, chained operators, `else if`s)"
-            );
-            return Some(TooDeep { at, what });
+    }
+    None
+}
+
+/// The first token of WGSL or WESL `source` at which an expression or statement nests past
+/// [`MAX_NESTING`] brackets or [`MAX_EXPRESSION_DEPTH`] (see there). naga's WGSL front end and
+/// wesl-rs recurse on long operator chains as naga's GLSL parser does. Comments and naga_oil's
+/// `#` directive lines are skipped; every operator character counts (`->` twice), which only
+/// makes the count larger.
+pub(crate) fn wgsl_too_deep(source: &str) -> Option<TooDeep> {
+    let mut nesting = Nesting::new();
+    let mut chars = source.char_indices().peekable();
+    let mut line_start = true;
+    while let Some((i, c)) = chars.next() {
+        let rest = &source[i..];
+        let tok = match c {
+            '\n' => {
+                line_start = true;
+                continue;
+            }
+            c if c.is_whitespace() => continue,
+            '#' if line_start => {
+                while chars.next_if(|&(_, c)| c != '\n').is_some() {}
+                continue;
+            }
+            '/' if rest.starts_with("//") => {
+                while chars.next_if(|&(_, c)| c != '\n').is_some() {}
+                continue;
+            }
+            '/' if rest.starts_with("/*") => {
+                // WGSL block comments nest.
+                let (mut open, mut last) = (0usize, '\0');
+                for (_, c) in chars.by_ref() {
+                    match (last, c) {
+                        ('/', '*') => (open, last) = (open + 1, '\0'),
+                        ('*', '/') if open == 0 => break,
+                        ('*', '/') => (open, last) = (open - 1, '\0'),
+                        _ => last = c,
+                    }
+                }
+                continue;
+            }
+            '(' | '[' | '{' => Tok::Open,
+            ')' | ']' => Tok::Close { brace: false },
+            '}' => Tok::Close { brace: true },
+            ';' | ',' => Tok::Separator,
+            '.' | ':' | '@' | '"' | '\'' => Tok::Other,
+            c if c.is_alphanumeric() || c == '_' => {
+                let mut end = i + c.len_utf8();
+                while let Some((j, d)) = chars.next_if(|&(_, d)| d.is_alphanumeric() || d == '_') {
+                    end = j + d.len_utf8();
+                }
+                word_tok(&source[i..end])
+            }
+            _ => Tok::Operator,
+        };
+        line_start = false;
+        if let Some(e) = nesting.token(tok, i..i + c.len_utf8()) {
+            return Some(e);
         }
     }
     None

@@ -104,17 +104,13 @@ pub(crate) fn link(
             resolver.add_module(path(import), m.source.into());
         }
     }
-    // Brackets nested past the limit would recurse the WESL parser off the stack.
+    // Brackets or operator chains nested past the limits would recurse the WESL parser off the
+    // stack.
     for (text, name) in std::iter::once((source, file))
         .chain(user_modules.iter().map(|m| (&*m.source, m.file.as_str())))
     {
-        if let Some(nesting) = super::limits::too_deep(text) {
-            let message = nesting.message();
-            return Err(source_error(
-                Diagnostic::new(DiagnosticKind::Limit, name, message)
-                    .with_span(Arc::from(text), nesting.at)
-                    .with_label("nested too deep"),
-            ));
+        if let Some(nesting) = super::limits::wgsl_too_deep(text) {
+            return Err(super::limits::limit_error(name, text, nesting));
         }
     }
     // A user module at the root's own path (a `main.wesl` in an include folder) would replace
