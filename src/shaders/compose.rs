@@ -427,8 +427,8 @@ impl ShaderLibrary {
             defines: defines.into_iter().collect(),
         };
         // Within the limits above naga's parser still recurses thousands of levels deep, and the
-        // validator recurses once per nested block (a `?:` chain nests as deep): both run on a
-        // thread with a deep stack.
+        // validator recurses once per nested block (a `?:` chain nests as deep): `compose` runs
+        // this on a thread with a deep stack. A panic in naga is this file's error.
         let capabilities = self.capabilities;
         let parse_and_validate = || {
             let module = naga::front::glsl::Frontend::default().parse(&options, text)?;
@@ -437,7 +437,8 @@ impl ShaderLibrary {
                     .validate(&module);
             Ok((module, info))
         };
-        let parsed = super::limits::on_deep_stack(parse_and_validate).map_err(|()| {
+        let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse_and_validate));
+        let parsed = parsed.map_err(|_| {
             ShaderError::Source(Box::new(expanded.diagnostic(
                 DiagnosticKind::Parse,
                 0..0,
