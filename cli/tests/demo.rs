@@ -225,7 +225,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             c.name, c.settling_frames
         ));
     }
-    for run in &report.closed_loop.runs {
+    for run in report.closed_loop.runs() {
         say(&format!(
             "demo figure closed loop {}: settled {:?} within {:.2} overshoot {:.2} spread {:.2}",
             run.name, run.settling_frames, run.frames_within, run.overshoot, run.spread
@@ -411,7 +411,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     // at this test's 128x72 the frame time is mostly overhead and noise (the paper's controller
     // once went from 2.25 to 2.33 only), the demo's tables at 1280x720 show it.
     let closed = &report.closed_loop;
-    assert_eq!(closed.runs.len(), 3);
+    assert_eq!(closed.runs().count(), 3);
     assert!(closed.repeats.iter().all(|runs| runs.len() == 3));
     let step = lodkit_cli::demo::closed_loop::STEP_FRAME;
     for run in closed.repeats.iter().flatten() {

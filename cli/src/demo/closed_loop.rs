@@ -71,10 +71,15 @@ pub struct ClosedLoop {
     /// Relative standard deviation of the calibration frames at [`TARGET_R`]: the noise lodkit's
     /// controller is told to expect.
     pub noise: f32,
-    /// The first run of each controller (the plots show these).
-    pub runs: Vec<ClosedLoopRun>,
-    /// Every run of each controller: [`REPEATS`] per controller, in the order of `runs`.
+    /// Every run of each controller: [`REPEATS`] per controller.
     pub repeats: Vec<Vec<ClosedLoopRun>>,
+}
+
+impl ClosedLoop {
+    /// The first run of each controller (the plots show these).
+    pub fn runs(&self) -> impl Iterator<Item = &ClosedLoopRun> {
+        self.repeats.iter().filter_map(|runs| runs.first())
+    }
 }
 
 /// Runs lodkit's controller, the paper's and the step heuristic on the edge scene at `size`.
@@ -123,13 +128,11 @@ pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedL
             repeats[k].push(run);
         }
     }
-    let runs = repeats.iter().map(|r| r[0].clone()).collect();
     Ok(ClosedLoop {
         size,
         target_ms,
         paper_k,
         noise,
-        runs,
         repeats,
     })
 }
@@ -270,8 +273,7 @@ pub fn summary(closed: &ClosedLoop) -> String {
 pub fn write_plots(closed: &ClosedLoop, out: &Path) -> Result<(), DemoError> {
     let series = |of: &dyn Fn(&ClosedLoopRun) -> &Vec<f32>| -> Vec<Series> {
         closed
-            .runs
-            .iter()
+            .runs()
             .map(|run| Series {
                 name: run.name.clone(),
                 points: of(run)

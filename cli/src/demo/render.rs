@@ -517,8 +517,9 @@ impl<'a> SceneRenderer<'a> {
                 .filter_map(|key| scheduler.draw(*key).ok().map(|d| d.id))
                 .collect();
             let merged = merge_rects(&regions);
-            for buffer in [index, 1 - index] {
-                let image = read_lod_image(gpu, &self.buffers, buffer)?;
+            let newer = read_lod_image(gpu, &self.buffers, index)?;
+            let older = read_lod_image(gpu, &self.buffers, 1 - index)?;
+            for image in [&newer, &older] {
                 let outside = image.ids.iter().enumerate().filter(|&(p, id)| {
                     let (x, y) = (p as u32 % image.width, p as u32 / image.width);
                     *id != 0 && t_ids.contains(id) && !merged.iter().any(|r| r.contains(x, y))
@@ -539,8 +540,6 @@ impl<'a> SceneRenderer<'a> {
             )?;
             gpu.queue.submit([encoder.finish()]);
             if let Some(f) = on_sources.as_mut().filter(|_| frame == middle) {
-                let newer = read_lod_image(gpu, &self.buffers, index)?;
-                let older = read_lod_image(gpu, &self.buffers, 1 - index)?;
                 let sources = combine_images(&newer, &older, &m, DepthConvention::Standard);
                 f(sources.iter().map(|p| p.source).collect());
             }
