@@ -174,6 +174,20 @@ impl RlsController {
         }
     }
 
+    /// The same controller starting at `r` (clamped to [1, r_max]) instead of 1: for a
+    /// controller replaced mid-run (a new target or limits) that should not jump back to r = 1.
+    ///
+    /// ```
+    /// # use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController};
+    /// let c = RlsController::new(0.016, ResizeLimits::default()).starting_at(2.5);
+    /// assert_eq!(c.r(), 2.5);
+    /// assert_eq!(RlsController::new(0.016, ResizeLimits::default()).starting_at(9.0).r(), 4.0);
+    /// ```
+    pub fn starting_at(mut self, r: f32) -> Self {
+        self.r = self.limits.apply(r, r);
+        self
+    }
+
     /// Current estimates (K, C).
     pub fn estimates(&self) -> (f32, f32) {
         (self.theta[0] as f32, self.theta[1] as f32)
@@ -218,10 +232,36 @@ impl ResizeController for RlsController {
     }
 
     fn update(&mut self, frame_time: f32) -> f32 {
-        if !valid(frame_time) {
+        self.observe(self.r, frame_time)
+    }
+}
+
+impl RlsController {
+    /// Like [`ResizeController::update`], for a frame time measured at `rendered_r`, which need
+    /// not be the current r: GPU timestamps arrive a frame or more late, and by then r has moved.
+    /// Crediting each time to the r it was rendered at keeps K and C right under that delay.
+    /// A NaN or non-positive `rendered_r` or time is ignored (r is kept).
+    ///
+    /// ```
+    /// # use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController};
+    /// // 26 ms at r = 1 and 14 ms at r = 2, credited to the r they were rendered at:
+    /// // t = 16 / r^2 + 10 (ms).
+    /// let mut c = RlsController::new(0.020, ResizeLimits::default());
+    /// for _ in 0..30 {
+    ///     c.observe(1.0, 0.026);
+    ///     c.observe(2.0, 0.014);
+    /// }
+    /// let (k, overhead) = c.estimates();
+    /// assert!((k - 0.016).abs() < 0.002 && (overhead - 0.010).abs() < 0.002, "{k} {overhead}");
+    /// ```
+    pub fn observe(&mut self, rendered_r: f32, frame_time: f32) -> f32 {
+        if !valid(frame_time) || !valid(rendered_r) {
             return self.r;
         }
-        self.learn(1.0 / f64::from(self.r * self.r), f64::from(frame_time));
+        self.learn(
+            1.0 / f64::from(rendered_r * rendered_r),
+            f64::from(frame_time),
+        );
         let (k, c) = (self.theta[0], self.theta[1]);
         let wanted = if k > 1e-9 {
             let x_new = (f64::from(self.target) - c) / k;

@@ -2,48 +2,50 @@
 //! rendered headless and captured frame by frame.
 //!
 //! ```text
-//! cargo run --release [-- [--check] [OUT.png]]     (default OUT: lodkit-bevy-strip.png)
+//! cargo run --example crossfade [-- [--check] [OUT.png]]   (default OUT: lodkit-bevy-strip.png)
 //! ```
 //!
-//! What a Bevy application needs from lodkit (the first two live in `lod_material.rs`, the
+//! What a Bevy application needs from lodkit (the material lives in `lod_material.rs`, the
 //! part to copy):
 //!
-//! 1. [`LodkitShadersPlugin`]: every lodkit WGSL module becomes a `Shader` asset, so a material
-//!    can `#import lodkit::screen_door::screen_door_keep` (Bevy's naga_oil resolves imports
-//!    through `Assets<Shader>`; lodkit is used with `default-features = false`, no naga of its own).
+//! 1. `lodkit_bevy::LodkitShadersPlugin`: every lodkit WGSL module becomes a `Shader` asset, so a
+//!    material can `#import lodkit::screen_door::screen_door_keep` (Bevy's naga_oil resolves
+//!    imports through `Assets<Shader>`; lodkit is used with `default-features = false`).
 //! 2. [`LodDitherMaterial`]: a `Material` whose fragment shader (`assets/shaders/lod_dither.wgsl`)
 //!    discards through lodkit's pattern with a signed alpha per level.
 //! 3. [`LodDriver`]: `lodkit::select` decides which level(s) to draw and the transition `t`;
 //!    [`apply_selection`] turns `LodSelection::screen_door_alphas()` into visibility and alphas.
 //!
-//! The loop follows Bevy's `examples/app/externally_driven_headless_renderer.rs`: no window, no
-//! runner, `app.update()` pumped by hand, a camera rendering into an `Image`, `Screenshot`s read
-//! back through an observer. Exit codes: 0 done, 1 nothing rendered or `--check` failed, 2 usage
+//! The headless loop is `../common/headless.rs`. Exit codes: 0 done, 1 nothing rendered or `--check` failed, 2 usage
 //! or I/O error.
 
+#[path = "../common/frames.rs"]
+#[allow(
+    dead_code,
+    reason = "shared by the examples and tests; each uses a part"
+)]
+mod frames;
+#[path = "../common/headless.rs"]
+mod headless;
 mod lod_material;
+mod transition;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use bevy::asset::RenderAssetUsages;
 use bevy::camera::{CameraProjection, RenderTarget};
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
-use bevy::render::render_resource::{
-    Extent3d, PollType, TextureDimension, TextureFormat, TextureUsages,
-};
-use bevy::render::renderer::RenderDevice;
-use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::window::ExitCondition;
 use lodkit::select::{LodCamera, LodGroup, LodSelection, LodSettings, LodState, TransitionMode};
-use lodkit_bevy_example::{Frame, TransitionReport, strip};
+use lodkit_bevy::LodkitShadersPlugin;
 
+use frames::strip;
+use headless::{build_app, capture, render_target, save_png};
 use lod_material::{
-    LevelEntity, LodDitherMaterial, LodDitherParams, LodkitShadersPlugin, apply_selection,
+    LevelEntity, LodDitherMaterial, LodDitherParams, LodDitherShaderPlugin, apply_selection,
     show_levels,
 };
+use transition::TransitionReport;
 
 /// Size of one frame of the strip.
 const SIZE: u32 = 160;
@@ -51,8 +53,6 @@ const SIZE: u32 = 160;
 const TRANSITION_FRAMES: usize = 12;
 /// Duration of a transition; each captured frame advances time by a `TRANSITION_FRAMES`th of it.
 const TRANSITION_SECONDS: f32 = 0.5;
-/// Updates to wait for one screenshot to come back from the GPU.
-const READBACK_UPDATES: usize = 8;
 /// Frames to wait for a level to appear before declaring the pipeline never ready.
 const WARMUP_FRAMES: usize = 30;
 /// LOD1 is used from this view-normalized distance on (distance / |P[1][1]|, DigitalRune's
@@ -98,51 +98,9 @@ impl LodDriver {
     }
 }
 
-/// Where the last screenshot's image lands (filled by the screenshot observer).
-#[derive(Resource, Default)]
-struct ScreenshotInbox(Option<Image>);
-
-/// A headless app: no window, no runner, shaders compiled synchronously so the first frames draw.
-fn build_app() -> App {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin {
-                primary_window: None,
-                exit_condition: ExitCondition::DontExit,
-                ..default()
-            })
-            .set(RenderPlugin {
-                synchronous_pipeline_compilation: true,
-                ..default()
-            }),
-    )
-    .add_plugins((
-        LodkitShadersPlugin,
-        MaterialPlugin::<LodDitherMaterial>::default(),
-    ))
-    .init_resource::<ScreenshotInbox>();
-    // What `App::run` would do before its first update; we never call it.
-    app.finish();
-    app.cleanup();
-    app
-}
-
 /// The scene: the render target, a camera and a light, and the two levels at the origin.
 fn spawn_scene(world: &mut World) -> (Handle<Image>, Vec<LevelEntity>) {
-    let size = Extent3d {
-        width: SIZE,
-        height: SIZE,
-        depth_or_array_layers: 1,
-    };
-    let mut target = Image::new_uninit(
-        size,
-        TextureDimension::D2,
-        TextureFormat::Rgba8UnormSrgb,
-        RenderAssetUsages::RENDER_WORLD,
-    );
-    target.texture_descriptor.usage |= TextureUsages::RENDER_ATTACHMENT;
-    let target = world.resource_mut::<Assets<Image>>().add(target);
+    let target = render_target(world, SIZE, SIZE);
 
     // Exact colors for the checks: no MSAA (edge pixels would mix), no tonemapping, no debanding noise.
     world.spawn((
@@ -202,43 +160,6 @@ fn spawn_scene(world: &mut World) -> (Handle<Image>, Vec<LevelEntity>) {
     (target, levels)
 }
 
-/// Runs one frame and waits for the GPU to finish it.
-fn step(app: &mut App) {
-    app.update();
-    app.world()
-        .resource::<RenderDevice>()
-        .wgpu_device()
-        .poll(PollType::Wait {
-            submission_index: None,
-            timeout: None,
-        })
-        .expect("the GPU device was lost");
-}
-
-/// Renders a frame with a screenshot of `target` and pumps updates until its pixels are back.
-fn capture(app: &mut App, target: &Handle<Image>) -> Result<Frame, String> {
-    app.world_mut()
-        .spawn(Screenshot::image(target.clone()))
-        .observe(
-            |shot: On<ScreenshotCaptured>, mut inbox: ResMut<ScreenshotInbox>| {
-                inbox.0 = Some(shot.image.clone());
-            },
-        );
-    for _ in 0..READBACK_UPDATES {
-        step(app);
-        if let Some(image) = app.world_mut().resource_mut::<ScreenshotInbox>().0.take() {
-            let (width, height) = (image.width(), image.height());
-            let pixels = image
-                .try_into_dynamic()
-                .map_err(|e| format!("screenshot: {e}"))?;
-            return Ok(Frame::new(width, height, pixels.to_rgba8().into_raw()));
-        }
-    }
-    Err(format!(
-        "no screenshot came back within {READBACK_UPDATES} updates"
-    ))
-}
-
 /// Whether anything but the background shows up within `frames` frames.
 fn drawn_within(app: &mut App, target: &Handle<Image>, frames: usize) -> Result<bool, String> {
     for _ in 0..frames {
@@ -255,7 +176,13 @@ struct Failure(u8, String);
 
 fn run(out: &Path, check: bool) -> Result<(), Failure> {
     let io = |message: String| Failure(2, message);
-    let mut app = build_app();
+    let mut app = build_app(|app| {
+        app.add_plugins((
+            LodkitShadersPlugin,
+            LodDitherShaderPlugin,
+            MaterialPlugin::<LodDitherMaterial>::default(),
+        ));
+    });
     let (target, levels) = spawn_scene(app.world_mut());
 
     // Warm-up: show each level alone until it appears. Bevy gives no error when a shader import
@@ -329,26 +256,6 @@ fn run(out: &Path, check: bool) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Writes `frame` as a PNG through Bevy's own image conversion (`png` feature).
-fn save_png(frame: &Frame, path: &Path) -> Result<(), String> {
-    let size = Extent3d {
-        width: frame.width,
-        height: frame.height,
-        depth_or_array_layers: 1,
-    };
-    let image = Image::new(
-        size,
-        TextureDimension::D2,
-        frame.rgba.clone(),
-        TextureFormat::Rgba8UnormSrgb,
-        RenderAssetUsages::MAIN_WORLD,
-    );
-    let dynamic = image.try_into_dynamic().map_err(|e| e.to_string())?;
-    dynamic
-        .save(path)
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
-
 fn main() -> ExitCode {
     let mut check = false;
     let mut out = None;
@@ -356,12 +263,12 @@ fn main() -> ExitCode {
         match arg.as_str() {
             "--check" => check = true,
             "-h" | "--help" => {
-                println!("usage: lodkit-bevy-example [--check] [OUT.png]");
+                println!("usage: crossfade [--check] [OUT.png]");
                 return ExitCode::SUCCESS;
             }
             _ if arg.starts_with('-') || out.is_some() => {
                 eprintln!(
-                    "error: unexpected argument `{arg}`\nusage: lodkit-bevy-example [--check] [OUT.png]"
+                    "error: unexpected argument `{arg}`\nusage: crossfade [--check] [OUT.png]"
                 );
                 return ExitCode::from(2);
             }

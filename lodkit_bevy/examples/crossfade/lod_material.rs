@@ -1,6 +1,7 @@
-//! The part of the example to copy into a Bevy 0.19 application: lodkit's shader modules as
-//! `Shader` assets, a material that draws one LOD level through lodkit's complementary
-//! screen-door pattern, and applying a `lodkit::select::LodSelection` to a group's entities.
+//! The part of the example to copy into a Bevy 0.19 application: a material that draws one LOD
+//! level through lodkit's complementary screen-door pattern (its shader imports
+//! `lodkit::screen_door`, registered by `lodkit_bevy::LodkitShadersPlugin`), and applying a
+//! `lodkit::select::LodSelection` to a group's entities.
 
 use bevy::asset::uuid_handle;
 use bevy::prelude::*;
@@ -8,45 +9,24 @@ use bevy::reflect::TypePath;
 use bevy::render::render_resource::{AsBindGroup, ShaderType};
 use bevy::shader::ShaderRef;
 use lodkit::select::LodSelection;
-use lodkit::shaders::{Language, ModuleKind};
 
 /// The material's fragment shader, under a fixed handle (embedded, so no asset folder is needed).
 const LOD_DITHER_SHADER: Handle<Shader> = uuid_handle!("6f0c1c52-93a4-4d7e-9a51-2b7e0d3c5a10");
 
-/// Registers every lodkit WGSL module, and this example's material shader, as `Shader` assets.
-///
-/// Register all modules, not just the one you import: they import each other, and Bevy reports
-/// a missing module only as a pipeline that never becomes ready.
-pub struct LodkitShadersPlugin;
+/// Registers this example's material shader under its fixed handle (lodkit's modules it imports
+/// come from `lodkit_bevy::LodkitShadersPlugin`).
+pub struct LodDitherShaderPlugin;
 
-/// Strong handles that keep lodkit's modules loaded for the app's lifetime.
-#[derive(Resource)]
-pub struct LodkitShaders(
-    #[expect(
-        dead_code,
-        reason = "held, never read: dropping the handles unloads the modules"
-    )]
-    Vec<Handle<Shader>>,
-);
-
-impl Plugin for LodkitShadersPlugin {
+impl Plugin for LodDitherShaderPlugin {
     fn build(&self, app: &mut App) {
-        let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
-        // `from_wgsl` reads `#define_import_path lodkit::<topic>` from the source: that is the
-        // name `#import` resolves, whatever the asset path.
-        let modules: Vec<Handle<Shader>> = lodkit::shaders::modules()
-            .iter()
-            .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
-            .map(|m| shaders.add(Shader::from_wgsl(m.source, m.path)))
-            .collect();
-        let source = include_str!("../assets/shaders/lod_dither.wgsl");
-        shaders
+        let source = include_str!("lod_dither.wgsl");
+        app.world_mut()
+            .resource_mut::<Assets<Shader>>()
             .insert(
                 &LOD_DITHER_SHADER,
                 Shader::from_wgsl(source, "shaders/lod_dither.wgsl"),
             )
             .expect("UUID handles never fail to insert");
-        app.insert_resource(LodkitShaders(modules));
     }
 }
 

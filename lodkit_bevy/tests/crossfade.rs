@@ -2,11 +2,21 @@
 //! the shader's `screen_door_keep` (so we know they pass a good crossfade and catch a pop or a
 //! see-through one), then run on what Bevy renders (`--check`).
 
-use std::process::Command;
+#[path = "../examples/common/frames.rs"]
+#[allow(
+    dead_code,
+    reason = "shared with the examples; not every helper is used here"
+)]
+mod frames;
+mod support;
+#[path = "../examples/crossfade/transition.rs"]
+mod transition;
 
 use glam::Vec2;
 use lodkit::screen_door::screen_door_keep;
-use lodkit_bevy_example::{Frame, TransitionReport, strip};
+
+use frames::{Frame, strip};
+use transition::TransitionReport;
 
 const SIZE: u32 = 32;
 const BACKGROUND: [u8; 3] = [20, 23, 31];
@@ -107,21 +117,15 @@ fn strip_places_frames_side_by_side() {
 #[test]
 fn bevy_renders_a_complementary_crossfade() {
     let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("lodkit-bevy-strip.png");
-    let output = Command::new(env!("CARGO_BIN_EXE_lodkit-bevy-example"))
-        .arg("--check")
-        .arg(&out)
-        .output()
-        .expect("run the example");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    let strict = std::env::var("LODKIT_REQUIRE_GPU").is_ok_and(|v| v == "1");
-    if !output.status.success() && stderr.contains("Unable to find a GPU") && !strict {
-        eprintln!("SKIPPED: no GPU adapter (install mesa-vulkan-drivers for lavapipe)");
+    let Some(output) = support::run_example("crossfade", &["--check".as_ref(), out.as_os_str()])
+    else {
         return;
-    }
+    };
     assert!(
         output.status.success(),
-        "example failed:\n{stdout}\n{stderr}"
+        "example failed:\n{}\n{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
     );
     assert!(out.exists(), "no strip at {}", out.display());
 }

@@ -1,0 +1,122 @@
+//! A headless Bevy app for the examples, after Bevy's
+//! `examples/app/externally_driven_headless_renderer.rs`: no window, no runner, `app.update()`
+//! pumped by hand, cameras rendering into an `Image`, `Screenshot`s read back through an observer.
+
+use std::path::Path;
+
+use bevy::asset::RenderAssetUsages;
+use bevy::prelude::*;
+use bevy::render::RenderPlugin;
+use bevy::render::render_resource::{
+    Extent3d, PollType, TextureDimension, TextureFormat, TextureUsages,
+};
+use bevy::render::renderer::RenderDevice;
+use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
+use bevy::window::ExitCondition;
+
+use crate::frames::Frame;
+
+/// Updates to wait for one screenshot to come back from the GPU.
+const READBACK_UPDATES: usize = 8;
+
+/// Where the last screenshot's image lands (filled by the screenshot observer).
+#[derive(Resource, Default)]
+struct ScreenshotInbox(Option<Image>);
+
+/// A headless app with `plugins` added: no window, no runner, shaders compiled synchronously so
+/// the first frames draw.
+pub fn build_app(plugins: impl FnOnce(&mut App)) -> App {
+    let mut app = App::new();
+    app.add_plugins(
+        DefaultPlugins
+            .set(WindowPlugin {
+                primary_window: None,
+                exit_condition: ExitCondition::DontExit,
+                ..default()
+            })
+            .set(RenderPlugin {
+                synchronous_pipeline_compilation: true,
+                ..default()
+            }),
+    )
+    .init_resource::<ScreenshotInbox>();
+    plugins(&mut app);
+    // What `App::run` would do before its first update; we never call it.
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// An sRGB image a camera can render into, `width` x `height`.
+pub fn render_target(world: &mut World, width: u32, height: u32) -> Handle<Image> {
+    let size = Extent3d {
+        width,
+        height,
+        depth_or_array_layers: 1,
+    };
+    let mut target = Image::new_uninit(
+        size,
+        TextureDimension::D2,
+        TextureFormat::Rgba8UnormSrgb,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    target.texture_descriptor.usage |= TextureUsages::RENDER_ATTACHMENT;
+    world.resource_mut::<Assets<Image>>().add(target)
+}
+
+/// Runs one frame and waits for the GPU to finish it.
+pub fn step(app: &mut App) {
+    app.update();
+    app.world()
+        .resource::<RenderDevice>()
+        .wgpu_device()
+        .poll(PollType::Wait {
+            submission_index: None,
+            timeout: None,
+        })
+        .expect("the GPU device was lost");
+}
+
+/// Renders a frame with a screenshot of `target` and pumps updates until its pixels are back.
+pub fn capture(app: &mut App, target: &Handle<Image>) -> Result<Frame, String> {
+    app.world_mut()
+        .spawn(Screenshot::image(target.clone()))
+        .observe(
+            |shot: On<ScreenshotCaptured>, mut inbox: ResMut<ScreenshotInbox>| {
+                inbox.0 = Some(shot.image.clone());
+            },
+        );
+    for _ in 0..READBACK_UPDATES {
+        step(app);
+        if let Some(image) = app.world_mut().resource_mut::<ScreenshotInbox>().0.take() {
+            let (width, height) = (image.width(), image.height());
+            let pixels = image
+                .try_into_dynamic()
+                .map_err(|e| format!("screenshot: {e}"))?;
+            return Ok(Frame::new(width, height, pixels.to_rgba8().into_raw()));
+        }
+    }
+    Err(format!(
+        "no screenshot came back within {READBACK_UPDATES} updates"
+    ))
+}
+
+/// Writes `frame` as a PNG through Bevy's own image conversion (`png` feature).
+pub fn save_png(frame: &Frame, path: &Path) -> Result<(), String> {
+    let size = Extent3d {
+        width: frame.width,
+        height: frame.height,
+        depth_or_array_layers: 1,
+    };
+    let image = Image::new(
+        size,
+        TextureDimension::D2,
+        frame.rgba.clone(),
+        TextureFormat::Rgba8UnormSrgb,
+        RenderAssetUsages::MAIN_WORLD,
+    );
+    let dynamic = image.try_into_dynamic().map_err(|e| e.to_string())?;
+    dynamic
+        .save(path)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}

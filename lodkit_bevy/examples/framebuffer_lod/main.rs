@@ -1,0 +1,206 @@
+//! Framebuffer LOD in Bevy 0.19.1, headless: ray-marched height fog over a field of thin pillars,
+//! rendered at 1/r resolution and upsampled bilinearly or with lodkit's bilateral filter, then
+//! lodkit's controller holding a frame-time target while the fog's cost doubles and halves.
+//!
+//! ```text
+//! cargo run --example framebuffer_lod [-- [--out DIR] [--report FILE] [--size WxH]]
+//! ```
+//!
+//! Writes into DIR (default `lodkit-bevy-framebuffer-lod`): `reference.png` (the effect at full
+//! resolution), `bilinear_r2.png`, `bilateral_r2.png`, `bilinear_r3.png`, `bilateral_r3.png`
+//! (final frames: fog composited, tonemapped), their error maps `error_*.png` (|difference| x 4)
+//! and `figure.png` (reference, bilinear and bilateral at r = 2 above their error maps). With
+//! `--report` also the figures as JSON. Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O.
+//!
+//! The part an application copies is the camera in `spawn_scene` and `fog.wgsl`.
+
+#[path = "../common/frames.rs"]
+#[allow(
+    dead_code,
+    reason = "shared by the examples and tests; each uses a part"
+)]
+mod frames;
+#[path = "../common/headless.rs"]
+mod headless;
+mod measure;
+mod run;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use bevy::asset::uuid_handle;
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
+use bevy::prelude::*;
+use bevy::render::diagnostic::RenderDiagnosticsPlugin;
+use lodkit_bevy::prelude::*;
+
+/// The fog effect (fog.wgsl) and the depth probe (depth_probe.wgsl), under fixed handles.
+const FOG: Handle<Shader> = uuid_handle!("3b0e7c1e-5f0a-4d55-9a62-7f1f6c2d8e41");
+const PROBE: Handle<Shader> = uuid_handle!("9d4c2a77-1e3b-4c8f-b0a5-2e6f8d1c3b92");
+
+/// Fog parameters: (march steps, density, height scale in m, noise amount), (sun direction, -).
+const FOG_STEPS: f32 = 48.0;
+const FOG_PARAMS: [Vec4; 2] = [
+    Vec4::new(FOG_STEPS, 0.07, 3.0, 0.6),
+    Vec4::new(0.3, 0.25, -1.0, 0.0),
+];
+const SKY: Color = Color::srgb(0.45, 0.55, 0.72);
+
+/// Command-line options.
+pub struct Args {
+    out: PathBuf,
+    report: Option<PathBuf>,
+    width: u32,
+    height: u32,
+}
+
+/// The example's effect shaders as assets.
+struct EffectShadersPlugin;
+
+impl Plugin for EffectShadersPlugin {
+    fn build(&self, app: &mut App) {
+        let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
+        for (handle, source, path) in [
+            (&FOG, include_str!("fog.wgsl"), "fog.wgsl"),
+            (&PROBE, include_str!("depth_probe.wgsl"), "depth_probe.wgsl"),
+        ] {
+            shaders
+                .insert(handle, Shader::from_wgsl(source, path))
+                .expect("UUID handles never fail to insert");
+        }
+    }
+}
+
+/// The scene: a camera with framebuffer LOD rendering into an image, a sun, a ground plane and
+/// thin pillars from 3 m to 50 m away in front of the sky.
+fn spawn_scene(world: &mut World, width: u32, height: u32) -> (Handle<Image>, Entity) {
+    let target = headless::render_target(world, width, height);
+    let camera = world.spawn((
+        Camera3d::default(),
+        Camera {
+            clear_color: ClearColorConfig::Custom(SKY),
+            ..default()
+        },
+        RenderTarget::from(target.clone()),
+        Msaa::Off,
+        Tonemapping::AcesFitted,
+        DebandDither::Disabled,
+        Transform::from_xyz(0.0, 1.6, 6.0).looking_at(Vec3::new(0.0, 1.4, -30.0), Vec3::Y),
+        FramebufferLod {
+            effect: FOG,
+            params: FOG_PARAMS,
+            ..default()
+        },
+    ));
+    let camera = camera.id();
+    world.spawn((
+        DirectionalLight {
+            shadow_maps_enabled: false,
+            illuminance: 8_000.0,
+            ..default()
+        },
+        Transform::from_xyz(2.0, 3.0, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    let ground = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Plane3d::default().mesh().size(300.0, 300.0));
+    let ground_material = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(StandardMaterial {
+            base_color: Color::srgb(0.28, 0.32, 0.22),
+            perceptual_roughness: 0.95,
+            ..default()
+        });
+    world.spawn((Mesh3d(ground), MeshMaterial3d(ground_material)));
+    let bark = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(StandardMaterial {
+            base_color: Color::srgb(0.22, 0.16, 0.12),
+            perceptual_roughness: 0.8,
+            ..default()
+        });
+    // A deterministic scatter (a small LCG): no two runs differ.
+    let mut seed = 0x2545_f491_u32;
+    let mut next = move || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32
+    };
+    for _ in 0..48 {
+        let z = 3.0 - 45.0 * next();
+        let spread = 2.0 + 0.45 * (6.0 - z);
+        let x = spread * (2.0 * next() - 1.0);
+        let radius = 0.05 + 0.12 * next();
+        let height = 3.0 + 4.0 * next();
+        let mesh = world
+            .resource_mut::<Assets<Mesh>>()
+            .add(Cylinder::new(radius, height).mesh().resolution(12));
+        world.spawn((
+            Mesh3d(mesh),
+            MeshMaterial3d(bark.clone()),
+            Transform::from_xyz(x, height / 2.0, z),
+        ));
+    }
+    (target, camera)
+}
+
+fn parse_args() -> Result<Args, String> {
+    let mut args = Args {
+        out: PathBuf::from("lodkit-bevy-framebuffer-lod"),
+        report: None,
+        width: 480,
+        height: 270,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(arg) = it.next() {
+        let mut value = || it.next().ok_or(format!("{arg} needs a value"));
+        match arg.as_str() {
+            "--out" => args.out = PathBuf::from(value()?),
+            "--report" => args.report = Some(PathBuf::from(value()?)),
+            "--size" => {
+                let v = value()?;
+                let parsed = v
+                    .split_once('x')
+                    .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+                match parsed {
+                    Some((w, h)) if (16..=4096).contains(&w) && (16..=4096).contains(&h) => {
+                        (args.width, args.height) = (w, h);
+                    }
+                    _ => return Err(format!("--size {v}: expected WxH, 16..4096 each")),
+                }
+            }
+            _ => return Err(format!("unexpected argument `{arg}`")),
+        }
+    }
+    Ok(args)
+}
+
+fn main() -> ExitCode {
+    const USAGE: &str = "usage: framebuffer_lod [--out DIR] [--report FILE] [--size WxH]";
+    if std::env::args().any(|a| a == "-h" || a == "--help") {
+        println!("{USAGE}");
+        return ExitCode::SUCCESS;
+    }
+    let args = match parse_args() {
+        Ok(args) => args,
+        Err(message) => {
+            eprintln!("error: {message}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut app = headless::build_app(|app| {
+        app.add_plugins((
+            FramebufferLodPlugin,
+            EffectShadersPlugin,
+            RenderDiagnosticsPlugin,
+        ));
+    });
+    let (target, camera) = spawn_scene(app.world_mut(), args.width, args.height);
+    match run::run(&mut app, &target, camera, &args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(run::Failure(code, message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(code)
+        }
+    }
+}

@@ -1,0 +1,338 @@
+//! The example's runs: the depth probe, the effect at r = 1, 2, 3 with each upsample, the effect
+//! pass's fragment count, and the controller against a doubling and halving workload.
+
+use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
+use bevy::prelude::*;
+use lodkit::framebuffer_lod::psnr_rgba8;
+use lodkit_bevy::framebuffer_lod::EFFECT_PASS;
+use lodkit_bevy::prelude::*;
+use serde_json::json;
+
+use crate::frames::{Frame, strip};
+use crate::headless::{capture, save_png, step};
+use crate::measure::{
+    edge_mask, error_map, excursion, mean_abs_error, probe_depths, settle_frames,
+};
+use crate::{Args, FOG, FOG_STEPS, PROBE};
+
+/// A failure with its exit code.
+pub struct Failure(pub u8, pub String);
+
+/// Frames rendered after a change before a frame is captured or a count read (pipelines compile
+/// synchronously; GPU query results come back a frame or two late).
+const SETTLE_UPDATES: usize = 4;
+/// The controller's limit on r in this run (the default).
+const MAX_FACTOR: f32 = 4.0;
+/// r the frame-time target is chosen for at the base workload (about 3.1 when it doubles).
+const START_FACTOR: f32 = 2.2;
+/// March steps of the fog in the controller's run: three times the pictures', so that the fog,
+/// which r scales, costs more than the rest of the frame, which it does not.
+const CONTROLLER_STEPS: f32 = 3.0 * FOG_STEPS;
+/// Workload steps (fog march steps times this), and frames run at each.
+const WORKLOAD: [f32; 5] = [1.0, 2.0, 1.0, 2.0, 1.0];
+const FRAMES_PER_STEP: usize = 30;
+/// Settled: the 3-frame median within +-10 % of the target for 6 frames in a row.
+const TOLERANCE: f32 = 0.1;
+const MEDIAN_WINDOW: usize = 3;
+const HOLD: usize = 6;
+
+fn io(message: String) -> Failure {
+    Failure(2, message)
+}
+
+/// Sets the camera's framebuffer LOD and tonemapping.
+fn configure(
+    app: &mut App,
+    camera: Entity,
+    effect: &Handle<Shader>,
+    upsample: FramebufferLodUpsample,
+    resolution: FramebufferLodResolution,
+    tonemapping: Tonemapping,
+) {
+    let mut entity = app.world_mut().entity_mut(camera);
+    if let Some(mut lod) = entity.get_mut::<FramebufferLod>() {
+        lod.effect = effect.clone();
+        lod.upsample = upsample;
+        lod.resolution = resolution;
+    }
+    entity.insert(tonemapping);
+}
+
+fn state(app: &App, camera: Entity) -> FramebufferLodState {
+    app.world()
+        .get::<FramebufferLodState>(camera)
+        .cloned()
+        .unwrap_or_default()
+}
+
+/// The effect pass's latest fragment-shader invocation count (Bevy's render diagnostics).
+fn effect_fragments(app: &App) -> Option<f64> {
+    let path = DiagnosticPath::new(format!("render/{EFFECT_PASS}/fragment_shader_invocations"));
+    app.world()
+        .resource::<DiagnosticsStore>()
+        .get(&path)
+        .and_then(|d| d.value())
+}
+
+/// A captured frame after the settings have had time to apply.
+fn settled_capture(app: &mut App, target: &Handle<Image>) -> Result<Frame, Failure> {
+    for _ in 0..SETTLE_UPDATES {
+        step(app);
+    }
+    capture(app, target).map_err(io)
+}
+
+/// Median of `values` (NaN when empty).
+fn median(values: &[f32]) -> f32 {
+    let mut v = values.to_vec();
+    v.sort_by(f32::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f32::NAN)
+}
+
+/// The frame times of `frames` frames at a fixed r (seconds, as measured).
+fn fixed_times(app: &mut App, camera: Entity, r: f32, frames: usize) -> Vec<f32> {
+    configure(
+        app,
+        camera,
+        &FOG,
+        FramebufferLodUpsample::default(),
+        FramebufferLodResolution::Fixed(r),
+        Tonemapping::AcesFitted,
+    );
+    for _ in 0..SETTLE_UPDATES {
+        step(app);
+    }
+    (0..frames)
+        .filter_map(|_| {
+            step(app);
+            let s = state(app, camera);
+            (s.measured_factor == r).then(|| s.frame_time.map(|t| t.as_secs_f32()))?
+        })
+        .collect()
+}
+
+fn set_workload(app: &mut App, camera: Entity, scale: f32) {
+    if let Some(mut lod) = app.world_mut().get_mut::<FramebufferLod>(camera) {
+        lod.params[0].x = CONTROLLER_STEPS * scale;
+    }
+}
+
+pub fn run(
+    app: &mut App,
+    target: &Handle<Image>,
+    camera: Entity,
+    args: &Args,
+) -> Result<(), Failure> {
+    std::fs::create_dir_all(&args.out).map_err(|e| io(format!("{}: {e}", args.out.display())))?;
+    let path = |name: &str| args.out.join(name);
+
+    // Depth probe: where the depth discontinuities are.
+    let fixed = FramebufferLodResolution::Fixed(1.0);
+    let bilateral = FramebufferLodUpsample::default();
+    configure(app, camera, &PROBE, bilateral, fixed, Tonemapping::None);
+    let probe = settled_capture(app, target)?;
+    let depths = probe_depths(&probe);
+    let mask = edge_mask(&depths, probe.width, probe.height);
+    let edge_pixels = mask.iter().filter(|&&m| m).count();
+    if edge_pixels == 0 || edge_pixels == mask.len() {
+        return Err(Failure(
+            1,
+            format!(
+                "the depth probe shows {edge_pixels} edge pixels of {}: the effect pass drew \
+                 nothing (a shader that never compiled?)",
+                mask.len()
+            ),
+        ));
+    }
+
+    // The fog at full resolution, then at r = 2 and 3 with each upsample.
+    let mut frames = Vec::new();
+    let mut fragments = Vec::new();
+    for (name, upsample, r) in [
+        ("reference", bilateral, 1.0),
+        ("bilinear_r2", FramebufferLodUpsample::Bilinear, 2.0),
+        ("bilateral_r2", bilateral, 2.0),
+        ("bilinear_r3", FramebufferLodUpsample::Bilinear, 3.0),
+        ("bilateral_r3", bilateral, 3.0),
+    ] {
+        let r = FramebufferLodResolution::Fixed(r);
+        configure(app, camera, &FOG, upsample, r, Tonemapping::AcesFitted);
+        let frame = settled_capture(app, target)?;
+        fragments.push(effect_fragments(app));
+        save_png(&frame, &path(&format!("{name}.png"))).map_err(io)?;
+        frames.push(frame);
+    }
+    let reference = &frames[0];
+    let all = vec![true; mask.len()];
+    if mean_abs_error(reference, &probe, &all) < 1.0 {
+        return Err(Failure(1, "the fog frame equals the depth probe".into()));
+    }
+    let psnr = |i: usize| psnr_rgba8(&reference.rgba, &frames[i].rgba);
+    let edge_error = |i: usize| mean_abs_error(reference, &frames[i], &mask);
+    for (i, name) in [
+        (1, "bilinear_r2"),
+        (2, "bilateral_r2"),
+        (3, "bilinear_r3"),
+        (4, "bilateral_r3"),
+    ] {
+        save_png(
+            &error_map(reference, &frames[i], 4),
+            &path(&format!("error_{name}.png")),
+        )
+        .map_err(io)?;
+        println!(
+            "{name:13} PSNR {:5.2} dB, edge error {:5.2} (8-bit steps, {edge_pixels} pixels)",
+            psnr(i),
+            edge_error(i)
+        );
+    }
+    let black = Frame::filled(reference.width, reference.height, [0, 0, 0]);
+    let figure = strip(&[reference.clone(), frames[1].clone(), frames[2].clone()]);
+    let errors = strip(&[
+        black,
+        error_map(reference, &frames[1], 4),
+        error_map(reference, &frames[2], 4),
+    ]);
+    let mut both = figure.rgba.clone();
+    both.extend_from_slice(&errors.rgba);
+    save_png(
+        &Frame::new(figure.width, figure.height * 2, both),
+        &path("figure.png"),
+    )
+    .map_err(io)?;
+
+    let ratio = |i: usize| match (fragments[i], fragments[0]) {
+        (Some(low), Some(full)) if full > 0.0 => Some(low / full),
+        _ => None,
+    };
+    println!(
+        "effect fragments: r=1 {:?}, r=2 {:?} (ratio {:?}), r=3 {:?} (ratio {:?})",
+        fragments[0],
+        fragments[2],
+        ratio(2),
+        fragments[4],
+        ratio(4)
+    );
+
+    // The controller: a target for r = START_FACTOR from two calibration runs, then the fog's
+    // cost doubled and halved every FRAMES_PER_STEP frames.
+    set_workload(app, camera, 1.0);
+    let t1 = median(&fixed_times(app, camera, 1.0, 9));
+    let t3 = median(&fixed_times(app, camera, MAX_FACTOR, 9));
+    let k = (t1 - t3) / (1.0 - 1.0 / (MAX_FACTOR * MAX_FACTOR));
+    let c = t1 - k;
+    let goal = k / (START_FACTOR * START_FACTOR) + c;
+    println!(
+        "calibration: {:.1} ms at r = 1, {:.1} ms at r = {MAX_FACTOR} (K {:.1} ms, C {:.1} ms); target {:.1} ms",
+        t1 * 1e3,
+        t3 * 1e3,
+        k * 1e3,
+        c * 1e3,
+        goal * 1e3
+    );
+    if !(goal.is_finite() && k > 0.0) {
+        return Err(Failure(
+            1,
+            "the effect's cost does not fall with r: no controller run".into(),
+        ));
+    }
+    let adaptive = FramebufferLodResolution::Adaptive(FramerateTarget {
+        frame_time: std::time::Duration::from_secs_f32(goal),
+        max_factor: MAX_FACTOR,
+        ..default()
+    });
+    configure(
+        app,
+        camera,
+        &FOG,
+        bilateral,
+        adaptive,
+        Tonemapping::AcesFitted,
+    );
+    let mut settle = Vec::new();
+    let mut excursions = Vec::new();
+    let mut factors = Vec::new();
+    let mut source = None;
+    for (i, &scale) in WORKLOAD.iter().enumerate() {
+        set_workload(app, camera, scale);
+        let mut times = Vec::new();
+        for _ in 0..FRAMES_PER_STEP {
+            step(app);
+            let s = state(app, camera);
+            factors.push(s.factor);
+            source = s.measured_with;
+            times.push(s.frame_time.map_or(f32::NAN, |t| t.as_secs_f32()));
+        }
+        // The first run only brings r from 1 to the target's r: not a workload step.
+        if i > 0 {
+            let frames = settle_frames(&times, goal, TOLERANCE, MEDIAN_WINDOW, HOLD);
+            let out = excursion(&times, goal, MEDIAN_WINDOW);
+            println!(
+                "workload x{scale}: settled in {frames:?} frames (out by up to {:.0} %); \
+                 r {:.2} .. {:.2}; times (ms) {:?}",
+                out * 100.0,
+                factors[factors.len() - FRAMES_PER_STEP..]
+                    .iter()
+                    .copied()
+                    .fold(f32::MAX, f32::min),
+                factors[factors.len() - FRAMES_PER_STEP..]
+                    .iter()
+                    .copied()
+                    .fold(0.0, f32::max),
+                times
+                    .iter()
+                    .map(|t| (t * 1e4).round() / 10.0)
+                    .collect::<Vec<_>>()
+            );
+            settle.push(frames);
+            excursions.push(out);
+        }
+    }
+    set_workload(app, camera, 1.0);
+
+    let (r_min, r_max) = factors
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+    if let Some(report) = &args.report {
+        let png = |name: &str| path(name).display().to_string();
+        let json = json!({
+            "size": [reference.width, reference.height],
+            "psnr_bilinear_r2_db": psnr(1),
+            "psnr_bilateral_r2_db": psnr(2),
+            "psnr_bilinear_r3_db": psnr(3),
+            "psnr_bilateral_r3_db": psnr(4),
+            "edge_pixels": edge_pixels,
+            "edge_error_bilinear_r2": edge_error(1),
+            "edge_error_bilateral_r2": edge_error(2),
+            "edge_error_ratio_r2": edge_error(2) / edge_error(1),
+            "edge_error_ratio_r3": edge_error(4) / edge_error(3),
+            "effect_fragments": fragments,
+            "effect_fragments_ratio_r2": ratio(2),
+            "effect_fragments_ratio_r3": ratio(4),
+            "controller_target_ms": goal * 1e3,
+            "controller_calibration_ms": [t1 * 1e3, t3 * 1e3],
+            "controller_workload_steps": &WORKLOAD[1..],
+            "controller_settle_frames": settle,
+            "controller_step_excursion": excursions,
+            "controller_settle_rule": format!(
+                "first frame from which the {MEDIAN_WINDOW}-frame median frame time stays within \
+                 +-{:.0} % of the target for {HOLD} frames", TOLERANCE * 100.0),
+            "controller_frames_per_step": FRAMES_PER_STEP,
+            "controller_r_range": [r_min, r_max],
+            "controller_r_limits": [1.0, MAX_FACTOR],
+            "controller_measured_with": format!("{source:?}"),
+            "png_reference": png("reference.png"),
+            "png_bilinear_r2": png("bilinear_r2.png"),
+            "png_bilateral_r2": png("bilateral_r2.png"),
+            "png_bilinear_r3": png("bilinear_r3.png"),
+            "png_bilateral_r3": png("bilateral_r3.png"),
+            "png_figure": png("figure.png"),
+        });
+        let text = serde_json::to_string_pretty(&json).map_err(|e| io(e.to_string()))?;
+        std::fs::write(report, text).map_err(|e| io(format!("{}: {e}", report.display())))?;
+        println!("wrote {}", report.display());
+    }
+    println!("wrote PNGs into {}", args.out.display());
+    Ok(())
+}

@@ -1,0 +1,270 @@
+//! Geometry-aware framebuffer LOD on a Bevy camera (Yang, Sander & Lawrence 2008).
+//!
+//! An expensive screen-space effect (fog, ambient occlusion, ...) runs at 1/r of the camera's
+//! resolution; lodkit's bilateral upsample (eq. 1) rebuilds it at full resolution from Bevy's
+//! depth and normal prepass, so it does not bleed across depth edges the way a bilinear upsample
+//! does, and the result is composited into the camera's HDR main texture before tonemapping.
+//! lodkit's framerate controller can choose r every frame from the measured frame time.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use lodkit_bevy::prelude::*;
+//!
+//! fn setup(mut commands: Commands, assets: Res<AssetServer>) {
+//!     commands.spawn((
+//!         Camera3d::default(),
+//!         Msaa::Off, // the prepass is read per pixel
+//!         FramebufferLod {
+//!             effect: assets.load("shaders/fog.wgsl"),
+//!             resolution: FramebufferLodResolution::Adaptive(FramerateTarget::default()),
+//!             ..default()
+//!         },
+//!     ));
+//! }
+//!
+//! App::new()
+//!     .add_plugins((DefaultPlugins, FramebufferLodPlugin))
+//!     .add_systems(Startup, setup)
+//!     .run();
+//! ```
+//!
+//! The effect is a WGSL fragment shader run with Bevy's fullscreen vertex shader; it imports
+//! `lodkit_bevy::framebuffer_lod` (the bindings, `effect_sample`, `effect_output`) and may import
+//! any `lodkit::` module:
+//!
+//! ```wgsl
+//! #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
+//! #import lodkit::gbuffer::GBufferOutput
+//! #import lodkit_bevy::framebuffer_lod::{effect_sample, effect_output, effect_param}
+//!
+//! @fragment
+//! fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
+//!     let s = effect_sample(in.position);
+//!     let density = effect_param(0u).x;
+//!     let transmittance = exp(-density * s.view_depth);
+//!     // premultiplied: the fog's light, and how much of the scene it hides
+//!     return effect_output(vec4(vec3(0.6, 0.7, 0.8) * (1.0 - transmittance), 1.0 - transmittance), s);
+//! }
+//! ```
+
+mod controller;
+mod render;
+mod timer;
+
+use std::time::Duration;
+
+use bevy::asset::embedded_asset;
+use bevy::camera::Hdr;
+use bevy::core_pipeline::prepass::{DepthPrepass, NormalPrepass};
+use bevy::prelude::*;
+use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPlugin};
+use bevy::render::{RenderApp, renderer::RenderDevice};
+use bevy::shader::load_shader_library;
+
+pub use controller::FramebufferLodState;
+pub use render::{EFFECT_PASS, UPSAMPLE_PASS};
+
+use render::FramebufferLodUniform;
+
+use crate::LodkitShadersPlugin;
+
+/// Adds framebuffer LOD to every camera with a [`FramebufferLod`] component.
+///
+/// Registers lodkit's shader modules ([`LodkitShadersPlugin`], if not added yet) and the
+/// `lodkit_bevy::framebuffer_lod` module effects import, the render passes (scheduled in
+/// `Core3d` after the main pass, before the post-processing that precedes tonemapping) and the
+/// controller that updates [`FramebufferLodState`] every frame.
+pub struct FramebufferLodPlugin;
+
+impl Plugin for FramebufferLodPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<LodkitShadersPlugin>() {
+            app.add_plugins(LodkitShadersPlugin);
+        }
+        load_shader_library!(app, "framebuffer_lod.wgsl");
+        embedded_asset!(app, "upsample.wgsl");
+        app.register_type::<FramebufferLod>()
+            .add_plugins((
+                ExtractComponentPlugin::<FramebufferLod>::default(),
+                UniformComponentPlugin::<FramebufferLodUniform>::default(),
+            ))
+            .init_resource::<timer::GpuFrameTimes>()
+            .add_systems(Last, controller::update_resolution);
+        let times = app.world().resource::<timer::GpuFrameTimes>().clone();
+        if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+            render_app.insert_resource(times);
+            render::build(render_app);
+        }
+    }
+
+    fn finish(&self, app: &mut App) {
+        let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+            return;
+        };
+        let features = render_app.world().resource::<RenderDevice>().features();
+        let timestamps = timer::supported(features);
+        render::finish(render_app);
+        app.insert_resource(FramebufferLodCapabilities {
+            gpu_timestamps: timestamps,
+        });
+    }
+}
+
+/// What the render device offers framebuffer LOD (inserted by [`FramebufferLodPlugin`] once the
+/// renderer exists).
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FramebufferLodCapabilities {
+    /// Timestamp queries inside command encoders: [`FrameTimeSource::Auto`] measures the camera's
+    /// GPU time with them.
+    pub gpu_timestamps: bool,
+}
+
+/// Framebuffer LOD on a 3D camera: `effect` runs at 1/r resolution and is upsampled with lodkit's
+/// bilateral filter from the camera's depth and normal prepass.
+///
+/// Requires (and adds) [`DepthPrepass`], [`NormalPrepass`] and [`Hdr`]; the camera must also
+/// have `Msaa::Off` (the effect pass is skipped with an error otherwise). Only meshes drawn in the
+/// prepass (opaque and alpha-masked, with prepass-enabled materials) give the upsample its edges.
+#[derive(Component, Clone, Debug, Reflect)]
+#[reflect(Component, Default, Clone)]
+#[require(DepthPrepass, NormalPrepass, Hdr, FramebufferLodState)]
+pub struct FramebufferLod {
+    /// The effect: a WGSL fragment shader (entry point `fragment`) that imports
+    /// `lodkit_bevy::framebuffer_lod` and returns `effect_output(color, effect_sample(..))`.
+    /// Nothing is drawn while it is the default handle or still loading.
+    pub effect: Handle<Shader>,
+    /// How the upsampled effect is combined with the scene.
+    pub composite: FramebufferLodComposite,
+    /// How the low-resolution effect is brought to full resolution.
+    pub upsample: FramebufferLodUpsample,
+    /// How r is chosen.
+    pub resolution: FramebufferLodResolution,
+    /// Eight values the effect reads with `effect_param(0u)` and `effect_param(1u)`.
+    pub params: [Vec4; 2],
+}
+
+impl Default for FramebufferLod {
+    fn default() -> Self {
+        Self {
+            effect: Handle::default(),
+            composite: FramebufferLodComposite::default(),
+            upsample: FramebufferLodUpsample::default(),
+            resolution: FramebufferLodResolution::default(),
+            params: [Vec4::ZERO; 2],
+        }
+    }
+}
+
+/// How the upsampled effect is combined with the camera's image (before tonemapping).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Default, Clone, PartialEq)]
+pub enum FramebufferLodComposite {
+    /// `scene * (1 - a) + rgb`: the effect returns premultiplied color and coverage (fog:
+    /// in-scattered light and 1 - transmittance). The whole effect is resized.
+    #[default]
+    Over,
+    /// `scene * rgb`: the effect returns a factor (ambient occlusion, a shadow term). Only that
+    /// smooth factor is resized and the scene keeps its full-resolution detail: the paper's
+    /// fine-grained resizing (sec. 2.3).
+    Modulate,
+}
+
+/// How the low-resolution effect is brought to full resolution.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Default, Clone, PartialEq)]
+pub enum FramebufferLodUpsample {
+    /// lodkit's geometry-aware upsample (eq. 1): a 2x2 tent times Gaussians on the depth and
+    /// normal differences between the pixel and each low-resolution sample.
+    Bilateral {
+        /// Depth sigma as a fraction of the pixel's view depth (default 0.05: samples 5 % nearer
+        /// or farther weigh e^-1/2). Relative, so distant slanted surfaces stay smooth.
+        depth_sigma: f32,
+        /// Sigma on the foreshortened normal distance (lodkit::normal_distance; default 0.5).
+        normal_sigma: f32,
+    },
+    /// Plain bilinear upsampling (the same pass with infinite sigmas): what a renderer does
+    /// without geometry awareness; here for comparison.
+    Bilinear,
+}
+
+impl Default for FramebufferLodUpsample {
+    fn default() -> Self {
+        Self::Bilateral {
+            depth_sigma: 0.05,
+            normal_sigma: 0.5,
+        }
+    }
+}
+
+impl FramebufferLodUpsample {
+    /// The (depth, normal) sigmas the upsample pass uses; infinite for bilinear.
+    pub fn sigmas(&self) -> (f32, f32) {
+        match *self {
+            Self::Bilateral {
+                depth_sigma,
+                normal_sigma,
+            } => (depth_sigma, normal_sigma),
+            Self::Bilinear => (f32::INFINITY, f32::INFINITY),
+        }
+    }
+}
+
+/// Largest resize factor a camera accepts (fixed or adaptive).
+pub const MAX_FACTOR: f32 = 16.0;
+
+/// How the resize factor r (the effect renders at 1/r of the camera's width and height) is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Default, Clone, PartialEq)]
+pub enum FramebufferLodResolution {
+    /// A fixed r, clamped to [1, [`MAX_FACTOR`]].
+    Fixed(f32),
+    /// lodkit's framerate controller (`lodkit::framebuffer_lod::RlsController`) picks r every
+    /// frame so that the measured frame time meets a target.
+    Adaptive(FramerateTarget),
+}
+
+impl Default for FramebufferLodResolution {
+    fn default() -> Self {
+        Self::Fixed(2.0)
+    }
+}
+
+/// The framerate controller's target and limits.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Default, Clone, PartialEq)]
+pub struct FramerateTarget {
+    /// Frame time to hold (default 1/60 s).
+    pub frame_time: Duration,
+    /// Largest r (default 4, at most [`MAX_FACTOR`]); the smallest is 1.
+    pub max_factor: f32,
+    /// Largest change of r from one frame to the next (default 0.2, the paper's).
+    pub max_step: f32,
+    /// What is measured.
+    pub source: FrameTimeSource,
+}
+
+impl Default for FramerateTarget {
+    fn default() -> Self {
+        Self {
+            frame_time: Duration::from_secs_f64(1.0 / 60.0),
+            max_factor: 4.0,
+            max_step: 0.2,
+            source: FrameTimeSource::Auto,
+        }
+    }
+}
+
+/// Where the controller's frame time comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Reflect)]
+#[reflect(Default, Clone, PartialEq)]
+pub enum FrameTimeSource {
+    /// GPU timestamps where the device has them ([`FramebufferLodCapabilities`]), else wall time.
+    #[default]
+    Auto,
+    /// The camera's GPU time, from timestamp queries written before its prepass and after its
+    /// last post-process pass. Arrives a frame or two late; each measurement is credited to the
+    /// r it was rendered at. Falls back to wall time without timestamp support.
+    GpuTimestamps,
+    /// Real time between frames (`Time<Real>`): everything the frame costs, CPU included.
+    WallClock,
+}

@@ -1,0 +1,472 @@
+//! The render-world side: extraction, the effect and upsample pipelines, the low-resolution
+//! targets (allocated at full size once per camera size, drawn through a viewport that shrinks
+//! with r, so changing r never reallocates), bind groups and the two passes.
+
+use bevy::asset::load_embedded_asset;
+use bevy::core_pipeline::prepass::ViewPrepassTextures;
+use bevy::core_pipeline::{Core3d, Core3dSystems, FullscreenShader};
+use bevy::ecs::query::QueryItem;
+use bevy::log::warn_once;
+use bevy::prelude::*;
+use bevy::render::diagnostic::RecordDiagnostics;
+use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex, ExtractComponent};
+use bevy::render::globals::{GlobalsBuffer, GlobalsUniform};
+use bevy::render::render_resource::binding_types::{texture_2d, texture_depth_2d, uniform_buffer};
+use bevy::render::render_resource::*;
+use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
+use bevy::render::sync_component::SyncComponent;
+use bevy::render::view::{ExtractedView, ViewTarget, ViewUniform, ViewUniformOffset, ViewUniforms};
+use bevy::render::{GpuResourceAppExt, Render, RenderSystems};
+
+use super::controller::FramebufferLodState;
+use super::timer::{self, GpuFrameTimer};
+use super::{FramebufferLod, FramebufferLodComposite};
+
+/// Format of the low-resolution color and geometry targets (lodkit::gbuffer's geometry layout).
+const LOW_FORMAT: TextureFormat = TextureFormat::Rgba16Float;
+/// View depth given to the sky: far beyond any scene, inside half-float range.
+const SKY_DEPTH: f32 = 60_000.0;
+/// Name of the effect pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
+/// `render/<name>/elapsed_gpu` and `render/<name>/fragment_shader_invocations` (where the device
+/// has pipeline statistics).
+pub const EFFECT_PASS: &str = "lodkit_framebuffer_lod_effect";
+/// Name of the upsample pass in Bevy's render diagnostics (as [`EFFECT_PASS`]).
+pub const UPSAMPLE_PASS: &str = "lodkit_framebuffer_lod_upsample";
+
+/// What the render world keeps of a camera's [`FramebufferLod`].
+#[derive(Component, Clone, Debug)]
+pub struct ExtractedFramebufferLod {
+    effect: Handle<Shader>,
+    composite: FramebufferLodComposite,
+    /// r this frame.
+    pub(super) factor: f32,
+    /// Whether the camera's GPU time is measured (adaptive r on GPU timestamps).
+    pub(super) gpu_timed: bool,
+    low_size: UVec2,
+}
+
+/// The settings the shaders read (`FramebufferLodSettings` in framebuffer_lod.wgsl).
+#[derive(Component, ShaderType, Clone, Copy, Debug)]
+pub struct FramebufferLodUniform {
+    low_size: Vec2,
+    full_size: Vec2,
+    factor: f32,
+    depth_sigma: f32,
+    normal_sigma: f32,
+    sky_depth: f32,
+    params: [Vec4; 2],
+}
+
+impl SyncComponent for FramebufferLod {
+    type Target = (
+        ExtractedFramebufferLod,
+        FramebufferLodUniform,
+        FramebufferLodTextures,
+        FramebufferLodBindGroups,
+        FramebufferLodPipelineIds,
+        GpuFrameTimer,
+    );
+}
+
+impl ExtractComponent for FramebufferLod {
+    type QueryData = (
+        &'static FramebufferLod,
+        &'static FramebufferLodState,
+        &'static Camera,
+        Option<&'static Msaa>,
+    );
+    type QueryFilter = With<Camera3d>;
+    type Out = (ExtractedFramebufferLod, FramebufferLodUniform);
+
+    fn extract_component(
+        (settings, state, camera, msaa): QueryItem<'_, '_, Self::QueryData>,
+    ) -> Option<Self::Out> {
+        if !camera.is_active {
+            return None;
+        }
+        if msaa.is_some_and(|m| *m != Msaa::Off) {
+            warn_once!(
+                "FramebufferLod needs Msaa::Off on its camera (the prepass is read per pixel); \
+                 the effect is not drawn"
+            );
+            return None;
+        }
+        let full = camera.physical_target_size()?;
+        let factor = state.factor.clamp(1.0, super::MAX_FACTOR);
+        let low = (full.as_vec2() / factor)
+            .ceil()
+            .as_uvec2()
+            .clamp(UVec2::ONE, full.max(UVec2::ONE));
+        let (depth_sigma, normal_sigma) = settings.upsample.sigmas();
+        Some((
+            ExtractedFramebufferLod {
+                effect: settings.effect.clone(),
+                composite: settings.composite,
+                factor,
+                gpu_timed: state.gpu_timed,
+                low_size: low,
+            },
+            FramebufferLodUniform {
+                low_size: low.as_vec2(),
+                full_size: full.as_vec2(),
+                factor,
+                depth_sigma,
+                normal_sigma,
+                sky_depth: SKY_DEPTH,
+                params: settings.params,
+            },
+        ))
+    }
+}
+
+pub(super) fn build(render_app: &mut SubApp) {
+    render_app.add_systems(
+        Render,
+        (
+            prepare_pipelines.in_set(RenderSystems::Prepare),
+            prepare_textures.in_set(RenderSystems::PrepareResources),
+            prepare_bind_groups.in_set(RenderSystems::PrepareBindGroups),
+        ),
+    );
+    render_app.add_systems(
+        Core3d,
+        framebuffer_lod_pass
+            .after(Core3dSystems::MainPass)
+            .before(Core3dSystems::EarlyPostProcess),
+    );
+    timer::build(render_app);
+}
+
+pub(super) fn finish(render_app: &mut SubApp) {
+    render_app
+        .init_gpu_resource::<FramebufferLodPipelines>()
+        .init_gpu_resource::<SpecializedRenderPipelines<FramebufferLodPipelines>>();
+}
+
+/// Bind group layouts and shaders of the two passes.
+#[derive(Resource)]
+pub struct FramebufferLodPipelines {
+    effect_layout: BindGroupLayoutDescriptor,
+    upsample_layout: BindGroupLayoutDescriptor,
+    upsample_shader: Handle<Shader>,
+    fullscreen: FullscreenShader,
+}
+
+impl FromWorld for FramebufferLodPipelines {
+    fn from_world(world: &mut World) -> Self {
+        let common = (
+            uniform_buffer::<ViewUniform>(true),
+            uniform_buffer::<GlobalsUniform>(false),
+            texture_depth_2d(),
+            texture_2d(TextureSampleType::Float { filterable: true }),
+            uniform_buffer::<FramebufferLodUniform>(true),
+        );
+        let effect_layout = BindGroupLayoutDescriptor::new(
+            "lodkit_framebuffer_lod_effect",
+            &BindGroupLayoutEntries::sequential(ShaderStages::FRAGMENT, common),
+        );
+        let low = texture_2d(TextureSampleType::Float { filterable: false });
+        let upsample_layout = BindGroupLayoutDescriptor::new(
+            "lodkit_framebuffer_lod_upsample",
+            &BindGroupLayoutEntries::sequential(
+                ShaderStages::FRAGMENT,
+                (common.0, common.1, common.2, common.3, common.4, low, low),
+            ),
+        );
+        Self {
+            effect_layout,
+            upsample_layout,
+            upsample_shader: load_embedded_asset!(world, "upsample.wgsl"),
+            fullscreen: world.resource::<FullscreenShader>().clone(),
+        }
+    }
+}
+
+/// Which of the two pipelines, and what it depends on.
+#[derive(Clone, PartialEq, Eq, Hash)]
+pub enum PipelineKey {
+    /// The user's effect into the low-resolution targets.
+    Effect(Handle<Shader>),
+    /// The upsample, blended into a main texture of this format.
+    Upsample(FramebufferLodComposite, TextureFormat),
+}
+
+impl SpecializedRenderPipeline for FramebufferLodPipelines {
+    type Key = PipelineKey;
+
+    fn specialize(&self, key: Self::Key) -> RenderPipelineDescriptor {
+        let (label, layout, shader, targets) = match key {
+            PipelineKey::Effect(shader) => {
+                let target = ColorTargetState {
+                    format: LOW_FORMAT,
+                    blend: None,
+                    write_mask: ColorWrites::ALL,
+                };
+                (
+                    "lodkit_framebuffer_lod_effect",
+                    self.effect_layout.clone(),
+                    shader,
+                    vec![Some(target.clone()), Some(target)],
+                )
+            }
+            PipelineKey::Upsample(composite, format) => {
+                let keep_alpha = BlendComponent {
+                    src_factor: BlendFactor::Zero,
+                    dst_factor: BlendFactor::One,
+                    operation: BlendOperation::Add,
+                };
+                let color = match composite {
+                    FramebufferLodComposite::Over => BlendComponent {
+                        src_factor: BlendFactor::One,
+                        dst_factor: BlendFactor::OneMinusSrcAlpha,
+                        operation: BlendOperation::Add,
+                    },
+                    FramebufferLodComposite::Modulate => BlendComponent {
+                        src_factor: BlendFactor::Zero,
+                        dst_factor: BlendFactor::Src,
+                        operation: BlendOperation::Add,
+                    },
+                };
+                let target = ColorTargetState {
+                    format,
+                    blend: Some(BlendState {
+                        color,
+                        alpha: keep_alpha,
+                    }),
+                    write_mask: ColorWrites::ALL,
+                };
+                (
+                    "lodkit_framebuffer_lod_upsample",
+                    self.upsample_layout.clone(),
+                    self.upsample_shader.clone(),
+                    vec![Some(target)],
+                )
+            }
+        };
+        RenderPipelineDescriptor {
+            label: Some(label.into()),
+            layout: vec![layout],
+            vertex: self.fullscreen.to_vertex_state(),
+            fragment: Some(FragmentState {
+                shader,
+                entry_point: Some("fragment".into()),
+                targets,
+                ..default()
+            }),
+            ..default()
+        }
+    }
+}
+
+/// The camera's two pipelines.
+#[derive(Component)]
+pub struct FramebufferLodPipelineIds {
+    effect: CachedRenderPipelineId,
+    upsample: CachedRenderPipelineId,
+}
+
+fn prepare_pipelines(
+    mut commands: Commands,
+    cache: Res<PipelineCache>,
+    mut specialized: ResMut<SpecializedRenderPipelines<FramebufferLodPipelines>>,
+    pipelines: Res<FramebufferLodPipelines>,
+    views: Query<(Entity, &ExtractedFramebufferLod, &ExtractedView)>,
+) {
+    for (entity, extracted, view) in &views {
+        let effect = specialized.specialize(
+            &cache,
+            &pipelines,
+            PipelineKey::Effect(extracted.effect.clone()),
+        );
+        let upsample = specialized.specialize(
+            &cache,
+            &pipelines,
+            PipelineKey::Upsample(extracted.composite, view.target_format),
+        );
+        commands
+            .entity(entity)
+            .insert(FramebufferLodPipelineIds { effect, upsample });
+    }
+}
+
+/// The low-resolution color and geometry targets, at the camera's full size.
+#[derive(Component)]
+pub struct FramebufferLodTextures {
+    size: UVec2,
+    color: TextureView,
+    geometry: TextureView,
+}
+
+fn prepare_textures(
+    mut commands: Commands,
+    device: Res<RenderDevice>,
+    views: Query<(
+        Entity,
+        &FramebufferLodUniform,
+        Option<&FramebufferLodTextures>,
+    )>,
+) {
+    for (entity, uniform, textures) in &views {
+        let size = uniform.full_size.as_uvec2();
+        if textures.is_some_and(|t| t.size == size) {
+            continue;
+        }
+        let target = |label| {
+            device
+                .create_texture(&TextureDescriptor {
+                    label: Some(label),
+                    size: Extent3d {
+                        width: size.x,
+                        height: size.y,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: TextureDimension::D2,
+                    format: LOW_FORMAT,
+                    usage: TextureUsages::RENDER_ATTACHMENT | TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+                .create_view(&TextureViewDescriptor::default())
+        };
+        commands.entity(entity).insert(FramebufferLodTextures {
+            size,
+            color: target("lodkit_framebuffer_lod_color"),
+            geometry: target("lodkit_framebuffer_lod_geometry"),
+        });
+    }
+}
+
+/// The camera's bind groups for the two passes.
+#[derive(Component)]
+pub struct FramebufferLodBindGroups {
+    effect: BindGroup,
+    upsample: BindGroup,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn prepare_bind_groups(
+    mut commands: Commands,
+    device: Res<RenderDevice>,
+    cache: Res<PipelineCache>,
+    pipelines: Res<FramebufferLodPipelines>,
+    view_uniforms: Res<ViewUniforms>,
+    globals: Res<GlobalsBuffer>,
+    settings: Res<ComponentUniforms<FramebufferLodUniform>>,
+    views: Query<(Entity, &FramebufferLodTextures, &ViewPrepassTextures)>,
+) {
+    let (Some(view), Some(globals), Some(settings)) = (
+        view_uniforms.uniforms.binding(),
+        globals.buffer.binding(),
+        settings.uniforms().binding(),
+    ) else {
+        return;
+    };
+    for (entity, textures, prepass) in &views {
+        let (Some(depth), Some(normal)) = (prepass.depth_view(), prepass.normal_view()) else {
+            continue;
+        };
+        let effect = device.create_bind_group(
+            "lodkit_framebuffer_lod_effect",
+            &cache.get_bind_group_layout(&pipelines.effect_layout),
+            &BindGroupEntries::sequential((
+                view.clone(),
+                globals.clone(),
+                depth,
+                normal,
+                settings.clone(),
+            )),
+        );
+        let upsample = device.create_bind_group(
+            "lodkit_framebuffer_lod_upsample",
+            &cache.get_bind_group_layout(&pipelines.upsample_layout),
+            &BindGroupEntries::sequential((
+                view.clone(),
+                globals.clone(),
+                depth,
+                normal,
+                settings.clone(),
+                &textures.color,
+                &textures.geometry,
+            )),
+        );
+        commands
+            .entity(entity)
+            .insert(FramebufferLodBindGroups { effect, upsample });
+    }
+}
+
+/// What the pass reads from the view.
+type PassView = (
+    &'static ViewTarget,
+    &'static ViewUniformOffset,
+    &'static DynamicUniformIndex<FramebufferLodUniform>,
+    &'static ExtractedFramebufferLod,
+    &'static FramebufferLodTextures,
+    &'static FramebufferLodBindGroups,
+    &'static FramebufferLodPipelineIds,
+);
+
+/// The effect at 1/r into the low-resolution targets, then the upsample into the main texture.
+fn framebuffer_lod_pass(
+    view: ViewQuery<PassView>,
+    cache: Res<PipelineCache>,
+    mut ctx: RenderContext,
+) {
+    let (target, view_offset, settings_index, extracted, textures, bind_groups, ids) =
+        view.into_inner();
+    let (Some(effect), Some(upsample)) = (
+        cache.get_render_pipeline(ids.effect),
+        cache.get_render_pipeline(ids.upsample),
+    ) else {
+        return;
+    };
+    let offsets = [view_offset.offset, settings_index.index()];
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
+    let keep = Operations {
+        load: LoadOp::Load,
+        store: StoreOp::Store,
+    };
+    let attachment = |view| {
+        Some(RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: keep,
+        })
+    };
+    {
+        // Texels outside the viewport are never read, so the targets are not cleared.
+        let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
+            label: Some(EFFECT_PASS),
+            color_attachments: &[attachment(&textures.color), attachment(&textures.geometry)],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let span = diagnostics.pass_span(&mut pass, EFFECT_PASS);
+        let low = extracted.low_size.as_vec2();
+        pass.set_viewport(0.0, 0.0, low.x, low.y, 0.0, 1.0);
+        pass.set_render_pipeline(effect);
+        pass.set_bind_group(0, &bind_groups.effect, &offsets);
+        pass.draw(0..3, 0..1);
+        span.end(&mut pass);
+    }
+    {
+        let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
+            label: Some(UPSAMPLE_PASS),
+            color_attachments: &[attachment(target.main_texture_view())],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let span = diagnostics.pass_span(&mut pass, UPSAMPLE_PASS);
+        pass.set_render_pipeline(upsample);
+        pass.set_bind_group(0, &bind_groups.upsample, &offsets);
+        pass.draw(0..3, 0..1);
+        span.end(&mut pass);
+    }
+}

@@ -1,0 +1,43 @@
+//! # lodkit_bevy
+//!
+//! [lodkit](https://docs.rs/lodkit) in Bevy 0.19: its shader modules as Bevy shader assets, and
+//! its techniques as plugins.
+//!
+//! - [`LodkitShadersPlugin`]: every `lodkit::` WGSL module becomes a `Shader` asset, so your
+//!   materials and post-processing shaders can `#import lodkit::screen_door::screen_door_keep`,
+//!   `#import lodkit::bilateral::bilateral_upsample`, and so on.
+//! - [`FramebufferLodPlugin`] with the [`FramebufferLod`] camera component: geometry-aware
+//!   framebuffer LOD (Yang, Sander & Lawrence 2008). Your expensive effect runs at 1/r
+//!   resolution, lodkit's bilateral upsample rebuilds it from the depth and normal prepass
+//!   without bleeding across edges, and lodkit's controller can hold a frame-time target by
+//!   choosing r every frame. See [`framebuffer_lod`].
+//!
+//! lodkit is used with `default-features = false`: it brings no naga of its own, Bevy's naga_oil
+//! composes its modules.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use lodkit_bevy::prelude::*;
+//!
+//! App::new()
+//!     .add_plugins((DefaultPlugins, LodkitShadersPlugin, FramebufferLodPlugin))
+//!     .run();
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod framebuffer_lod;
+mod shaders;
+
+pub use framebuffer_lod::{FramebufferLod, FramebufferLodPlugin};
+pub use shaders::{LodkitShaders, LodkitShadersPlugin};
+
+/// The plugins, components and settings an app uses.
+pub mod prelude {
+    pub use crate::framebuffer_lod::{
+        FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodComposite,
+        FramebufferLodPlugin, FramebufferLodResolution, FramebufferLodState,
+        FramebufferLodUpsample, FramerateTarget,
+    };
+    pub use crate::shaders::LodkitShadersPlugin;
+}

@@ -1,0 +1,70 @@
+//! Running the examples from the tests. `cargo test` builds every example before the tests run;
+//! they sit in `examples/` beside the directory of the test binary.
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::SystemTime;
+
+/// The built example `name`.
+pub fn example(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("the test binary's path");
+    let profile = exe
+        .parent()
+        .and_then(|deps| deps.parent())
+        .expect("tests run from target/<profile>/deps");
+    profile
+        .join("examples")
+        .join(format!("{name}{}", std::env::consts::EXE_SUFFIX))
+}
+
+/// Runs example `name` with `args`. Without a GPU adapter it says SKIPPED and returns `None`,
+/// unless `LODKIT_REQUIRE_GPU=1` (lodkit's CI), where that fails the test.
+pub fn run_example(name: &str, args: &[&OsStr]) -> Option<Output> {
+    let path = example(name);
+    assert!(
+        path.exists(),
+        "{} is missing: run `cargo test` (which builds the examples), not only `--test`",
+        path.display()
+    );
+    let built = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
+    let sources = newest_source(Path::new(env!("CARGO_MANIFEST_DIR")));
+    assert!(
+        built >= sources,
+        "{} is older than the sources: run `cargo test` (which rebuilds the examples), not only \
+         `--test`",
+        path.display()
+    );
+    let output = Command::new(&path)
+        .args(args)
+        .output()
+        .expect("run the example");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let strict = std::env::var("LODKIT_REQUIRE_GPU").is_ok_and(|v| v == "1");
+    if !output.status.success() && stderr.contains("Unable to find a GPU") && !strict {
+        eprintln!("SKIPPED: no GPU adapter (install mesa-vulkan-drivers for lavapipe)");
+        return None;
+    }
+    Some(output)
+}
+
+/// The newest modification time of the files under `src/` and `examples/`.
+fn newest_source(root: &Path) -> Option<SystemTime> {
+    fn walk(dir: &Path, newest: &mut Option<SystemTime>) {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                walk(&path, newest);
+            } else if let Ok(modified) = entry.metadata().and_then(|m| m.modified()) {
+                *newest = (*newest).max(Some(modified));
+            }
+        }
+    }
+    let mut newest = None;
+    walk(&root.join("src"), &mut newest);
+    walk(&root.join("examples"), &mut newest);
+    newest
+}
