@@ -102,6 +102,14 @@ fn bevy_framebuffer_lod_meets_its_figures() {
             "r = {r}: bilateral {bilateral:.2} dB, bilinear {bilinear:.2} dB"
         );
     }
+    // The same with the Modulate composite (fine-grained resizing: a factor on the full-res
+    // scene; measured 54.04 dB against 40.93 dB).
+    let bilinear = number(&report, "psnr_modulate_bilinear_r2_db");
+    let bilateral = number(&report, "psnr_modulate_bilateral_r2_db");
+    assert!(
+        bilateral >= bilinear + 3.0,
+        "Modulate, r = 2: bilateral {bilateral:.2} dB, bilinear {bilinear:.2} dB"
+    );
     // Near depth edges bilateral's error at most half of bilinear's (measured: 0.06).
     let edge = number(&report, "edge_error_ratio_r2");
     assert!(edge <= 0.5, "edge error ratio {edge}");
@@ -119,7 +127,9 @@ fn bevy_framebuffer_lod_meets_its_figures() {
     }
     // Every doubling of the fog's cost knocked the frame time out of the +-10 % band (else the
     // test proves nothing), and after every step, up or down, the controller brought it back
-    // within 15 frames (measured: 4 to 6); r stayed inside its limits.
+    // within 15 frames (measured over five runs: 4 to 12); r stayed inside its limits. Steps the
+    // machine stalled (a frame over 1.6 x the calibrated model) are reported apart; four
+    // undisturbed ones are needed.
     let settle = report["controller_settle_frames"].as_array().expect("list");
     let excursions = report["controller_step_excursion"]
         .as_array()
@@ -127,7 +137,10 @@ fn bevy_framebuffer_lod_meets_its_figures() {
     let steps = report["controller_workload_steps"]
         .as_array()
         .expect("list");
-    assert!(settle.len() >= 4, "{report:#}");
+    assert!(
+        settle.len() >= 4,
+        "fewer than 4 steps ran undisturbed by the machine: {report:#}"
+    );
     for ((frames, excursion), scale) in settle.iter().zip(excursions).zip(steps) {
         assert!(
             frames.as_u64().is_some_and(|f| f <= 15),

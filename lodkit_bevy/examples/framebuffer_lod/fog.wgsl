@@ -3,7 +3,9 @@
 // density with low-frequency value noise. Composited `Over`: it returns the in-scattered light
 // and 1 - transmittance, premultiplied.
 //
-// params[0] = (steps, density, fog height, noise amount); params[1] = (sun direction xyz, -).
+// params[0] = (steps, density, fog height, noise amount); params[1] = (sun direction xyz,
+// factor). With factor = 1 it returns the transmittance as a factor instead (composited
+// `Modulate`, a stand-in for an ambient-occlusion term: fine-grained resizing).
 #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
 #import lodkit::gbuffer::GBufferOutput
 #import lodkit_bevy::framebuffer_lod::{view, effect_sample, effect_output, effect_param}
@@ -52,6 +54,9 @@ fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
         let absorbed = 1.0 - exp(-density * dt);
         light += transmittance * absorbed * (SUN * phase + SKY);
         transmittance *= 1.0 - absorbed;
+    }
+    if effect_param(1u).w > 0.5 {
+        return effect_output(vec4<f32>(vec3<f32>(0.25 + 0.75 * transmittance), 1.0), s);
     }
     return effect_output(vec4<f32>(light, 1.0 - transmittance), s);
 }

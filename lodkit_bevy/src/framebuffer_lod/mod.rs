@@ -125,6 +125,7 @@ pub struct FramebufferLodCapabilities {
 /// Requires (and adds) [`DepthPrepass`], [`NormalPrepass`] and [`Hdr`]; the camera must also
 /// have `Msaa::Off` (the effect pass is skipped with an error otherwise). Only meshes drawn in the
 /// prepass (opaque and alpha-masked, with prepass-enabled materials) give the upsample its edges.
+/// The effect covers the camera's whole render target (a camera `viewport` is not supported).
 #[derive(Component, Clone, Debug, Reflect)]
 #[reflect(Component, Default, Clone)]
 #[require(DepthPrepass, NormalPrepass, Hdr, FramebufferLodState)]

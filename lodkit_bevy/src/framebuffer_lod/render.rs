@@ -91,6 +91,11 @@ impl ExtractComponent for FramebufferLod {
             );
             return None;
         }
+        if camera.viewport.is_some() {
+            warn_once!(
+                "FramebufferLod covers the camera's whole render target: its viewport is ignored"
+            );
+        }
         let full = camera.physical_target_size()?;
         let factor = state.factor.clamp(1.0, super::MAX_FACTOR);
         let low = (full.as_vec2() / factor)
