@@ -4,7 +4,8 @@
 //
 //   node .ci/browser/webgpu-probe.mjs PACKAGE_DIR JOBS.json
 //
-// PACKAGE_DIR is shader_lib/wesl/lodkit. JOBS.json: [{ "name", "root" (WESL of package::main:
+// PACKAGE_DIR is shader_lib/wesl/lodkit, or `-` when every job carries "code", WGSL linked
+// elsewhere (npm-user.mjs: the installed npm package). JOBS.json: [{ "name", "root" (WESL of package::main:
 // a compute shader `main`, @workgroup_size(1), one workgroup per case, reading
 // `array<u32>` at @group(0) @binding(0) and writing `array<u32>` at binding 1), "conditions",
 // "input": [u32...], "cases", "outputs" (words per case) }].
@@ -17,13 +18,15 @@ import { launch, withTimeout, die, TIMEOUT_MS } from './common.mjs';
 
 const [pkgDir, jobsFile] = process.argv.slice(2);
 if (!pkgDir || !jobsFile || process.argv.length > 4) die('usage: node webgpu-probe.mjs PACKAGE_DIR JOBS.json');
-if (!fs.existsSync(path.join(pkgDir, 'wesl.toml'))) die(`no wesl.toml in ${pkgDir}`);
+const linkedElsewhere = pkgDir === '-';
+if (!linkedElsewhere && !fs.existsSync(path.join(pkgDir, 'wesl.toml'))) die(`no wesl.toml in ${pkgDir}`);
 const here = path.dirname(fileURLToPath(import.meta.url));
 const weslDist = path.join(here, 'node_modules/wesl/dist');
 if (!fs.existsSync(weslDist)) die('npm package `wesl` is missing: npm ci --prefix .ci/browser');
 const jobs = JSON.parse(fs.readFileSync(jobsFile, 'utf8'));
-const moduleFiles = fs.readdirSync(pkgDir).filter((f) => f.endsWith('.wesl')).sort();
-const edition = /edition\s*=\s*"([^"]+)"/.exec(fs.readFileSync(path.join(pkgDir, 'wesl.toml'), 'utf8'))?.[1];
+if (linkedElsewhere && !jobs.every((j) => typeof j.code === 'string')) die('with PACKAGE_DIR `-` every job needs "code"');
+const moduleFiles = linkedElsewhere ? [] : fs.readdirSync(pkgDir).filter((f) => f.endsWith('.wesl')).sort();
+const edition = linkedElsewhere ? null : /edition\s*=\s*"([^"]+)"/.exec(fs.readFileSync(path.join(pkgDir, 'wesl.toml'), 'utf8'))?.[1];
 
 // The page's origin is served from disk by request interception: nothing listens on the port.
 const ORIGIN = 'http://localhost:9'; // localhost is a secure context (WebGPU needs one)
@@ -48,8 +51,8 @@ async function runJobs({ files, edition, jobs }) {
   const info = adapter.info;
   const results = {};
   for (const job of jobs) {
-    let code;
-    try {
+    let code = job.code;
+    if (code === undefined) try {
       code = (await link({ weslSrc: { 'main.wesl': job.root }, rootModuleName: 'main', libs: [lodkit], conditions: job.conditions })).dest;
     } catch (e) {
       return { error: `${job.name}: wesl-js cannot link: ${e.message}` };

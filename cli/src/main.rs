@@ -8,6 +8,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod library;
+
 use clap::{Parser, Subcommand, ValueEnum};
 use lodkit::shaders::{
     self, ComposeDescriptor, ExportOptions, ExportTarget, Exported, ShaderDefValue, ShaderError,
@@ -18,6 +20,11 @@ use lodkit::shaders::{
 #[command(
     name = "lodkit",
     version,
+    long_version = concat!(
+        env!("CARGO_PKG_VERSION"),
+        "\nbuilt with ",
+        env!("LODKIT_TOOL_VERSIONS")
+    ),
     about = "Smooth discrete-LOD and framebuffer-LOD shader modules"
 )]
 struct Cli {
@@ -90,11 +97,16 @@ enum Command {
         files: Vec<PathBuf>,
     },
     /// Write lodkit's WESL package (wesl.toml and <topic>.wesl, generated from the naga_oil
-    /// modules) into a folder, for wesl-js and wesl-rs projects.
+    /// modules) into a folder for wesl-rs projects, or with `--npm` the npm package `lodkit`
+    /// (plus package.json and the ES module of the bundle wesl-js links, with its types).
+    #[command(group = clap::ArgGroup::new("dest").required(true))]
     Wesl {
-        /// Folder to write into (created; the package's files in it are overwritten).
-        #[arg(long, value_name = "DIR")]
-        out: PathBuf,
+        /// Folder to write the WESL package into (created; its files in it are overwritten).
+        #[arg(long, value_name = "DIR", group = "dest")]
+        out: Option<PathBuf>,
+        /// Folder to write the npm package into (created; ready for `npm pack` or `npm publish`).
+        #[arg(long, value_name = "DIR", group = "dest")]
+        npm: Option<PathBuf>,
     },
     /// Show the GPU adapter the demo would run on (Vulkan, then GL; `LODKIT_BACKEND=vulkan|gl`
     /// picks one). Exits 1 when there is none.
@@ -206,33 +218,6 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
     }
 }
 
-fn write_wesl(out: &Path) -> ExitCode {
-    let files = match shaders::wesl_package() {
-        Ok(files) => files,
-        Err(e) => {
-            eprintln!("error: a lodkit module has no WESL form: {e}");
-            return ExitCode::from(1);
-        }
-    };
-    for (rel, text) in &files {
-        let path = out.join(rel);
-        let written = path
-            .parent()
-            .map_or(Ok(()), std::fs::create_dir_all)
-            .and_then(|()| std::fs::write(&path, text));
-        if let Err(e) = written {
-            eprintln!("error: cannot write `{}`: {e}", path.display());
-            return ExitCode::from(2);
-        }
-    }
-    println!(
-        "wrote {} files of the WESL package `lodkit` into {}",
-        files.len(),
-        out.display()
-    );
-    ExitCode::SUCCESS
-}
-
 fn adapter() -> ExitCode {
     match lodkit_cli::demo::open_gpu() {
         Ok(gpu) => {
@@ -250,7 +235,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Adapter => adapter(),
-        Command::Wesl { out } => write_wesl(&out),
+        // clap requires exactly one of the two.
+        Command::Wesl { out, npm } => match npm {
+            Some(dir) => library::write_wesl(&dir, true),
+            None => library::write_wesl(&out.unwrap_or_default(), false),
+        },
         Command::Demo {
             out,
             size,
@@ -269,7 +258,7 @@ fn main() -> ExitCode {
             fb_size,
             progress: true,
         }),
-        Command::Modules { format } => modules(format),
+        Command::Modules { format } => library::modules(matches!(format, Format::Json)),
         Command::Check {
             compose,
             format,
@@ -283,45 +272,6 @@ fn main() -> ExitCode {
             file,
         } => export(&compose, to, entry, &output, &file),
     }
-}
-
-fn modules(format: Format) -> ExitCode {
-    let modules = shaders::modules();
-    if let Format::Json = format {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(modules).unwrap_or_default()
-        );
-        return ExitCode::SUCCESS;
-    }
-    for m in modules {
-        let name = m.import_path.clone().unwrap_or_else(|| m.path.to_owned());
-        let kind = match (m.kind, m.language) {
-            (shaders::ModuleKind::Pass, _) => "pass",
-            (_, shaders::Language::Wgsl) => "wgsl",
-            (_, shaders::Language::Glsl) => "glsl twin",
-            (_, shaders::Language::Wesl) => "wesl",
-        };
-        println!("{name}  [{kind}: shader_lib/{}]", m.path);
-        if let Some(path) = &m.embedded_path {
-            println!("    Bevy 0.20: Shader::from_wesl(source, \"{path}\")");
-        }
-        println!("    {}", m.summary);
-        for f in &m.functions {
-            println!("    {}", f.signature);
-            if !f.doc.is_empty() {
-                println!("        {}", f.doc);
-            }
-        }
-        if m.shader_defs.is_empty() {
-            println!("    shader defs: none");
-        }
-        for d in &m.shader_defs {
-            println!("    shader def {} {}", d.name, d.doc);
-        }
-        println!();
-    }
-    ExitCode::SUCCESS
 }
 
 /// What happened to one file.

@@ -309,6 +309,24 @@ fn modules_lists_every_module_as_json() {
 }
 
 #[test]
+fn a_reader_that_stops_early_is_no_crash() {
+    // `lodkit modules | head -1`: the pipe closes before the listing is written.
+    for args in [&["modules"][..], &["modules", "--format", "json"]] {
+        let mut child = lodkit()
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
 fn export_writes_every_target() {
     let dir = fixture(&[("good.wgsl", GOOD)]);
     for (to, needle) in [

@@ -10,4 +10,5 @@ mod demo;
 mod docs_figures;
 mod engine_tree;
 mod impostor;
+mod npm_package;
 mod wesl_check;
