@@ -7,6 +7,7 @@
 mod support;
 mod alpha_tested;
 mod composition;
+mod cost;
 mod display_time;
 mod draw_limits;
 mod frame_sequential;

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod library;
+mod stats;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use lodkit::shaders::{
@@ -92,6 +93,14 @@ enum Command {
         compose: ComposeArgs,
         #[arg(long, value_enum, default_value_t)]
         format: Format,
+        /// Print what each entry point fetches (texture loads, samples, gathers, storage reads,
+        /// per resource) and its ALU ops, counted from the IR for one invocation.
+        #[arg(long)]
+        stats: bool,
+        /// A RON or TOML table of entry points and maxima (`"fs_main": (fetches: 9)`): exit 1
+        /// when an entry point goes over.
+        #[arg(long, value_name = "FILE")]
+        budget: Option<PathBuf>,
         /// Shaders to check (.wgsl: naga_oil; .wesl: WESL linked by wesl-rs; .glsl/.vert/.frag/.comp).
         #[arg(required = true)]
         files: Vec<PathBuf>,
@@ -262,8 +271,10 @@ fn main() -> ExitCode {
         Command::Check {
             compose,
             format,
+            stats,
+            budget,
             files,
-        } => check(&compose, format, &files),
+        } => check(&compose, format, stats, budget.as_deref(), &files),
         Command::Export {
             compose,
             to,
@@ -376,7 +387,21 @@ fn print_error(e: &ShaderError) {
     }
 }
 
-fn check(args: &ComposeArgs, format: Format, files: &[PathBuf]) -> ExitCode {
+fn check(
+    args: &ComposeArgs,
+    format: Format,
+    stats: bool,
+    budget: Option<&Path>,
+    files: &[PathBuf],
+) -> ExitCode {
+    let mut budget = match budget.map(stats::Budget::load).transpose() {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error[budget]: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut over = Vec::new();
     let mut library = match library(args) {
         Ok(l) => l,
         Err(e) => {
@@ -409,7 +434,20 @@ fn check(args: &ComposeArgs, format: Format, files: &[PathBuf]) -> ExitCode {
                         if entry_points.len() == 1 { "" } else { "s" }
                     );
                 }
-                reports.push(serde_json::json!({"file": file, "valid": true, "entry_points": entry_points, "diagnostics": []}));
+                let mut report = serde_json::json!({"file": file, "valid": true, "entry_points": entry_points, "diagnostics": []});
+                if stats || budget.is_some() {
+                    let costs = shaders::cost::entry_point_costs(&c.module);
+                    for cost in &costs {
+                        if let Some(b) = budget.as_mut() {
+                            over.extend(b.check(path, cost));
+                        }
+                        if stats && matches!(format, Format::Human) {
+                            print!("{}", stats::human(cost));
+                        }
+                    }
+                    report["stats"] = costs.iter().map(stats::json).collect();
+                }
+                reports.push(report);
             }
             Outcome::Invalid(e) | Outcome::Unreadable(e) => {
                 if matches!(outcome, Outcome::Invalid(_)) {
@@ -424,23 +462,42 @@ fn check(args: &ComposeArgs, format: Format, files: &[PathBuf]) -> ExitCode {
             }
         }
     }
+    if let Some(b) = &budget {
+        for key in b.unused() {
+            eprintln!("warning[budget]: no entry point of the files checked matches \"{key}\"");
+        }
+    }
+    if let Format::Human = format {
+        for line in &over {
+            eprintln!("error[budget]: {line}");
+        }
+    }
     match format {
-        Format::Json => println!(
-            "{}",
-            serde_json::json!({"valid": invalid + unreadable == 0, "files": reports})
-        ),
+        Format::Json => {
+            let mut doc = serde_json::json!({"valid": invalid + unreadable == 0, "files": reports});
+            if budget.is_some() {
+                doc["within_budget"] = over.is_empty().into();
+                doc["over_budget"] = over.clone().into();
+            }
+            println!("{doc}")
+        }
         Format::Human if files.len() > 1 => eprintln!(
-            "checked {} files: {} valid, {} invalid, {} unreadable",
+            "checked {} files: {} valid, {} invalid, {} unreadable{}",
             files.len(),
             files.len() - invalid - unreadable,
             invalid,
-            unreadable
+            unreadable,
+            if budget.is_some() {
+                format!(", {} over budget", over.len())
+            } else {
+                String::new()
+            }
         ),
         Format::Human => {}
     }
     ExitCode::from(if unreadable > 0 {
         2
-    } else if invalid > 0 {
+    } else if invalid > 0 || !over.is_empty() {
         1
     } else {
         0

@@ -4,6 +4,7 @@
 #[macro_use]
 #[path = "../../integration_tests/support.rs"]
 mod support;
+mod budget;
 mod cli;
 mod combine_regions;
 mod demo;

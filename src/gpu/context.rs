@@ -15,10 +15,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use super::GpuError;
-use crate::shaders::{
-    ComposeDescriptor, Composed, Diagnostic, DiagnosticKind, ShaderDefValue, ShaderError,
-    ShaderLibrary,
-};
+use crate::shaders::Composed;
 
 /// Most errors the uncaptured-error handler keeps (it still counts the rest).
 const RECORDED_ERRORS: usize = 16;
@@ -312,25 +309,7 @@ impl GpuContext {
     /// The shader module of lodkit's pass `shader_lib/passes/<name>.wgsl`, composed with the
     /// boolean shader defs `defs` switched on.
     pub fn pass_module(&self, name: &str, defs: &[&str]) -> Result<wgpu::ShaderModule, GpuError> {
-        let file_path = format!("shader_lib/passes/{name}.wgsl");
-        let Some(source) = crate::shaders::find_pass_source(name) else {
-            let d = Diagnostic::new(
-                DiagnosticKind::UnknownImport,
-                file_path,
-                format!("lodkit has no pass `{name}`"),
-            );
-            return Err(ShaderError::Source(Box::new(d)).into());
-        };
-        let shader_defs = defs
-            .iter()
-            .map(|d| (d.to_string(), ShaderDefValue::Bool(true)))
-            .collect();
-        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-            source,
-            file_path: &file_path,
-            shader_defs,
-            ..Default::default()
-        })?;
+        let composed = crate::shaders::compose_pass(name, defs)?;
         self.guarded("GpuContext::pass_module", || {
             self.shader_module(name, &composed)
         })

@@ -7,6 +7,7 @@
 //! - [`ShaderLibrary`] composes your WGSL (`#import lodkit::...`) or GLSL
 //!   (`#include "lodkit/....glsl"`) into a validated `naga::Module`.
 //! - [`export`] writes it as SPIR-V, MSL, HLSL, GLSL 450, GLSL ES or WGSL.
+//! - [`cost::entry_point_costs`] counts what each entry point fetches and computes, from the IR.
 //!
 //! Errors are [`ShaderError`]s; problems in source carry a [`Diagnostic`] with file, line and
 //! column.
@@ -17,6 +18,8 @@
 
 #[cfg(feature = "compose")]
 mod compose;
+#[cfg(feature = "compose")]
+pub mod cost;
 #[cfg(feature = "compose")]
 mod diagnostic;
 #[cfg(feature = "compose")]
@@ -119,4 +122,30 @@ pub fn wesl_package() -> Result<Vec<(String, String)>, WeslError> {
 pub fn find_pass_source(name: &str) -> Option<&'static str> {
     let path = format!("passes/{name}.wgsl");
     modules().iter().find(|m| m.path == path).map(|m| m.source)
+}
+
+/// lodkit's pass `shader_lib/passes/<name>.wgsl` composed and validated, with the boolean shader
+/// defs `defs` switched on: what `lodkit::gpu` runs, for counting its costs
+/// ([`cost::entry_point_costs`]) or exporting it. An unknown pass is an error naming it.
+#[cfg(feature = "compose")]
+pub fn compose_pass(name: &str, defs: &[&str]) -> Result<Composed, ShaderError> {
+    let file_path = format!("shader_lib/passes/{name}.wgsl");
+    let Some(source) = find_pass_source(name) else {
+        let d = Diagnostic::new(
+            DiagnosticKind::UnknownImport,
+            file_path,
+            format!("lodkit has no pass `{name}`"),
+        );
+        return Err(ShaderError::Source(Box::new(d)));
+    };
+    let shader_defs = defs
+        .iter()
+        .map(|d| (d.to_string(), ShaderDefValue::Bool(true)))
+        .collect();
+    ShaderLibrary::new()?.compose(&ComposeDescriptor {
+        source,
+        file_path: &file_path,
+        shader_defs,
+        ..Default::default()
+    })
 }

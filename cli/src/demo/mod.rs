@@ -16,6 +16,7 @@ pub mod doc_pictures;
 pub mod frame_cost;
 pub mod impostor;
 pub mod plots;
+pub mod reads;
 pub mod render;
 pub mod report;
 pub mod report_fb;

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::plots::{Chart, Series, line_chart};
-use super::timing::Reads;
+use super::reads::Reads;
 use super::upsampling::{CONTROLLER_SEEDS, METHODS, SHADING_WORK, SIGMA_N, SIGMA_Z, TARGET_MS};
 use super::{DemoError, DemoReport};
 
@@ -310,7 +310,14 @@ fn ratio_table(report: &DemoReport) -> Table {
 }
 
 fn reads(r: &Reads) -> String {
-    format!("{} / {} / {} B", r.fetches, r.texels, r.bytes)
+    let always = format!("{} / {} / {} B", r.fetches, r.texels, r.bytes);
+    match r.conditional_fetches {
+        0 => always,
+        _ => format!(
+            "{always} (+ at most {} / {} / {} B under branches)",
+            r.conditional_fetches, r.conditional_texels, r.conditional_bytes
+        ),
+    }
 }
 
 fn controller_table(report: &DemoReport) -> Table {

@@ -9,6 +9,7 @@ use std::time::Instant;
 use glam::{Mat4, Vec3, Vec4};
 use serde::Serialize;
 
+use super::reads::{Reads, Texels};
 use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
 use lodkit::gpu::frame_sequential::{CombinePass, LOD_DEPTH_FORMAT, LodBuffers};
@@ -47,38 +48,6 @@ pub struct PassRatio {
     pub pass_reads: Reads,
     /// Texture reads per output pixel of the baseline.
     pub baseline_reads: Reads,
-}
-
-/// Texture reads per output pixel, counted from a shader's code: they hold on any GPU (before
-/// caches), where milliseconds on a software GPU do not.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct Reads {
-    /// Fetch instructions (`textureLoad`, `textureSample*`).
-    pub fetches: u32,
-    /// Texels those fetches touch (4 for a bilinear fetch).
-    pub texels: u32,
-    /// Bytes of those texels.
-    pub bytes: u64,
-}
-
-impl Reads {
-    /// No reads.
-    const NONE: Self = Self {
-        fetches: 0,
-        texels: 0,
-        bytes: 0,
-    };
-
-    /// Adds `fetches` fetches of `texels_each` texels of `format`.
-    fn plus(self, fetches: u32, texels_each: u32, format: wgpu::TextureFormat) -> Self {
-        let texels = fetches * texels_each;
-        let bytes = u64::from(format.block_copy_size(None).unwrap_or(0)) * u64::from(texels);
-        Self {
-            fetches: self.fetches + fetches,
-            texels: self.texels + texels,
-            bytes: self.bytes + bytes,
-        }
-    }
 }
 
 /// Median (the upper one for even lengths); NaN when empty.
@@ -290,13 +259,26 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     };
     let run_copy = || draw_fullscreen(gpu, &copy7, &group, &target_view);
     let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs)?;
-    // The copy reads color, id and depth of each buffer and the object motion; the combine
-    // also the older depth at its first estimate.
-    let copy = Reads::NONE
-        .plus(2, 1, FORMAT)
-        .plus(2, 1, ID_FORMAT)
-        .plus(2, 1, LOD_DEPTH_FORMAT)
-        .plus(1, 1, MOTION_FORMAT);
+    // Counted from the shaders: the copy reads color, id and depth of each buffer and the object
+    // motion; the combine the same, the older depth at its first estimate, and under branches
+    // the older ids of its search.
+    let buffer = |color, id, depth| {
+        [
+            (color, FORMAT, Texels::One),
+            (id, ID_FORMAT, Texels::One),
+            (depth, LOD_DEPTH_FORMAT, Texels::One),
+        ]
+    };
+    let mut copy_formats = [buffer("a", "b", "c"), buffer("d", "e", "f")].concat();
+    copy_formats.push(("g", MOTION_FORMAT, Texels::One));
+    let copy = Reads::of_source(COPY7, "copy7.wgsl", &copy_formats)?;
+    let mut combine_formats = [
+        buffer("newer_color", "newer_id", "newer_depth"),
+        buffer("older_color", "older_id", "older_depth"),
+    ]
+    .concat();
+    combine_formats.push(("object_motion", MOTION_FORMAT, Texels::One));
+    let combine_reads = Reads::of_pass("combine", &combine_formats)?;
     Ok(PassRatio {
         pass: "combine (frame-sequential)".to_owned(),
         baseline: "plain copy of the same 7 textures".to_owned(),
@@ -305,7 +287,7 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
         baseline_ms,
         ratio,
         pairs,
-        pass_reads: copy.plus(1, 1, LOD_DEPTH_FORMAT),
+        pass_reads: combine_reads,
         baseline_reads: copy,
     })
 }
@@ -384,12 +366,21 @@ pub fn upsample_vs_bilinear(
     let layout = loads.get_bind_group_layout(0);
     let loads_group = textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads9")?;
     let run_loads = || draw_fullscreen(gpu, &loads, &loads_group, &view);
-    // Eq. 1: the pixel's own geometry, then the 2x2 cell's colors and geometry, one load each.
-    let eq1_reads = Reads::NONE
-        .plus(1, 1, GEOMETRY_FORMAT)
-        .plus(4, 1, FORMAT)
-        .plus(4, 1, GEOMETRY_FORMAT);
-    let time = |pass: String, run: &dyn Fn() -> Result<(), GpuError>| {
+    // Counted from the shaders: eq. 1 reads the pixel's own geometry and the 2x2 cell's colors
+    // and geometry; the bilinear pass one filtered sample (4 texels).
+    let eq1_formats = [
+        ("low_color", FORMAT, Texels::One),
+        ("low_geometry", GEOMETRY_FORMAT, Texels::One),
+        ("full_geometry", GEOMETRY_FORMAT, Texels::One),
+    ];
+    let bilateral_reads = Reads::of_pass("upsample", &eq1_formats)?;
+    let loads_reads = Reads::of_source(LOADS9, "loads9.wgsl", &eq1_formats)?;
+    let bilinear_reads = Reads::of_source(
+        BILINEAR,
+        "bilinear.wgsl",
+        &[("low_color", FORMAT, Texels::Linear)],
+    )?;
+    let time = |pass: String, reads: Reads, run: &dyn Fn() -> Result<(), GpuError>| {
         let (pass_ms, baseline_ms, ratio) = interleaved(run, &run_bilinear, pairs)?;
         Ok::<_, GpuError>(PassRatio {
             pass,
@@ -399,12 +390,20 @@ pub fn upsample_vs_bilinear(
             baseline_ms,
             ratio,
             pairs,
-            pass_reads: eq1_reads,
-            baseline_reads: Reads::NONE.plus(1, 4, FORMAT),
+            pass_reads: reads,
+            baseline_reads: bilinear_reads,
         })
     };
     Ok([
-        time(format!("bilateral upsample (r = {r})"), &run_bilateral)?,
-        time("eq. 1's 9 texel loads alone".to_owned(), &run_loads)?,
+        time(
+            format!("bilateral upsample (r = {r})"),
+            bilateral_reads,
+            &run_bilateral,
+        )?,
+        time(
+            "eq. 1's 9 texel loads alone".to_owned(),
+            loads_reads,
+            &run_loads,
+        )?,
     ])
 }
