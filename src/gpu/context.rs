@@ -220,8 +220,10 @@ impl GpuContext {
     /// `f` comes back as this call's error instead of reaching the uncaptured-error handler.
     ///
     /// Inside another guarded call on the same thread it only runs `f`: the outermost call, the
-    /// one the engine made, checks the device and names the error.
-    pub(crate) fn guarded<T>(
+    /// one the engine made, checks the device and names the error. An application's own passes
+    /// can record through it to get lodkit's error handling (and its host cost, which is what
+    /// the demo's baselines do to be timed fairly against lodkit's passes).
+    pub fn guarded<T>(
         &self,
         call: &'static str,
         f: impl FnOnce() -> Result<T, GpuError>,

@@ -408,7 +408,7 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     let mut b = header(report, "Benchmarks");
     b.push_str("\n## Cost of a transition\n\nTriangles submitted and fragments counted over the transition's frames, static camera. Frame-sequential adds the combine pass over the screen rectangles of the objects in transition (one fragment per pixel of the rectangles, included; the rest of the frame is a copy). The last column compares the frames before and after the transition, with no object in transition.\n");
     b.push_str(&transition_tables(report, true));
-    b.push_str("\n## Pass time ratios\n\nEach pass against the plainest pass with the same memory traffic, timed in interleaved pairs; the figure is the median of the per-pair ratios.\n\n");
+    b.push_str(&format!("\n## Pass time ratios\n\nEach pass against the plainest pass with the same memory traffic, timed in interleaved pairs; the figure is the median of the per-pair ratios. Host work is the same on both sides: {}. Fetches, texels and bytes per pixel are counted from each shader (`lodkit check --stats`), weighed by the formats bound.\n\n", super::timing::HOST_WORK));
     b.push_str(&ratio_table(report).markdown());
     b.push_str("\n## Framebuffer LOD: whole-frame speed-up\n\n");
     let _ = writeln!(

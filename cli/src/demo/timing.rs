@@ -50,11 +50,16 @@ pub struct PassRatio {
     pub baseline_reads: Reads,
 }
 
-/// Median (the upper one for even lengths); NaN when empty.
+/// Median: the middle value, or the mean of the two middle values for an even count; NaN when
+/// empty.
 pub fn median(v: &[f64]) -> f64 {
     let mut v = v.to_vec();
     v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => (v[n / 2 - 1] + v[n / 2]) / 2.0,
+    }
 }
 
 /// Wall time of `f` in milliseconds.
@@ -162,22 +167,35 @@ struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 }
 ";
 
+/// A baseline pass timed as lodkit's passes run: its bind group built and its uniform (if any)
+/// written per call inside the same error scopes ([`GpuContext::guarded`]), then submit and
+/// wait. The lodkit pass and its baseline so do the same host work per call.
 fn draw_fullscreen(
     gpu: &GpuContext,
     pipeline: &wgpu::RenderPipeline,
-    group: &wgpu::BindGroup,
+    group: &dyn Fn() -> Result<wgpu::BindGroup, GpuError>,
+    uniform: Option<(&wgpu::Buffer, &[u8])>,
     target: &wgpu::TextureView,
 ) -> Result<(), GpuError> {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    {
+    gpu.guarded("baseline", || {
+        if let Some((buffer, bytes)) = uniform {
+            gpu.queue.write_buffer(buffer, 0, bytes);
+        }
+        let group = group()?;
         let mut pass = begin_color_pass(&mut encoder, target, wgpu::Color::BLACK, "baseline");
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, group, &[]);
+        pass.set_bind_group(0, &group, &[]);
         pass.draw(0..3, 0..1);
-    }
+        Ok(())
+    })?;
     gpu.queue.submit([encoder.finish()]);
     gpu.wait_idle()
 }
+
+/// What the timed pass and its baseline each do on the host per call.
+pub const HOST_WORK: &str = "each call builds its bind group, writes its uniform (where it has \
+    one), records inside wgpu error scopes, submits and waits";
 
 /// The combine pass against a plain pass reading the same seven textures (color, id and depth of
 /// each buffer, the object motion) at `size` x `size`, on two LOD buffers of a grid of spheres
@@ -250,14 +268,14 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     let mut textures = textures.as_flattened().to_vec();
     // LodBuffers::new has the motion target.
     textures.extend(buffers.motion());
-    let group = textures_and_uniform(gpu, &layout, &textures, None, "copy7")?;
+    let group = || textures_and_uniform(gpu, &layout, &textures, None, "copy7");
     let run_combine = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         combine.encode(gpu, &mut encoder, &buffers, 1, m, &target_view)?;
         gpu.queue.submit([encoder.finish()]);
         gpu.wait_idle()
     };
-    let run_copy = || draw_fullscreen(gpu, &copy7, &group, &target_view);
+    let run_copy = || draw_fullscreen(gpu, &copy7, &group, None, &target_view);
     let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs)?;
     // Counted from the shaders: the copy reads color, id and depth of each buffer and the object
     // motion; the combine the same, the older depth at its first estimate, and under branches
@@ -327,24 +345,26 @@ pub fn upsample_vs_bilinear(
     let s = [vw as f32 / w as f32, vh as f32 / h as f32, 0.0, 0.0];
     gpu.queue.write_buffer(&scale, 0, bytemuck::cast_slice(&s));
     let low_view = low.color().create_view(&Default::default());
-    let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &bilinear.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&low_view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::Sampler(&sampler),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: scale.as_entire_binding(),
-            },
-        ],
-    });
+    let group = || {
+        Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &bilinear.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&low_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: scale.as_entire_binding(),
+                },
+            ],
+        }))
+    };
     let run_bilateral = || {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         upsample.encode(
@@ -360,12 +380,22 @@ pub fn upsample_vs_bilinear(
         gpu.queue.submit([encoder.finish()]);
         gpu.wait_idle()
     };
-    let run_bilinear = || draw_fullscreen(gpu, &bilinear, &group, &view);
+    let scale_bytes: &[u8] = bytemuck::cast_slice(&s);
+    let run_bilinear =
+        || draw_fullscreen(gpu, &bilinear, &group, Some((&scale, scale_bytes)), &view);
     let loads = plain_pass(gpu, LOADS9, "loads9.wgsl")?;
     let textures = [low.color(), low.geometry(), full.geometry()];
     let layout = loads.get_bind_group_layout(0);
-    let loads_group = textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads9")?;
-    let run_loads = || draw_fullscreen(gpu, &loads, &loads_group, &view);
+    let loads_group = || textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads9");
+    let run_loads = || {
+        draw_fullscreen(
+            gpu,
+            &loads,
+            &loads_group,
+            Some((&scale, scale_bytes)),
+            &view,
+        )
+    };
     // Counted from the shaders: eq. 1 reads the pixel's own geometry and the 2x2 cell's colors
     // and geometry; the bilinear pass one filtered sample (4 texels).
     let eq1_formats = [
@@ -406,4 +436,16 @@ pub fn upsample_vs_bilinear(
             &run_loads,
         )?,
     ])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn median_of_an_even_count_is_the_mean_of_the_middle_two() {
+        assert_eq!(median(&[4.0, 1.0, 3.0]), 3.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert!(median(&[]).is_nan());
+    }
 }
