@@ -8,7 +8,8 @@
 //! i++)` gives) multiplies its body; any other loop counts once and is reported in
 //! [`EntryCost::unknown_loops`]. What runs under an `if` or `switch` is counted apart as
 //! `conditional`: the most that any one path through the branches adds (per count, so a sound
-//! upper bound), on top of the `always` part every invocation executes.
+//! upper bound), on top of the `always` part, what runs outside any branch. (What follows an
+//! early `return` inside a branch still counts as `always`: the main path.)
 
 use std::collections::BTreeMap;
 
@@ -102,7 +103,7 @@ pub struct EntryCost {
     pub name: String,
     /// `vertex`, `fragment`, `compute`, ...
     pub stage: String,
-    /// What every invocation executes.
+    /// What runs outside any branch: the main path.
     pub always: Counts,
     /// What branches add at most, on top of `always`.
     pub conditional: Counts,
@@ -278,7 +279,7 @@ impl Walker<'_> {
                 }
                 Statement::Atomic { pointer, .. } => {
                     if let Some(g) = storage_root(self.module, f, *pointer, args) {
-                        fetch(&mut t, g, FetchKind::StorageRead);
+                        fetch(&mut t, Some(g), FetchKind::StorageRead);
                     }
                 }
                 _ => {}
@@ -290,23 +291,19 @@ impl Walker<'_> {
     fn expression(&mut self, f: &Function, h: Handle<Expression>, args: &Args, t: &mut Tally) {
         match &f.expressions[h] {
             Expression::ImageSample { image, gather, .. } => {
-                if let Some(g) = global_root(f, *image, args) {
-                    let kind = if gather.is_some() {
-                        FetchKind::Gather
-                    } else {
-                        FetchKind::Sample
-                    };
-                    fetch(t, g, kind);
-                }
+                let kind = if gather.is_some() {
+                    FetchKind::Gather
+                } else {
+                    FetchKind::Sample
+                };
+                fetch(t, global_root(f, *image, args), kind);
             }
             Expression::ImageLoad { image, .. } => {
-                if let Some(g) = global_root(f, *image, args) {
-                    fetch(t, g, FetchKind::TextureLoad);
-                }
+                fetch(t, global_root(f, *image, args), FetchKind::TextureLoad);
             }
             Expression::Load { pointer } => {
                 if let Some(g) = storage_root(self.module, f, *pointer, args) {
-                    fetch(t, g, FetchKind::StorageRead);
+                    fetch(t, Some(g), FetchKind::StorageRead);
                 }
             }
             Expression::Unary { .. }
@@ -321,9 +318,13 @@ impl Walker<'_> {
     }
 }
 
-fn fetch(t: &mut Tally, g: Handle<naga::GlobalVariable>, kind: FetchKind) {
+/// One fetch; by resource too when the texture or buffer it reads is known (a texture that
+/// reaches a function some other way than as a global or an argument counts in the totals only).
+fn fetch(t: &mut Tally, g: Option<Handle<naga::GlobalVariable>>, kind: FetchKind) {
     t.always.add_fetch(kind, 1);
-    t.fetches.entry((g, kind)).or_default().0 += 1;
+    if let Some(g) = g {
+        t.fetches.entry((g, kind)).or_default().0 += 1;
+    }
 }
 
 /// The global variable an image or pointer expression reads from (through binding-array and

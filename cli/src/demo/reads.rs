@@ -92,6 +92,13 @@ impl Reads {
             reads.conditional_texels += r.conditional * each;
             reads.conditional_bytes += r.conditional * each * size;
         }
+        if reads.fetches + reads.conditional_fetches != fs.worst().fetches() {
+            return Err(unfit(
+                name,
+                "fs_main",
+                "reads a texture that is not a bound global",
+            ));
+        }
         Ok(reads)
     }
 }
