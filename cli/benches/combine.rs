@@ -20,10 +20,14 @@ fn main() {
     };
     println!("adapter: {}", gpu.adapter_summary());
     match combine_vs_copy(&gpu, size, pairs) {
-        Ok(r) => println!(
-            "{size}x{size}, {pairs} interleaved pairs: {} {:.3} ms, {} {:.3} ms, median ratio {:.3}",
-            r.pass, r.pass_ms, r.baseline, r.baseline_ms, r.ratio
-        ),
+        Ok(ratios) => {
+            for r in ratios {
+                println!(
+                    "{size}x{size}, {pairs} interleaved pairs: {} {:.3} ms, {} {:.3} ms, median ratio {:.3}",
+                    r.pass, r.pass_ms, r.baseline, r.baseline_ms, r.ratio
+                );
+            }
+        }
         Err(e) => eprintln!("error: {e}"),
     }
 }

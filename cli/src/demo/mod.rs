@@ -328,11 +328,8 @@ pub fn run_on(
     let closed_loop = closed_loop::measure_closed_loop(gpu, options.fb_size)?;
     bar.inc(1);
     bar.set_message("pass time ratios");
-    let mut pass_ratios = vec![timing::combine_vs_copy(
-        gpu,
-        options.size.0.min(1024),
-        options.timing_pairs,
-    )?];
+    let mut pass_ratios =
+        timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?.to_vec();
     pass_ratios.extend(timing::upsample_vs_bilinear(
         gpu,
         options.fb_size,

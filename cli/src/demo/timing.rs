@@ -134,6 +134,27 @@ const COPY7: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_v
 }
 ";
 
+/// The combine's main-path loads without its arithmetic: COPY7 and the older depth once more
+/// (the combine's first estimate), at a neighbouring texel: the floor of any combine.
+const LOADS8: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+@group(0) @binding(0) var a: texture_2d<f32>;
+@group(0) @binding(1) var b: texture_2d<u32>;
+@group(0) @binding(2) var c: texture_2d<f32>;
+@group(0) @binding(3) var d: texture_2d<f32>;
+@group(0) @binding(4) var e: texture_2d<u32>;
+@group(0) @binding(5) var f: texture_2d<f32>;
+@group(0) @binding(6) var g: texture_2d<f32>;
+@vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
+@fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
+    let p = vec2<u32>(v.position.xy);
+    let q = min(p + 1u, textureDimensions(f, 0) - 1u);
+    let ids = textureLoad(b, p, 0).x ^ textureLoad(e, p, 0).x;
+    let depth = textureLoad(c, p, 0).x + textureLoad(f, p, 0).x + textureLoad(f, q, 0).x;
+    let motion = textureLoad(g, p, 0).xy;
+    return textureLoad(a, p, 0) + textureLoad(d, p, 0) + vec4<f32>(f32(ids & 1u), depth, motion);
+}
+";
+
 const BILINEAR: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 @group(0) @binding(0) var low_color: texture_2d<f32>;
@@ -199,8 +220,13 @@ pub const HOST_WORK: &str = "each call builds its bind group, writes its uniform
 
 /// The combine pass against a plain pass reading the same seven textures (color, id and depth of
 /// each buffer, the object motion) at `size` x `size`, on two LOD buffers of a grid of spheres
-/// and boxes with a third of them in transition and the camera moved between the frames.
-pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<PassRatio, GpuError> {
+/// and boxes with a third of them in transition and the camera moved between the frames; then,
+/// against the same baseline, the combine's eight main-path loads alone: its floor.
+pub fn combine_vs_copy(
+    gpu: &GpuContext,
+    size: u32,
+    pairs: usize,
+) -> Result<[PassRatio; 2], GpuError> {
     let buffers = LodBuffers::new(gpu, size, size, FORMAT)?;
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
     let renderer = LodBufferRenderer::new(gpu, FORMAT, &vis, 0.25)?;
@@ -264,6 +290,13 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     entries.push(CombinePass::motion_layout_entry(6));
     let (layout, pipeline_layout) = one_group_layout(gpu, &entries, "copy7");
     let copy7 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "copy7")?;
+    let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+        source: LOADS8,
+        file_path: "loads8.wgsl",
+        ..Default::default()
+    })?;
+    let module = gpu.shader_module("loads8.wgsl", &composed)?;
+    let loads8 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "loads8")?;
     let textures = [1, 0].map(|i| [buffers.color(i), buffers.id(i), buffers.depth(i)]);
     let mut textures = textures.as_flattened().to_vec();
     // LodBuffers::new has the motion target.
@@ -276,7 +309,7 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
         gpu.wait_idle()
     };
     let run_copy = || draw_fullscreen(gpu, &copy7, &group, None, &target_view);
-    let (pass_ms, baseline_ms, ratio) = interleaved(&run_combine, &run_copy, pairs)?;
+    let run_loads = || draw_fullscreen(gpu, &loads8, &group, None, &target_view);
     // Counted from the shaders: the copy reads color, id and depth of each buffer and the object
     // motion; the combine the same, the older depth at its first estimate, and under branches
     // the older ids of its search.
@@ -297,17 +330,29 @@ pub fn combine_vs_copy(gpu: &GpuContext, size: u32, pairs: usize) -> Result<Pass
     .concat();
     combine_formats.push(("object_motion", MOTION_FORMAT, Texels::One));
     let combine_reads = Reads::of_pass("combine", &combine_formats)?;
-    Ok(PassRatio {
-        pass: "combine (frame-sequential)".to_owned(),
-        baseline: "plain copy of the same 7 textures".to_owned(),
-        size: (size, size),
-        pass_ms,
-        baseline_ms,
-        ratio,
-        pairs,
-        pass_reads: combine_reads,
-        baseline_reads: copy,
-    })
+    let loads_reads = Reads::of_source(LOADS8, "loads8.wgsl", &copy_formats)?;
+    let time = |pass: &str, reads: Reads, run: &dyn Fn() -> Result<(), GpuError>| {
+        let (pass_ms, baseline_ms, ratio) = interleaved(run, &run_copy, pairs)?;
+        Ok::<_, GpuError>(PassRatio {
+            pass: pass.to_owned(),
+            baseline: "plain copy of the same 7 textures".to_owned(),
+            size: (size, size),
+            pass_ms,
+            baseline_ms,
+            ratio,
+            pairs,
+            pass_reads: reads,
+            baseline_reads: copy,
+        })
+    };
+    Ok([
+        time("combine (frame-sequential)", combine_reads, &run_combine)?,
+        time(
+            "the combine's 8 main-path loads alone",
+            loads_reads,
+            &run_loads,
+        )?,
+    ])
 }
 
 /// The bilateral upsample pass against a hardware-filtered bilinear pass over the same low-res
