@@ -129,3 +129,29 @@ fn a_malformed_budget_names_its_file_and_line() {
     assert_eq!(code, 2, "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// lodkit's own passes stay within `cli/tests/passes-budget.ron`: the budget CI holds them to.
+#[test]
+fn lodkits_passes_meet_their_budget() {
+    let root = crate::support::workspace_root();
+    let mut args = vec![
+        "check".to_owned(),
+        "--budget".to_owned(),
+        root.join("cli/tests/passes-budget.ron")
+            .display()
+            .to_string(),
+    ];
+    let passes = root.join("shader_lib/passes");
+    let mut files: Vec<String> = std::fs::read_dir(&passes)
+        .unwrap()
+        .map(|e| e.unwrap().path().display().to_string())
+        .filter(|p| p.ends_with(".wgsl"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 6, "a new pass needs a budget: {files:?}");
+    args.extend(files);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, stderr) = run(&root, &args);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!stderr.contains("warning[budget]"), "{stderr}");
+}
