@@ -97,8 +97,8 @@ enum Command {
         /// per resource) and its ALU ops, counted from the IR for one invocation.
         #[arg(long)]
         stats: bool,
-        /// A RON or TOML table of entry points and maxima (`"fs_main": (fetches: 9)`): exit 1
-        /// when an entry point goes over.
+        /// A RON or TOML table of entry points and maxima (RON: `{ "fs_main": { "fetches": 9 } }`):
+        /// exit 1 when an entry point goes over.
         #[arg(long, value_name = "FILE")]
         budget: Option<PathBuf>,
         /// Shaders to check (.wgsl: naga_oil; .wesl: WESL linked by wesl-rs; .glsl/.vert/.frag/.comp).
@@ -110,7 +110,8 @@ enum Command {
     /// (plus package.json and the ES module of the bundle wesl-js links, with its types).
     #[command(group = clap::ArgGroup::new("dest").required(true))]
     Wesl {
-        /// Folder to write the WESL package into (created; its files in it are overwritten).
+        /// Folder to write the WESL package into (created; the package's files in it are
+        /// overwritten).
         #[arg(long, value_name = "DIR", group = "dest")]
         out: Option<PathBuf>,
         /// Folder to write the npm package into (created; ready for `npm pack` or `npm publish`).
