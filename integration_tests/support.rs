@@ -27,6 +27,28 @@ pub fn workspace_root() -> PathBuf {
     }
 }
 
+/// Fails unless the files under `dir` that `keep` selects are exactly `generated` ((path, text)
+/// pairs): none missing, none extra, none stale or edited by hand. `fix` says how to regenerate.
+pub fn assert_folder_holds(
+    dir: &Path,
+    generated: &[(String, String)],
+    keep: impl Fn(&str) -> bool,
+    fix: &str,
+) {
+    let on_disk: Vec<String> = files_under(dir).into_iter().filter(|f| keep(f)).collect();
+    let mut names: Vec<String> = generated.iter().map(|(p, _)| p.clone()).collect();
+    names.sort();
+    assert_eq!(on_disk, names, "files of {} differ; {fix}", dir.display());
+    for (rel, text) in generated {
+        let written = std::fs::read_to_string(dir.join(rel)).unwrap();
+        assert!(
+            written == *text,
+            "{} is stale or was edited by hand; {fix}",
+            dir.join(rel).display()
+        );
+    }
+}
+
 /// Every file under `dir`, as `/`-separated paths relative to it, sorted.
 pub fn files_under(dir: &Path) -> Vec<String> {
     fn walk(dir: &Path, root: &Path, out: &mut Vec<String>) {

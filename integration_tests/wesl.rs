@@ -8,7 +8,9 @@ use std::path::Path;
 use lodkit::shaders::{self, Language, ModuleKind, naga};
 
 use crate::composition::{module_harness, wgsl_modules};
-use crate::support::{browser_script, files_under, node_script, run_ok, scratch, workspace_root};
+use crate::support::{
+    assert_folder_holds, browser_script, node_script, run_ok, scratch, workspace_root,
+};
 
 #[test]
 fn committed_wesl_package_is_what_the_generator_writes() {
@@ -16,25 +18,9 @@ fn committed_wesl_package_is_what_the_generator_writes() {
     let generated = shaders::wesl_package().expect("every module converts to WESL");
     // The folder is also the npm package: its package.json, ES module, README and licences are
     // held to their generator by the CLI's test `committed_npm_package_is_what_the_generator_writes`.
-    let on_disk: Vec<String> = files_under(&dir)
-        .into_iter()
-        .filter(|f| f.ends_with(".wesl") || f == "wesl.toml")
-        .collect();
-    let names: Vec<String> = generated.iter().map(|(p, _)| p.clone()).collect();
-    let mut sorted = names.clone();
-    sorted.sort();
     let fix = "regenerate with `cargo run -p lodkit-cli -- wesl --npm shader_lib/wesl/lodkit`";
-    assert_eq!(
-        on_disk, sorted,
-        "files of shader_lib/wesl/lodkit differ; {fix}"
-    );
-    for (rel, text) in &generated {
-        let committed = std::fs::read_to_string(dir.join(rel)).unwrap();
-        assert!(
-            committed == *text,
-            "shader_lib/wesl/lodkit/{rel} is stale or was edited by hand; {fix}"
-        );
-    }
+    let wesl_files = |f: &str| f.ends_with(".wesl") || f == "wesl.toml";
+    assert_folder_holds(&dir, &generated, wesl_files, fix);
 }
 
 #[test]

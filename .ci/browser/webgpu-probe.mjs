@@ -52,10 +52,12 @@ async function runJobs({ files, edition, jobs }) {
   const results = {};
   for (const job of jobs) {
     let code = job.code;
-    if (code === undefined) try {
-      code = (await link({ weslSrc: { 'main.wesl': job.root }, rootModuleName: 'main', libs: [lodkit], conditions: job.conditions })).dest;
-    } catch (e) {
-      return { error: `${job.name}: wesl-js cannot link: ${e.message}` };
+    if (code === undefined) {
+      try {
+        code = (await link({ weslSrc: { 'main.wesl': job.root }, rootModuleName: 'main', libs: [lodkit], conditions: job.conditions })).dest;
+      } catch (e) {
+        return { error: `${job.name}: wesl-js cannot link: ${e.message}` };
+      }
     }
     device.pushErrorScope('validation');
     const module = device.createShaderModule({ code });

@@ -41,12 +41,18 @@ fn js_string(text: &str) -> String {
     serde_json::to_string(text).expect("a string always serializes")
 }
 
-/// The edition `wesl.toml` names, which the bundle repeats.
-fn edition() -> &'static str {
-    shaders::WESL_TOML
-        .lines()
-        .find_map(|l| l.strip_prefix("edition = "))
-        .map_or("unstable_2025", |e| e.trim_matches('"'))
+/// The edition `wesl.toml` names, which the bundle repeats. `WESL_TOML` is lodkit's own constant:
+/// the tests fail if it ever lacks one.
+fn edition() -> String {
+    toml::from_str::<toml::Table>(shaders::WESL_TOML)
+        .ok()
+        .and_then(|t| {
+            t.get("package")?
+                .get("edition")?
+                .as_str()
+                .map(str::to_owned)
+        })
+        .expect("lodkit's wesl.toml names its edition")
 }
 
 /// `package.json`, its fields in the order npm writes them.
@@ -121,7 +127,7 @@ fn index_js(modules: &[&(String, String)]) -> String {
          // Shader defs are WESL conditions, off unless set: `link({{ ..., conditions: {{ LODKIT_REVERSE_Z: true }} }})`.\n\n\
          export const weslBundle = {{\n  name: {},\n  edition: {},\n  modules: {{\n",
         js_string(NPM_NAME),
-        js_string(edition()),
+        js_string(&edition()),
     );
     for (path, source) in modules {
         text.push_str(&format!(
