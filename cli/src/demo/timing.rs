@@ -115,8 +115,12 @@ pub fn plain_pass(
 
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// Color, id word and depth of both buffers, read at the pixel and summed.
-const COPY7: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+/// A fullscreen pass reading color, id word and depth of both buffers and the object motion at
+/// the pixel, summed so none is optimized away; `$depth` adds more to the depth sum.
+macro_rules! buffer_reads {
+    ($depth:literal) => {
+        concat!(
+            "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 @group(0) @binding(0) var a: texture_2d<f32>;
 @group(0) @binding(1) var b: texture_2d<u32>;
 @group(0) @binding(2) var c: texture_2d<f32>;
@@ -128,32 +132,24 @@ const COPY7: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_v
 @fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let p = vec2<u32>(v.position.xy);
     let ids = textureLoad(b, p, 0).x ^ textureLoad(e, p, 0).x;
-    let depth = textureLoad(c, p, 0).x + textureLoad(f, p, 0).x;
+    let depth = textureLoad(c, p, 0).x + textureLoad(f, p, 0).x",
+            $depth,
+            ";
     let motion = textureLoad(g, p, 0).xy;
     return textureLoad(a, p, 0) + textureLoad(d, p, 0) + vec4<f32>(f32(ids & 1u), depth, motion);
 }
-";
+"
+        )
+    };
+}
+
+/// The seven textures the combine reads, each once at the pixel: the combine's baseline.
+const COPY7: &str = buffer_reads!("");
 
 /// The combine's main-path loads without its arithmetic: COPY7 and the older depth once more
 /// (the combine's first estimate), at a neighbouring texel: the floor of any combine.
-const LOADS8: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
-@group(0) @binding(0) var a: texture_2d<f32>;
-@group(0) @binding(1) var b: texture_2d<u32>;
-@group(0) @binding(2) var c: texture_2d<f32>;
-@group(0) @binding(3) var d: texture_2d<f32>;
-@group(0) @binding(4) var e: texture_2d<u32>;
-@group(0) @binding(5) var f: texture_2d<f32>;
-@group(0) @binding(6) var g: texture_2d<f32>;
-@vertex fn vs_main(@builtin(vertex_index) i: u32) -> FullscreenVertex { return fullscreen_vertex(i); }
-@fragment fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
-    let p = vec2<u32>(v.position.xy);
-    let q = min(p + 1u, textureDimensions(f, 0) - 1u);
-    let ids = textureLoad(b, p, 0).x ^ textureLoad(e, p, 0).x;
-    let depth = textureLoad(c, p, 0).x + textureLoad(f, p, 0).x + textureLoad(f, q, 0).x;
-    let motion = textureLoad(g, p, 0).xy;
-    return textureLoad(a, p, 0) + textureLoad(d, p, 0) + vec4<f32>(f32(ids & 1u), depth, motion);
-}
-";
+const LOADS8: &str =
+    buffer_reads!(" + textureLoad(f, min(p + 1u, textureDimensions(f, 0) - 1u), 0).x");
 
 const BILINEAR: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
