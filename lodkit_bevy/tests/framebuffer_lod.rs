@@ -16,7 +16,7 @@ mod measure;
 mod support;
 
 use frames::Frame;
-use measure::{edge_mask, excursion, mean_abs_error, settle_frames};
+use measure::{edge_mask, excursion, mean_abs_error, relative_spread, settle_frames};
 
 #[test]
 fn edge_mask_marks_two_pixels_around_a_depth_step() {
@@ -125,11 +125,14 @@ fn bevy_framebuffer_lod_meets_its_figures() {
             1.05 / (r * r)
         );
     }
-    // Every doubling of the fog's cost knocked the frame time out of the +-10 % band (else the
-    // test proves nothing), and after every step, up or down, the controller brought it back
-    // within 15 frames (measured over five runs: 4 to 12); r stayed inside its limits. Steps the
-    // machine stalled (a frame over 1.6 x the calibrated model) are reported apart; four
-    // undisturbed ones are needed.
+    // Every doubling of the fog's cost knocked the frame time out of the band (else the test
+    // proves nothing), and after every step, up or down, the controller brought it back within
+    // 15 frames (measured over five runs: 4 to 12); r stayed inside its limits. The band is
+    // +-10 %, or twice the spread of frame times at a fixed r on a machine busy with other work,
+    // at most +-20 %. Steps the machine stalled (a frame over 1.6 x the calibrated model) are
+    // reported apart; four undisturbed ones are needed.
+    let band = number(&report, "controller_band");
+    assert!((0.1..=0.2).contains(&band), "band {band}: {report:#}");
     let settle = report["controller_settle_frames"].as_array().expect("list");
     let excursions = report["controller_step_excursion"]
         .as_array()
@@ -149,7 +152,7 @@ fn bevy_framebuffer_lod_meets_its_figures() {
         if scale.as_f64() == Some(2.0) {
             let excursion = excursion.as_f64().expect("a fraction");
             assert!(
-                excursion > 0.1,
+                excursion > band,
                 "doubling the cost never left the band (out by {excursion}): {report:#}"
             );
         }
@@ -165,4 +168,13 @@ fn bevy_framebuffer_lod_meets_its_figures() {
         let path = report[key].as_str().expect("a path");
         assert!(std::path::Path::new(path).exists(), "{key}: {path} missing");
     }
+}
+
+#[test]
+fn frame_time_spread_ignores_one_stalled_frame() {
+    // Hand-derived: median 1, absolute deviations 0, 0, 0, 0, 1: their median is 0.
+    assert_eq!(relative_spread(&[1.0, 1.0, 1.0, 1.0, 2.0]), 0.0);
+    // Median 1, deviations 0.1, 0, 0.1: median 0.1, times 1.4826.
+    assert!((relative_spread(&[0.9, 1.0, 1.1]) - 0.14826).abs() < 1e-5);
+    assert_eq!(relative_spread(&[]), 0.0);
 }

@@ -130,3 +130,16 @@ pub fn excursion(times: &[f32], target: f32, window: usize) -> f32 {
         .filter(|r| r.is_finite())
         .fold(0.0, f32::max)
 }
+
+/// Relative spread of frame times measured at one r: 1.4826 x the median absolute deviation over
+/// the median (a standard deviation that one stalled frame does not inflate); 0 when empty.
+pub fn relative_spread(times: &[f32]) -> f32 {
+    let median = |v: &mut Vec<f32>| {
+        v.sort_by(f32::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f32::NAN)
+    };
+    let m = median(&mut times.to_vec());
+    let mut deviations: Vec<f32> = times.iter().map(|t| (t - m).abs()).collect();
+    let spread = 1.4826 * median(&mut deviations) / m;
+    if spread.is_finite() { spread } else { 0.0 }
+}

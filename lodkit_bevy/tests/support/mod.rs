@@ -28,7 +28,7 @@ pub fn run_example(name: &str, args: &[&OsStr]) -> Option<Output> {
         path.display()
     );
     let built = std::fs::metadata(&path).and_then(|m| m.modified()).ok();
-    let sources = newest_source(Path::new(env!("CARGO_MANIFEST_DIR")));
+    let sources = newest_source(Path::new(env!("CARGO_MANIFEST_DIR")), name);
     assert!(
         built >= sources,
         "{} is older than the sources: run `cargo test` (which rebuilds the examples), not only \
@@ -48,8 +48,9 @@ pub fn run_example(name: &str, args: &[&OsStr]) -> Option<Output> {
     Some(output)
 }
 
-/// The newest modification time of the files under `src/` and `examples/`.
-fn newest_source(root: &Path) -> Option<SystemTime> {
+/// The newest modification time of the files `example` is built from: `src/`,
+/// `examples/<example>/` and `examples/common/`.
+fn newest_source(root: &Path, example: &str) -> Option<SystemTime> {
     fn walk(dir: &Path, newest: &mut Option<SystemTime>) {
         let Ok(entries) = std::fs::read_dir(dir) else {
             return;
@@ -65,6 +66,9 @@ fn newest_source(root: &Path) -> Option<SystemTime> {
     }
     let mut newest = None;
     walk(&root.join("src"), &mut newest);
-    walk(&root.join("examples"), &mut newest);
+    // The example's own folder and what the examples share: another example's edit does not
+    // rebuild this one.
+    walk(&root.join("examples").join(example), &mut newest);
+    walk(&root.join("examples/common"), &mut newest);
     newest
 }
