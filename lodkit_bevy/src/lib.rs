@@ -11,6 +11,12 @@
 //!   resolution, lodkit's bilateral upsample rebuilds it from the depth and normal prepass
 //!   without bleeding across edges, and lodkit's controller can hold a frame-time target by
 //!   choosing r every frame. See [`framebuffer_lod`].
+//! - [`FrameSequentialLodPlugin`] with the [`FrameSequentialLod`] camera component and
+//!   [`FrameSequentialGroup`](frame_sequential::FrameSequentialGroup) entities: smooth discrete
+//!   LOD transitions (Scherzer & Wimmer 2008). A group in transition draws one of its two
+//!   levels per frame and a combine pass merges consecutive frames, reprojected with Bevy's
+//!   depth and motion vectors: no see-through, no pop, about one level's cost. See
+//!   [`frame_sequential`].
 //!
 //! lodkit is used with `default-features = false`: it brings no naga of its own, Bevy's naga_oil
 //! composes its modules.
@@ -26,14 +32,21 @@
 
 #![warn(missing_docs)]
 
+pub mod frame_sequential;
 pub mod framebuffer_lod;
 mod shaders;
 
+pub use frame_sequential::{FrameSequentialLod, FrameSequentialLodPlugin};
 pub use framebuffer_lod::{FramebufferLod, FramebufferLodPlugin};
 pub use shaders::{LodkitShaders, LodkitShadersPlugin};
 
 /// The plugins, components and settings an app uses.
 pub mod prelude {
+    pub use crate::frame_sequential::{
+        FrameSequentialExtension, FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod,
+        FrameSequentialLodPlugin, FrameSequentialMaterial, FrameSequentialStats, LodLevel,
+        LodLevels, PatternAnchor,
+    };
     pub use crate::framebuffer_lod::{
         FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodComposite,
         FramebufferLodPlugin, FramebufferLodResolution, FramebufferLodState,

@@ -1,0 +1,105 @@
+//! Frame-sequential LOD in Bevy 0.19.1 side by side with Bevy's own `VisibilityRange`
+//! crossfade: the same scene, meshes and transition distances, rendered headless in one app,
+//! one run after the other, every frame read back.
+//!
+//! ```text
+//! cargo run --example frame_sequential [-- [--out DIR] [--report FILE]
+//!     [--schedule complementary|paper] [--anchor screen|object] [--no-reprojection]]
+//! ```
+//!
+//! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_frame_sequential.png` and
+//! `strip_bevy_crossfade.png` (7 frames over the moving camera's transitions), and with
+//! `--report` the figures as JSON. `--no-reprojection` breaks the combine on purpose (the
+//! older frame read at the same pixel): the moving camera then shows the background through
+//! the objects. Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
+//!
+//! The scene is `scene.rs` (what a Bevy app writes to use the plugin is there, in
+//! `spawn_groups`), the metrics `measure.rs`, the run loop `run.rs`.
+
+#[path = "../common/frames.rs"]
+#[allow(
+    dead_code,
+    reason = "shared by the examples and tests; each uses a part"
+)]
+mod frames;
+#[path = "../common/headless.rs"]
+#[allow(dead_code, reason = "shared by the examples; each uses a part")]
+mod headless;
+mod measure;
+mod run;
+mod scene;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use lodkit::frame_sequential::Schedule;
+use lodkit_bevy::frame_sequential::PatternAnchor;
+
+/// Parsed command line.
+pub struct Args {
+    out: PathBuf,
+    report: Option<PathBuf>,
+    schedule: Schedule,
+    anchor: PatternAnchor,
+    reprojection: bool,
+}
+
+const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] \
+[--schedule complementary|paper] [--anchor screen|object] [--no-reprojection]";
+
+fn parse() -> Result<Option<Args>, String> {
+    let mut args = Args {
+        out: PathBuf::from("lodkit-bevy-frame-sequential"),
+        report: None,
+        schedule: Schedule::Complementary,
+        anchor: PatternAnchor::Screen,
+        reprojection: true,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(arg) = it.next() {
+        let mut value = || it.next().ok_or(format!("`{arg}` needs a value"));
+        match arg.as_str() {
+            "-h" | "--help" => return Ok(None),
+            "--out" => args.out = PathBuf::from(value()?),
+            "--report" => args.report = Some(PathBuf::from(value()?)),
+            "--schedule" => {
+                args.schedule = match value()?.as_str() {
+                    "complementary" => Schedule::Complementary,
+                    "paper" => Schedule::Paper,
+                    other => return Err(format!("unknown schedule `{other}`")),
+                }
+            }
+            "--anchor" => {
+                args.anchor = match value()?.as_str() {
+                    "screen" => PatternAnchor::Screen,
+                    "object" => PatternAnchor::Object,
+                    other => return Err(format!("unknown anchor `{other}`")),
+                }
+            }
+            "--no-reprojection" => args.reprojection = false,
+            _ => return Err(format!("unexpected argument `{arg}`")),
+        }
+    }
+    Ok(Some(args))
+}
+
+fn main() -> ExitCode {
+    let args = match parse() {
+        Ok(Some(args)) => args,
+        Ok(None) => {
+            println!("{USAGE}");
+            return ExitCode::SUCCESS;
+        }
+        Err(message) => {
+            eprintln!("error: {message}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    match run::run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(run::Failure(code, message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(code)
+        }
+    }
+}

@@ -1,0 +1,91 @@
+//! The material a LOD group's levels are drawn with: Bevy's `StandardMaterial`, shaded by Bevy's
+//! PBR functions, extended to write the fragment's LOD-buffer id word in alpha.
+
+use bevy::asset::{RenderAssetUsages, uuid_handle};
+use bevy::pbr::{ExtendedMaterial, MaterialExtension};
+use bevy::prelude::*;
+use bevy::reflect::TypePath;
+use bevy::render::render_resource::{AsBindGroup, Extent3d, TextureDimension, TextureFormat};
+use bevy::shader::ShaderRef;
+use lodkit::visibility::{VisibilityPattern, visibility_texture};
+
+/// The main-pass shader of [`FrameSequentialExtension`].
+pub(super) const LOD_MATERIAL_SHADER: Handle<Shader> =
+    uuid_handle!("0b8f3e7a-5c1d-4e92-a6b4-7d2c9e1f3a58");
+/// The visibility texture every [`FrameSequentialExtension`] binds (64x64 void-and-cluster
+/// blue noise from `lodkit::visibility::visibility_texture`).
+pub const VISIBILITY_TEXTURE: Handle<Image> = uuid_handle!("5d7a2c41-8e36-4b0f-9c15-e2a4b6d8f013");
+/// Size of [`VISIBILITY_TEXTURE`].
+pub const VISIBILITY_TEXTURE_SIZE: u32 = 64;
+/// Seed of [`VISIBILITY_TEXTURE`].
+pub const VISIBILITY_TEXTURE_SEED: u64 = 1;
+
+/// A LOD level's material: Bevy's [`StandardMaterial`] with [`FrameSequentialExtension`].
+pub type FrameSequentialMaterial = ExtendedMaterial<StandardMaterial, FrameSequentialExtension>;
+
+/// The extension that makes a [`StandardMaterial`] a level of a frame-sequential LOD group: the
+/// shading is Bevy's, unchanged; the main pass also writes the fragment's LOD-buffer id word and
+/// display-time flags (from lodkit's visibility pattern) in alpha, which the combine pass reads.
+/// Opaque materials only.
+///
+/// ```
+/// use bevy::prelude::*;
+/// use lodkit_bevy::frame_sequential::{FrameSequentialExtension, FrameSequentialMaterial};
+///
+/// let material = FrameSequentialMaterial {
+///     base: StandardMaterial::from(Color::srgb(0.8, 0.5, 0.2)),
+///     extension: FrameSequentialExtension::default(),
+/// };
+/// # let _ = material;
+/// ```
+#[derive(Asset, AsBindGroup, TypePath, Clone, Debug)]
+pub struct FrameSequentialExtension {
+    /// The visibility texture ([`VISIBILITY_TEXTURE`] unless you bring your own: single-channel,
+    /// values strictly between 0 and 1).
+    #[texture(100, sample_type = "float", filterable = false)]
+    pub visibility: Handle<Image>,
+    /// x: texture repeats per object-space unit where the pattern sticks to the object
+    /// ([`PatternAnchor::Object`](super::PatternAnchor::Object)); y, z, w unused.
+    #[uniform(101)]
+    pub pattern_scale: Vec4,
+}
+
+impl Default for FrameSequentialExtension {
+    fn default() -> Self {
+        Self {
+            visibility: VISIBILITY_TEXTURE,
+            pattern_scale: Vec4::new(8.0, 0.0, 0.0, 0.0),
+        }
+    }
+}
+
+impl MaterialExtension for FrameSequentialExtension {
+    fn fragment_shader() -> ShaderRef {
+        LOD_MATERIAL_SHADER.into()
+    }
+}
+
+/// lodkit's blue-noise visibility texture as an R32Float image.
+pub(super) fn visibility_image() -> Image {
+    let texture = visibility_texture(
+        VisibilityPattern::BlueNoise,
+        VISIBILITY_TEXTURE_SIZE,
+        VISIBILITY_TEXTURE_SEED,
+    );
+    let bytes = texture
+        .texels
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    Image::new(
+        Extent3d {
+            width: texture.size,
+            height: texture.size,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        bytes,
+        TextureFormat::R32Float,
+        RenderAssetUsages::RENDER_WORLD,
+    )
+}

@@ -1,0 +1,233 @@
+//! Frame-sequential LOD on a Bevy camera (Scherzer & Wimmer 2008): a LOD group in transition
+//! draws ONE of its two levels per frame, alternating, and a combine pass merges this frame's
+//! picture with the last one's, reprojected with Bevy's depth and motion vectors. Each level is
+//! shown through lodkit's visibility pattern at the frame displayed, so the object never shows
+//! what is behind it (no see-through), the change is spread over the transition (no pop), and
+//! the group costs about one level's fragments per frame, not two as a crossfade does.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use lodkit::select::{LodGroup, LodSettings};
+//! use lodkit_bevy::frame_sequential::*;
+//!
+//! fn setup(
+//!     mut commands: Commands,
+//!     mut meshes: ResMut<Assets<Mesh>>,
+//!     mut materials: ResMut<Assets<FrameSequentialMaterial>>,
+//! ) {
+//!     commands.spawn((
+//!         Camera3d::default(),
+//!         Msaa::Off, // the combine reads the main pass per pixel
+//!         FrameSequentialLod {
+//!             settings: LodSettings { hysteresis: 0.5, ..default() },
+//!             ..default()
+//!         },
+//!     ));
+//!     let material = materials.add(FrameSequentialMaterial {
+//!         base: StandardMaterial::from(Color::srgb(0.8, 0.5, 0.2)),
+//!         extension: FrameSequentialExtension::default(),
+//!     });
+//!     commands.spawn((
+//!         LodLevels(vec![
+//!             LodLevel::new(meshes.add(Sphere::new(1.0).mesh().uv(48, 24)), material.clone()),
+//!             LodLevel::new(meshes.add(Sphere::new(1.0).mesh().uv(10, 6)), material),
+//!         ]),
+//!         FrameSequentialGroup::new(LodGroup::from_distances(&[0.0, 4.0]).unwrap()),
+//!         Transform::from_xyz(0.0, 0.0, -6.0),
+//!     ));
+//! }
+//!
+//! App::new()
+//!     .add_plugins((DefaultPlugins, FrameSequentialLodPlugin))
+//!     .add_systems(Startup, setup)
+//!     .run();
+//! ```
+//!
+//! How it fits into Bevy's frame:
+//! - [`FrameSequentialLodPlugin`] selects every [`FrameSequentialGroup`]'s level from the camera
+//!   with [`FrameSequentialLod`] (lodkit::select, with hysteresis; distance- or time-driven),
+//!   and runs lodkit's transition scheduler: a group shows the level the scheduler draws this
+//!   frame, through a child entity of the group, in Bevy's normal prepass and main pass. A
+//!   group not in transition is an ordinary Bevy mesh.
+//! - Levels use [`FrameSequentialMaterial`] (Bevy's `StandardMaterial`, lit by Bevy's PBR
+//!   functions) or any material whose fragment shader ends with
+//!   `lodkit_bevy::frame_sequential::lod_fragment_alpha`: the main pass's HDR color is the LOD
+//!   buffer, its alpha the id word.
+//! - After Bevy's opaque pass, before the transparent pass and post-processing, the plugin
+//!   copies the main texture and depth (the next frame's older buffer) and runs lodkit's
+//!   combine over the screen rectangles of the groups in transition.
+//!
+//! Limits: one camera per app drives the selection (the first active one with
+//! [`FrameSequentialLod`]); MSAA must be off; a group in transition casts the shadow of the
+//! level drawn that frame (use `NotShadowCaster` on levels if that flickers in your scene);
+//! at most [`MAX_TAG_ID`] groups in transition at once (more switch at once, with a warning).
+
+mod material;
+mod render;
+mod select;
+mod tag;
+
+use bevy::asset::embedded_asset;
+use bevy::camera::Hdr;
+use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass};
+use bevy::pbr::MaterialPlugin;
+use bevy::prelude::*;
+use bevy::render::RenderApp;
+use bevy::render::extract_component::ExtractComponentPlugin;
+use bevy::shader::load_shader_library;
+use lodkit::frame_sequential::Schedule;
+use lodkit::select::{LodGroup, LodSettings};
+
+pub use material::{
+    FrameSequentialExtension, FrameSequentialMaterial, VISIBILITY_TEXTURE, VISIBILITY_TEXTURE_SEED,
+    VISIBILITY_TEXTURE_SIZE,
+};
+pub use render::COMBINE_PASS;
+pub use select::{FrameSequentialLevels, FrameSequentialStats};
+pub use tag::{MAX_TAG_ID, decode_tag, encode_tag};
+
+use crate::LodkitShadersPlugin;
+
+/// Adds frame-sequential LOD: the selection and transition scheduling of every
+/// [`FrameSequentialGroup`], the [`FrameSequentialMaterial`], and the combine pass on the camera
+/// with [`FrameSequentialLod`].
+pub struct FrameSequentialLodPlugin;
+
+impl Plugin for FrameSequentialLodPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<LodkitShadersPlugin>() {
+            app.add_plugins(LodkitShadersPlugin);
+        }
+        load_shader_library!(app, "frame_sequential.wgsl");
+        embedded_asset!(app, "combine.wgsl");
+        app.world_mut()
+            .resource_mut::<Assets<Shader>>()
+            .insert(
+                &material::LOD_MATERIAL_SHADER,
+                Shader::from_wgsl(
+                    include_str!("lod_material.wgsl"),
+                    "lodkit_bevy/frame_sequential/lod_material.wgsl",
+                ),
+            )
+            .expect("UUID handles never fail to insert");
+        app.world_mut()
+            .resource_mut::<Assets<Image>>()
+            .insert(&VISIBILITY_TEXTURE, material::visibility_image())
+            .expect("UUID handles never fail to insert");
+        app.add_plugins((
+            MaterialPlugin::<FrameSequentialMaterial>::default(),
+            ExtractComponentPlugin::<render::FrameSequentialView>::default(),
+        ));
+        select::build(app);
+        if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+            render::build(render_app);
+        }
+    }
+
+    fn finish(&self, app: &mut App) {
+        if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
+            render::finish(render_app);
+        }
+    }
+}
+
+/// Where lodkit's visibility pattern is anchored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+pub enum PatternAnchor {
+    /// To the screen, one texel per pixel, like a dither: the pattern holds still while objects
+    /// and camera move (`lodkit::visibility::visibility_flags_screen`).
+    #[default]
+    Screen,
+    /// To the object, looked up at the object-space position (the paper's choice): the pattern
+    /// moves with the object (`lodkit::visibility::visibility_flags`).
+    Object,
+}
+
+/// Frame-sequential LOD on a 3D camera: the camera that selects the levels of every
+/// [`FrameSequentialGroup`] and combines its frames.
+///
+/// Requires (and adds) [`DepthPrepass`], [`MotionVectorPrepass`] and [`Hdr`]; the camera must
+/// also have `Msaa::Off`.
+#[derive(Component, Clone, Debug, Reflect)]
+#[reflect(Component, Default, Clone)]
+#[require(DepthPrepass, MotionVectorPrepass, Hdr)]
+pub struct FrameSequentialLod {
+    /// How the two levels share the visibility pattern over a transition (default: the paper's
+    /// Fig. 2; `Schedule::Complementary` spreads the change at silhouettes over the whole
+    /// transition).
+    #[reflect(ignore)]
+    pub schedule: Schedule,
+    /// Where the pattern is anchored (default: the screen).
+    pub anchor: PatternAnchor,
+    /// Selection settings shared by every group: global bias, hysteresis band and how a switch
+    /// is staged (`TransitionMode::Distance` blends across the band, `Time` over a duration,
+    /// `Hard` switches at once).
+    #[reflect(ignore)]
+    pub settings: LodSettings,
+    /// Whether the combine reprojects the older frame with the camera's motion and Bevy's
+    /// motion vectors (default true). Off, the older frame is read at the same pixel: only for
+    /// seeing what reprojection does; a moving camera then shows the background through
+    /// objects in transition.
+    pub reprojection: bool,
+}
+
+impl Default for FrameSequentialLod {
+    fn default() -> Self {
+        Self {
+            schedule: Schedule::default(),
+            anchor: PatternAnchor::default(),
+            settings: LodSettings {
+                hysteresis: 0.5,
+                ..default()
+            },
+            reprojection: true,
+        }
+    }
+}
+
+/// A LOD group: its levels ([`LodLevels`]) are selected by distance from the camera with
+/// [`FrameSequentialLod`], and a switch between two levels is a frame-sequential transition.
+///
+/// The plugin spawns one child entity that draws the group (see [`FrameSequentialLevels`]) and
+/// gives it the mesh and material of the level drawn each frame.
+#[derive(Component, Clone, Debug)]
+#[require(Transform, Visibility)]
+pub struct FrameSequentialGroup {
+    /// The level distances (view-normalized, lodkit::select's measure: distance / |P\[1\]\[1\]|).
+    pub group: LodGroup,
+    /// The box that holds every level's vertices (object space; None: the union of the level
+    /// meshes' bounds, computed once they are loaded). Give it for vertex animation that moves
+    /// vertices beyond the meshes' bounds (`lodkit::combine::displaced_bounds`): the combine
+    /// only works inside the box's screen rectangle.
+    pub bounds: Option<(Vec3, Vec3)>,
+}
+
+impl FrameSequentialGroup {
+    /// A group selecting with `group`'s distances, bounds from its meshes.
+    pub fn new(group: LodGroup) -> Self {
+        Self {
+            group,
+            bounds: None,
+        }
+    }
+}
+
+/// One level of a LOD group: a mesh and its material.
+#[derive(Clone, Debug)]
+pub struct LodLevel {
+    /// The level's mesh.
+    pub mesh: Handle<Mesh>,
+    /// The level's material.
+    pub material: Handle<FrameSequentialMaterial>,
+}
+
+impl LodLevel {
+    /// A level of `mesh` drawn with `material`.
+    pub fn new(mesh: Handle<Mesh>, material: Handle<FrameSequentialMaterial>) -> Self {
+        Self { mesh, material }
+    }
+}
+
+/// The levels of a [`FrameSequentialGroup`], finest first (at most 256).
+#[derive(Component, Clone, Debug, Default)]
+pub struct LodLevels(pub Vec<LodLevel>);

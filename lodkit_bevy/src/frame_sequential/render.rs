@@ -1,0 +1,324 @@
+//! The render-world side: the older frame's copies (color with id words, depth; ping-pong per
+//! view), the combine pipeline and its pass after Bevy's opaque pass.
+
+use bevy::asset::load_embedded_asset;
+use bevy::core_pipeline::core_3d::{
+    CORE_3D_DEPTH_FORMAT, main_opaque_pass_3d, main_transparent_pass_3d,
+};
+use bevy::core_pipeline::prepass::ViewPrepassTextures;
+use bevy::core_pipeline::{Core3d, FullscreenShader};
+use bevy::log::warn_once;
+use bevy::prelude::*;
+use bevy::render::diagnostic::RecordDiagnostics;
+use bevy::render::extract_component::ExtractComponent;
+use bevy::render::render_resource::binding_types::{texture_2d, texture_depth_2d, uniform_buffer};
+use bevy::render::render_resource::*;
+use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
+use bevy::render::view::{ExtractedView, ViewDepthTexture, ViewTarget};
+use bevy::render::{GpuResourceAppExt, Render, RenderSystems};
+
+/// Name of the combine pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
+/// `render/<name>/elapsed_gpu` and `render/<name>/fragment_shader_invocations`.
+pub const COMBINE_PASS: &str = "lodkit_frame_sequential_combine";
+
+/// What the render world needs of the camera's frame (inserted every frame by the plugin).
+#[derive(Component, ExtractComponent, Clone, Debug)]
+pub struct FrameSequentialView {
+    /// This frame's view_from_world (next frame's reprojection source).
+    pub view_from_world: Mat4,
+    /// This frame's clip_from_view.
+    pub clip_from_view: Mat4,
+    /// Last frame's clip_from_world times this frame's world_from_clip.
+    pub new_to_old: Mat4,
+    /// Whether the combine reads Bevy's motion vectors.
+    pub motion_vectors: bool,
+    /// The combine's rectangles (pixels, top left origin), not overlapping.
+    pub rects: Vec<URect>,
+    /// Frames the plugin has run: the ping-pong parity.
+    pub frame: u64,
+}
+
+/// The uniform of combine.wgsl.
+#[derive(ShaderType, Clone, Copy)]
+struct CombineParams {
+    new_to_old: Mat4,
+    flags: UVec4,
+}
+
+pub(super) fn build(render_app: &mut SubApp) {
+    render_app.add_systems(
+        Render,
+        (
+            prepare_pipelines.in_set(RenderSystems::Prepare),
+            prepare_textures.in_set(RenderSystems::PrepareResources),
+            prepare_bind_groups.in_set(RenderSystems::PrepareBindGroups),
+        ),
+    );
+    render_app.add_systems(
+        Core3d,
+        combine_pass
+            .after(main_opaque_pass_3d)
+            .before(main_transparent_pass_3d),
+    );
+}
+
+pub(super) fn finish(render_app: &mut SubApp) {
+    render_app
+        .init_gpu_resource::<CombinePipeline>()
+        .init_gpu_resource::<SpecializedRenderPipelines<CombinePipeline>>();
+}
+
+/// The combine's bind group layout and shaders.
+#[derive(Resource)]
+pub struct CombinePipeline {
+    layout: BindGroupLayoutDescriptor,
+    shader: Handle<Shader>,
+    fullscreen: FullscreenShader,
+}
+
+impl FromWorld for CombinePipeline {
+    fn from_world(world: &mut World) -> Self {
+        let color = texture_2d(TextureSampleType::Float { filterable: false });
+        let layout = BindGroupLayoutDescriptor::new(
+            "lodkit_frame_sequential_combine",
+            &BindGroupLayoutEntries::sequential(
+                ShaderStages::FRAGMENT,
+                (
+                    color,
+                    texture_depth_2d(),
+                    color,
+                    texture_depth_2d(),
+                    color,
+                    uniform_buffer::<CombineParams>(false),
+                ),
+            ),
+        );
+        Self {
+            layout,
+            shader: load_embedded_asset!(world, "combine.wgsl"),
+            fullscreen: world.resource::<FullscreenShader>().clone(),
+        }
+    }
+}
+
+impl SpecializedRenderPipeline for CombinePipeline {
+    type Key = TextureFormat;
+
+    fn specialize(&self, format: Self::Key) -> RenderPipelineDescriptor {
+        RenderPipelineDescriptor {
+            label: Some(COMBINE_PASS.into()),
+            layout: vec![self.layout.clone()],
+            vertex: self.fullscreen.to_vertex_state(),
+            fragment: Some(FragmentState {
+                shader: self.shader.clone(),
+                // Bevy's depth is reversed: 1 near, 0 far.
+                shader_defs: vec!["LODKIT_REVERSE_Z".into()],
+                entry_point: Some("fragment".into()),
+                targets: vec![Some(ColorTargetState {
+                    format,
+                    blend: None,
+                    write_mask: ColorWrites::ALL,
+                })],
+            }),
+            ..default()
+        }
+    }
+}
+
+/// The camera's combine pipeline.
+#[derive(Component)]
+pub struct CombinePipelineId(CachedRenderPipelineId);
+
+fn prepare_pipelines(
+    mut commands: Commands,
+    cache: Res<PipelineCache>,
+    mut specialized: ResMut<SpecializedRenderPipelines<CombinePipeline>>,
+    pipeline: Res<CombinePipeline>,
+    views: Query<(Entity, &ViewTarget), With<FrameSequentialView>>,
+) {
+    for (entity, target) in &views {
+        let id = specialized.specialize(&cache, &pipeline, target.main_texture_format());
+        commands.entity(entity).insert(CombinePipelineId(id));
+    }
+}
+
+/// The two frames' copies (color with id words, depth), used in turn as newer and older.
+#[derive(Component)]
+pub struct FrameSequentialTextures {
+    size: UVec2,
+    format: TextureFormat,
+    color: [Texture; 2],
+    depth: [Texture; 2],
+}
+
+fn prepare_textures(
+    mut commands: Commands,
+    device: Res<RenderDevice>,
+    views: Query<
+        (Entity, &ViewTarget, Option<&FrameSequentialTextures>),
+        With<FrameSequentialView>,
+    >,
+) {
+    for (entity, target, textures) in &views {
+        let size = target.main_texture().size();
+        let size = UVec2::new(size.width, size.height);
+        let format = target.main_texture_format();
+        if textures.is_some_and(|t| t.size == size && t.format == format) {
+            continue;
+        }
+        let make = |label, format| {
+            device.create_texture(&TextureDescriptor {
+                label: Some(label),
+                size: Extent3d {
+                    width: size.x,
+                    height: size.y,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: TextureDimension::D2,
+                format,
+                usage: TextureUsages::COPY_DST | TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let color = || make("lodkit_frame_sequential_color", format);
+        let depth = || make("lodkit_frame_sequential_depth", CORE_3D_DEPTH_FORMAT);
+        commands.entity(entity).insert(FrameSequentialTextures {
+            size,
+            format,
+            color: [color(), color()],
+            depth: [depth(), depth()],
+        });
+    }
+}
+
+/// The combine's bind group this frame (newer: this frame's copies, older: last frame's).
+#[derive(Component)]
+pub struct CombineBindGroup(BindGroup);
+
+fn prepare_bind_groups(
+    mut commands: Commands,
+    device: Res<RenderDevice>,
+    cache: Res<PipelineCache>,
+    pipeline: Res<CombinePipeline>,
+    views: Query<(
+        Entity,
+        &FrameSequentialView,
+        &FrameSequentialTextures,
+        Option<&ViewPrepassTextures>,
+    )>,
+) {
+    for (entity, view, textures, prepass) in &views {
+        let Some(motion) = prepass.and_then(ViewPrepassTextures::motion_vectors_view) else {
+            warn_once!(
+                "FrameSequentialLod needs MotionVectorPrepass on its camera: nothing is combined"
+            );
+            continue;
+        };
+        let newer = (view.frame % 2) as usize;
+        let older = 1 - newer;
+        let params = CombineParams {
+            new_to_old: view.new_to_old,
+            flags: UVec4::new(u32::from(view.motion_vectors), 0, 0, 0),
+        };
+        let mut buffer = encase::UniformBuffer::new(Vec::new());
+        buffer
+            .write(&params)
+            .expect("a fixed-size uniform always encodes");
+        let uniform = device.create_buffer_with_data(&BufferInitDescriptor {
+            label: Some("lodkit_frame_sequential_combine"),
+            contents: &buffer.into_inner(),
+            usage: BufferUsages::UNIFORM,
+        });
+        let views = |t: &Texture| t.create_view(&TextureViewDescriptor::default());
+        let bind_group = device.create_bind_group(
+            "lodkit_frame_sequential_combine",
+            &cache.get_bind_group_layout(&pipeline.layout),
+            &BindGroupEntries::sequential((
+                &views(&textures.color[newer]),
+                &views(&textures.depth[newer]),
+                &views(&textures.color[older]),
+                &views(&textures.depth[older]),
+                motion,
+                uniform.as_entire_binding(),
+            )),
+        );
+        commands.entity(entity).insert(CombineBindGroup(bind_group));
+    }
+}
+
+type PassView = (
+    &'static ExtractedView,
+    &'static ViewTarget,
+    &'static ViewDepthTexture,
+    &'static FrameSequentialView,
+    &'static FrameSequentialTextures,
+    Option<&'static CombineBindGroup>,
+    Option<&'static CombinePipelineId>,
+);
+
+/// Copies this frame's main color and depth (the next frame's older buffer), then combines
+/// within the rectangles.
+fn combine_pass(view: ViewQuery<PassView>, cache: Res<PipelineCache>, mut ctx: RenderContext) {
+    let (_, target, depth, frame, textures, bind_group, pipeline_id) = view.into_inner();
+    let newer = (frame.frame % 2) as usize;
+    let main = target.main_texture();
+    let extent = main.size();
+    if extent.width != textures.size.x || extent.height != textures.size.y {
+        return;
+    }
+    let encoder = ctx.command_encoder();
+    encoder.copy_texture_to_texture(
+        main.as_image_copy(),
+        textures.color[newer].as_image_copy(),
+        extent,
+    );
+    encoder.copy_texture_to_texture(
+        depth.texture.as_image_copy(),
+        textures.depth[newer].as_image_copy(),
+        extent,
+    );
+    let (Some(bind_group), Some(pipeline)) = (
+        bind_group,
+        pipeline_id.and_then(|id| cache.get_render_pipeline(id.0)),
+    ) else {
+        return;
+    };
+    let diagnostics = ctx.diagnostic_recorder();
+    let diagnostics = diagnostics.as_deref();
+    let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
+        label: Some(COMBINE_PASS),
+        color_attachments: &[Some(RenderPassColorAttachment {
+            view: target.main_texture_view(),
+            depth_slice: None,
+            resolve_target: None,
+            ops: Operations {
+                load: LoadOp::Load,
+                store: StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    let span = diagnostics.pass_span(&mut pass, COMBINE_PASS);
+    pass.set_render_pipeline(pipeline);
+    pass.set_bind_group(0, &bind_group.0, &[]);
+    // Frame 0 has no older frame; the pass still runs (empty) so its diagnostics count it.
+    let rects = if frame.frame == 0 {
+        &[][..]
+    } else {
+        &frame.rects[..]
+    };
+    for rect in rects {
+        let r = rect.intersect(URect::new(0, 0, extent.width, extent.height));
+        if r.is_empty() {
+            continue;
+        }
+        pass.set_scissor_rect(r.min.x, r.min.y, r.width(), r.height());
+        pass.draw(0..3, 0..1);
+    }
+    span.end(&mut pass);
+}

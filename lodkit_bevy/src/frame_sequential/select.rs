@@ -1,0 +1,491 @@
+//! The main-world side: level entities, selection from the camera, lodkit's transition
+//! scheduler, and what the render world needs of the frame (the combine's rectangles and the
+//! reprojection matrix).
+
+use bevy::camera::CameraUpdateSystems;
+use bevy::camera::primitives::MeshAabb;
+use bevy::camera::visibility::VisibilitySystems;
+use bevy::log::warn_once;
+use bevy::mesh::{MeshTag, VertexAttributeValues};
+use bevy::prelude::*;
+use bevy::transform::TransformSystems;
+use lodkit::combine::{ScreenRect, merge_rects, screen_rect};
+use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
+use lodkit::select::{LodCamera, LodSelection, LodState};
+
+use super::render::FrameSequentialView;
+use super::tag::encode_tag;
+use super::{
+    FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, PatternAnchor,
+};
+
+/// Pixels the combine rectangles grow by on each side (rasterization and reprojection reach).
+const RECT_DILATE: u32 = 1;
+
+pub(super) fn build(app: &mut App) {
+    app.init_resource::<Scheduler>()
+        .init_resource::<FrameSequentialStats>()
+        .add_systems(
+            PostUpdate,
+            (spawn_levels, update)
+                .chain()
+                .after(TransformSystems::Propagate)
+                .after(CameraUpdateSystems)
+                .before(VisibilitySystems::VisibilityPropagate),
+        );
+}
+
+/// lodkit's transition scheduler for the app's frame-sequential camera, and the key of each
+/// group in it (released when the group goes away).
+#[derive(Resource, Default)]
+struct Scheduler(TransitionScheduler, Vec<(Entity, InstanceKey)>);
+
+/// What the plugin keeps of a [`FrameSequentialGroup`] (inserted by the plugin).
+#[derive(Component, Clone, Debug)]
+pub struct FrameSequentialLevels {
+    /// The child entity that draws the group: the plugin gives it the mesh and material of the
+    /// level drawn each frame. One entity, not one per level, so Bevy's motion vectors follow
+    /// the group from frame to frame (an entity that was hidden last frame gets none).
+    pub entity: Entity,
+    /// The level drawn this frame.
+    pub drawn: u8,
+    /// lodkit's selection this frame.
+    pub selection: Option<LodSelection>,
+    /// The transition under way: (from, to).
+    pub transition: Option<(u8, u8)>,
+    key: Option<InstanceKey>,
+    state: LodState,
+    /// The group's model matrix last frame (where the older buffer holds it).
+    previous_model: Option<Mat4>,
+    bounds: Option<Bounds>,
+}
+
+/// A group's bounds: the box, and the sphere around the box's center holding every vertex.
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    lo: Vec3,
+    hi: Vec3,
+    radius: f32,
+}
+
+/// What the last frame's selection did, for reports and tests.
+#[derive(Resource, Clone, Debug, Default, PartialEq)]
+pub struct FrameSequentialStats {
+    /// Groups in transition this frame.
+    pub in_transition: usize,
+    /// Pixels the combine pass covers this frame (its rectangles' area).
+    pub combine_pixels: u64,
+    /// Frames the scheduler has run.
+    pub frames: u64,
+}
+
+/// Spawns the drawing child of every new or changed [`LodLevels`].
+fn spawn_levels(
+    mut commands: Commands,
+    groups: Query<(Entity, &LodLevels, Option<&FrameSequentialLevels>), Changed<LodLevels>>,
+) {
+    for (group, levels, old) in &groups {
+        if let Some(old) = old {
+            commands.entity(old.entity).despawn();
+        }
+        if levels.0.len() > 256 {
+            warn_once!("a LOD group has more than 256 levels: the rest are ignored");
+        }
+        let Some(first) = levels.0.first() else {
+            warn_once!("a LOD group has no levels: nothing is drawn");
+            continue;
+        };
+        let entity = commands
+            .spawn((
+                Mesh3d(first.mesh.clone()),
+                MeshMaterial3d(first.material.clone()),
+                MeshTag(0),
+                Transform::IDENTITY,
+                Visibility::Hidden,
+                ChildOf(group),
+            ))
+            .id();
+        commands.entity(group).insert(FrameSequentialLevels {
+            entity,
+            drawn: 0,
+            selection: None,
+            transition: None,
+            key: None,
+            state: LodState::NEW,
+            previous_model: None,
+            bounds: None,
+        });
+    }
+}
+
+/// Bevy 0.19's glam and lodkit's differ in version: matrices cross as arrays.
+fn to_lodkit(m: Mat4) -> glam::Mat4 {
+    glam::Mat4::from_cols_array(&m.to_cols_array())
+}
+
+/// The union of the level meshes' bounds, once every mesh is loaded.
+fn level_bounds(levels: &LodLevels, meshes: &Assets<Mesh>) -> Option<Bounds> {
+    let mut boxed: Option<(Vec3, Vec3)> = None;
+    for level in &levels.0 {
+        let aabb = meshes.get(&level.mesh)?.compute_aabb()?;
+        let (lo, hi) = (Vec3::from(aabb.min()), Vec3::from(aabb.max()));
+        boxed = Some(boxed.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
+    }
+    let (lo, hi) = boxed?;
+    let center = (lo + hi) / 2.0;
+    let mut radius = 0.0f32;
+    for level in &levels.0 {
+        let Some(VertexAttributeValues::Float32x3(positions)) = meshes
+            .get(&level.mesh)
+            .and_then(|m| m.attribute(Mesh::ATTRIBUTE_POSITION))
+        else {
+            radius = (hi - lo).length() / 2.0;
+            break;
+        };
+        for p in positions {
+            radius = radius.max(Vec3::from(*p).distance(center));
+        }
+    }
+    Some(Bounds { lo, hi, radius })
+}
+
+/// The screen rectangle of a sphere (world `center`, `radius`) under a symmetric perspective
+/// projection: the tangent planes through the eye in x and y. None where it does not apply
+/// (an orthographic projection, the eye within the sphere's depth).
+fn sphere_rect(
+    center: Vec3,
+    radius: f32,
+    view_from_world: Mat4,
+    clip_from_view: Mat4,
+    size: UVec2,
+    dilate: u32,
+) -> Option<ScreenRect> {
+    if clip_from_view.w_axis.w != 0.0 {
+        return None;
+    }
+    let c = view_from_world.transform_point3(center);
+    let z = -c.z;
+    let denom = z * z - radius * radius;
+    if z <= radius || denom <= 0.0 {
+        return None;
+    }
+    let slopes = |a: f32| {
+        let t = (a * a + denom).sqrt();
+        ((a * z - radius * t) / denom, (a * z + radius * t) / denom)
+    };
+    let (x0, x1) = slopes(c.x);
+    let (y0, y1) = slopes(c.y);
+    let (w, h) = (size.x as f32, size.y as f32);
+    let px = |s: f32| (clip_from_view.x_axis.x * s * 0.5 + 0.5) * w;
+    let py = |s: f32| (0.5 - clip_from_view.y_axis.y * s * 0.5) * h;
+    let d = dilate as f32;
+    let left = (px(x0) - d).floor().clamp(0.0, w);
+    let right = (px(x1) + d).ceil().clamp(0.0, w);
+    let top = (py(y1) - d).floor().clamp(0.0, h);
+    let bottom = (py(y0) + d).ceil().clamp(0.0, h);
+    Some(ScreenRect {
+        x: left as u32,
+        y: top as u32,
+        width: (right - left).max(0.0) as u32,
+        height: (bottom - top).max(0.0) as u32,
+    })
+}
+
+/// The pixels both rectangles cover (None when they do not meet).
+fn intersect(a: ScreenRect, b: ScreenRect) -> Option<ScreenRect> {
+    let (x0, y0) = (a.x.max(b.x), a.y.max(b.y));
+    let (x1, y1) = (
+        (a.x + a.width).min(b.x + b.width),
+        (a.y + a.height).min(b.y + b.height),
+    );
+    (x0 < x1 && y0 < y1).then_some(ScreenRect {
+        x: x0,
+        y: y0,
+        width: x1 - x0,
+        height: y1 - y0,
+    })
+}
+
+/// The combine rectangle of a group drawn with `model` by a camera: its box's rectangle
+/// (lodkit::combine::screen_rect) cut down to its bounding sphere's. None: off screen.
+fn group_rect(
+    bounds: Bounds,
+    model: Mat4,
+    view_from_world: Mat4,
+    clip_from_view: Mat4,
+    size: UVec2,
+) -> Option<ScreenRect> {
+    let v = |v: Vec3| glam::Vec3::from_array(v.to_array());
+    let boxed = screen_rect(
+        (v(bounds.lo), v(bounds.hi)),
+        to_lodkit(model),
+        &[to_lodkit(clip_from_view * view_from_world)],
+        (size.x, size.y),
+        RECT_DILATE,
+    )?;
+    let scale = model.to_scale_rotation_translation().0.abs().max_element();
+    let center = model.transform_point3((bounds.lo + bounds.hi) / 2.0);
+    match sphere_rect(
+        center,
+        bounds.radius * scale,
+        view_from_world,
+        clip_from_view,
+        size,
+        RECT_DILATE,
+    ) {
+        Some(sphere) => intersect(boxed, sphere),
+        None => Some(boxed),
+    }
+}
+
+/// Brings the scheduler's view of a group in line with lodkit's selection.
+fn reconcile(
+    scheduler: &mut TransitionScheduler,
+    levels: &mut FrameSequentialLevels,
+    selection: &LodSelection,
+) {
+    let key = *levels
+        .key
+        .get_or_insert_with(|| scheduler.insert(selection.current));
+    if !scheduler.in_transition(key) {
+        // The scheduler ended it (progress reached 1 last frame).
+        levels.transition = None;
+    }
+    if let Some((from, to)) = levels.transition {
+        if selection.current == from && selection.next == Some(to) {
+            let _ = scheduler.set_progress(key, selection.transition);
+            return;
+        }
+        if selection.current == to && selection.next.is_none() {
+            // Done: the scheduler shows `to` whole this frame and settles on it.
+            let _ = scheduler.set_progress(key, 1.0);
+            return;
+        }
+        // The selection turned back or jumped: settle where it is now.
+        let _ = scheduler.remove(key);
+        levels.key = Some(scheduler.insert(selection.current));
+        levels.transition = None;
+    }
+    let key = levels.key.expect("inserted above");
+    let settled = scheduler
+        .draw(key)
+        .map(|d| d.lod)
+        .unwrap_or(selection.current);
+    if settled != selection.current {
+        let _ = scheduler.remove(key);
+        levels.key = Some(scheduler.insert(selection.current));
+    }
+    if let Some(next) = selection.next {
+        let key = levels.key.expect("inserted above");
+        if scheduler
+            .begin_transition(key, next, Drive::Progress)
+            .is_ok()
+        {
+            let _ = scheduler.set_progress(key, selection.transition);
+            levels.transition = Some((selection.current, next));
+        }
+    }
+}
+
+type CameraQuery<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Camera,
+        &'static GlobalTransform,
+        &'static FrameSequentialLod,
+        Option<&'static FrameSequentialView>,
+    ),
+>;
+
+type GroupQuery<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static FrameSequentialGroup,
+        &'static LodLevels,
+        &'static GlobalTransform,
+        &'static mut FrameSequentialLevels,
+    ),
+>;
+
+/// Selects, schedules and shows the level each group draws this frame; hands the camera's
+/// combine rectangles and reprojection to the render world.
+#[allow(clippy::too_many_arguments)]
+fn update(
+    mut commands: Commands,
+    time: Res<Time>,
+    meshes: Res<Assets<Mesh>>,
+    mut scheduler: ResMut<Scheduler>,
+    mut stats: ResMut<FrameSequentialStats>,
+    cameras: CameraQuery,
+    mut groups: GroupQuery,
+    mut drawers: Query<(
+        &mut Visibility,
+        &mut MeshTag,
+        &mut Mesh3d,
+        &mut MeshMaterial3d<FrameSequentialMaterial>,
+    )>,
+    stale: Query<Entity, (With<FrameSequentialView>, Without<FrameSequentialLod>)>,
+) {
+    for camera in &stale {
+        commands.entity(camera).remove::<FrameSequentialView>();
+    }
+    let Scheduler(scheduler, keys) = &mut *scheduler;
+    keys.retain(|&(group, key)| {
+        let live = groups.contains(group);
+        if !live {
+            let _ = scheduler.remove(key);
+        }
+        live
+    });
+    let Some((camera_entity, camera, camera_transform, settings, last)) =
+        cameras.iter().find(|(_, c, ..)| c.is_active)
+    else {
+        return;
+    };
+    if cameras.iter().filter(|(_, c, ..)| c.is_active).count() > 1 {
+        warn_once!("more than one active camera has FrameSequentialLod: the first one selects");
+    }
+    if stats.frames > 0 {
+        scheduler.advance(time.delta_secs());
+    }
+    let frame = stats.frames;
+    stats.frames += 1;
+    scheduler.set_schedule(settings.schedule);
+    let view_from_world = camera_transform.to_matrix().inverse();
+    let clip_from_view = camera.clip_from_view();
+    let clip_from_world = clip_from_view * view_from_world;
+    let previous_view = last.map_or((view_from_world, clip_from_view), |l| {
+        (l.view_from_world, l.clip_from_view)
+    });
+    let previous_clip_from_world = previous_view.1 * previous_view.0;
+    let size = camera.physical_target_size().unwrap_or(UVec2::ONE);
+    let lod_camera = LodCamera::new(
+        glam::Vec3::from_array(camera_transform.translation().to_array()),
+        to_lodkit(camera.clip_from_view()),
+    );
+    let object = settings.anchor == PatternAnchor::Object;
+    let mut rects = Vec::new();
+    let mut in_transition = 0;
+    for (entity, group, levels, transform, mut state) in &mut groups {
+        let state = &mut *state;
+        let had_key = state.key;
+        let model = transform.to_matrix();
+        let scale = transform
+            .to_scale_rotation_translation()
+            .0
+            .abs()
+            .max_element();
+        let distance = lod_camera.lod_distance(
+            glam::Vec3::from_array(transform.translation().to_array()),
+            scale,
+            settings.settings.bias,
+        );
+        let selection = group.group.select(
+            distance,
+            &settings.settings,
+            time.delta_secs(),
+            &mut state.state,
+        );
+        reconcile(scheduler, state, &selection);
+        if state.key != had_key {
+            keys.retain(|&(g, _)| g != entity);
+            keys.extend(state.key.map(|k| (entity, k)));
+        }
+        let draw = state.key.and_then(|k| scheduler.draw(k).ok());
+        let (lod, tag) = match draw {
+            Some(d) => match encode_tag(d.id, d.tau, d.tau_next, object) {
+                Some(tag) => (d.lod, tag),
+                None => {
+                    warn_once!(
+                        "more than {} LOD groups in transition: the others switch at once",
+                        super::MAX_TAG_ID
+                    );
+                    (if d.incoming { d.lod } else { selection.current }, 0)
+                }
+            },
+            None => (selection.current, 0),
+        };
+        if tag != 0 {
+            in_transition += 1;
+            if state.bounds.is_none() {
+                state.bounds = match group.bounds {
+                    Some((lo, hi)) => Some(Bounds {
+                        lo,
+                        hi,
+                        radius: (hi - lo).length() / 2.0,
+                    }),
+                    None => level_bounds(levels, &meshes),
+                };
+            }
+            match state.bounds {
+                Some(bounds) => {
+                    let previous = state.previous_model.unwrap_or(model);
+                    rects.extend(group_rect(
+                        bounds,
+                        model,
+                        view_from_world,
+                        clip_from_view,
+                        size,
+                    ));
+                    rects.extend(group_rect(
+                        bounds,
+                        previous,
+                        previous_view.0,
+                        previous_view.1,
+                        size,
+                    ));
+                }
+                None => rects.push(ScreenRect {
+                    x: 0,
+                    y: 0,
+                    width: size.x,
+                    height: size.y,
+                }),
+            }
+        }
+        state.previous_model = Some(model);
+        state.selection = Some(selection);
+        state.drawn = lod;
+        let level = levels.0.get(usize::from(lod)).or(levels.0.last());
+        if let (Ok((mut visibility, mut mesh_tag, mut mesh, mut material)), Some(level)) =
+            (drawers.get_mut(state.entity), level)
+        {
+            visibility.set_if_neq(if selection.visible {
+                Visibility::Inherited
+            } else {
+                Visibility::Hidden
+            });
+            mesh_tag.set_if_neq(MeshTag(tag));
+            if mesh.0 != level.mesh {
+                mesh.0 = level.mesh.clone();
+            }
+            if material.0 != level.material {
+                material.0 = level.material.clone();
+            }
+        }
+    }
+    let rects = merge_rects(&rects);
+    stats.in_transition = in_transition;
+    stats.combine_pixels = rects.iter().map(ScreenRect::area).sum();
+    let world_from_clip = clip_from_world.inverse();
+    let new_to_old = if settings.reprojection {
+        previous_clip_from_world * world_from_clip
+    } else {
+        Mat4::IDENTITY
+    };
+    commands.entity(camera_entity).insert(FrameSequentialView {
+        view_from_world,
+        clip_from_view,
+        new_to_old,
+        motion_vectors: settings.reprojection,
+        rects: rects
+            .iter()
+            .map(|r| URect::new(r.x, r.y, r.x + r.width, r.y + r.height))
+            .collect(),
+        frame,
+    });
+}
