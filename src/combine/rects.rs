@@ -33,6 +33,27 @@ impl ScreenRect {
         }
     }
 
+    /// The pixels both cover (None when they share none).
+    ///
+    /// ```
+    /// # use lodkit::combine::ScreenRect;
+    /// let a = ScreenRect { x: 0, y: 0, width: 10, height: 10 };
+    /// let b = ScreenRect { x: 5, y: 8, width: 10, height: 10 };
+    /// assert_eq!(a.intersection(&b), Some(ScreenRect { x: 5, y: 8, width: 5, height: 2 }));
+    /// assert_eq!(a.intersection(&ScreenRect { x: 10, ..b }), None);
+    /// ```
+    pub fn intersection(&self, other: &ScreenRect) -> Option<ScreenRect> {
+        let (x0, y0) = (self.x.max(other.x), self.y.max(other.y));
+        let x1 = (self.x + self.width).min(other.x + other.width);
+        let y1 = (self.y + self.height).min(other.y + other.height);
+        (x0 < x1 && y0 < y1).then_some(ScreenRect {
+            x: x0,
+            y: y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        })
+    }
+
     /// Whether pixel (`x`, `y`) lies inside.
     pub fn contains(&self, x: u32, y: u32) -> bool {
         (self.x..self.x + self.width).contains(&x) && (self.y..self.y + self.height).contains(&y)

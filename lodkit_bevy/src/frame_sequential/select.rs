@@ -191,21 +191,6 @@ fn sphere_rect(
     })
 }
 
-/// The pixels both rectangles cover (None when they do not meet).
-fn intersect(a: ScreenRect, b: ScreenRect) -> Option<ScreenRect> {
-    let (x0, y0) = (a.x.max(b.x), a.y.max(b.y));
-    let (x1, y1) = (
-        (a.x + a.width).min(b.x + b.width),
-        (a.y + a.height).min(b.y + b.height),
-    );
-    (x0 < x1 && y0 < y1).then_some(ScreenRect {
-        x: x0,
-        y: y0,
-        width: x1 - x0,
-        height: y1 - y0,
-    })
-}
-
 /// The combine rectangle of a group drawn with `model` by a camera: its box's rectangle
 /// (lodkit::combine::screen_rect) cut down to its bounding sphere's. None: off screen.
 fn group_rect(
@@ -233,7 +218,7 @@ fn group_rect(
         size,
         RECT_DILATE,
     ) {
-        Some(sphere) => intersect(boxed, sphere),
+        Some(sphere) => boxed.intersection(&sphere),
         None => Some(boxed),
     }
 }
