@@ -286,7 +286,7 @@ fn library_with_module(module: &str) -> Result<ShaderLibrary, ShaderError> {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("m.wgsl"), module).unwrap();
     let mut library = ShaderLibrary::new().expect("the library composes");
-    library.add_import_dirs(&[dir])?;
+    library.add_import_dirs(&[dir.to_path_buf()])?;
     Ok(library)
 }
 

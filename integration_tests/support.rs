@@ -11,7 +11,6 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use lodkit::gpu::{GpuContext, GpuOptions};
 
@@ -82,16 +81,49 @@ pub fn run_ok(cmd: &mut std::process::Command, what: &str) -> String {
     text
 }
 
-/// A fresh scratch path `name` inside a new temporary folder.
-pub fn scratch(name: &str) -> PathBuf {
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let dir = std::env::temp_dir().join(format!(
-        "lodkit-test-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// A path inside a fresh temporary folder, which is removed with everything in it when the
+/// `Scratch` is dropped (also when the test fails), so test runs leave nothing behind.
+pub struct Scratch {
+    folder: tempfile::TempDir,
+    path: PathBuf,
+}
+
+impl Scratch {
+    /// The new empty folder itself.
+    pub fn folder() -> Self {
+        let folder = tempfile::Builder::new()
+            .prefix("lodkit-test-")
+            .tempdir()
+            .expect("a temporary folder");
+        let path = folder.path().to_path_buf();
+        Scratch { folder, path }
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.path.as_os_str()
+    }
+}
+
+/// The path `name` inside a fresh temporary folder (nothing is created at `name` itself).
+pub fn scratch(name: &str) -> Scratch {
+    let mut scratch = Scratch::folder();
+    scratch.path = scratch.folder.path().join(name);
+    scratch
 }
 
 /// Whether missing GPU or reference tools are failures (`LODKIT_REQUIRE_GPU=1`, as CI sets it).

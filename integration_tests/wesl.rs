@@ -9,7 +9,7 @@ use lodkit::shaders::{self, Language, ModuleKind, naga};
 
 use crate::composition::{module_harness, wgsl_modules};
 use crate::support::{
-    assert_folder_holds, browser_script, node_script, run_ok, scratch, workspace_root,
+    Scratch, assert_folder_holds, browser_script, node_script, run_ok, scratch, workspace_root,
 };
 
 #[test]
@@ -72,8 +72,9 @@ fn validate(wgsl: &str, what: &str) {
 }
 
 /// One link job per module and condition set: a harness importing every item of the module,
-/// with no condition set and with each one set. Returns the jobs and the file they are in.
-fn link_jobs(name: &str) -> (Vec<serde_json::Value>, std::path::PathBuf) {
+/// with no condition set and with each one set. Returns the jobs, the file they are in, and the
+/// temporary folder holding both (removed when dropped).
+fn link_jobs(name: &str) -> (Vec<serde_json::Value>, std::path::PathBuf, Scratch) {
     let defs: BTreeSet<String> = shaders::wesl_modules()
         .flat_map(|m| m.shader_defs.iter().map(|d| d.name.clone()))
         .collect();
@@ -103,13 +104,13 @@ fn link_jobs(name: &str) -> (Vec<serde_json::Value>, std::path::PathBuf) {
     }
     let jobs_file = dir.with_extension("json");
     std::fs::write(&jobs_file, serde_json::to_string(&jobs).unwrap()).unwrap();
-    (jobs, jobs_file)
+    (jobs, jobs_file, dir)
 }
 
 /// Runs a linker over the jobs (`PACKAGE_DIR JOBS.json`), then holds every linked file to naga's
 /// validator and to Tint.
 fn link_and_check(mut linker: std::process::Command, name: &str) {
-    let (jobs, jobs_file) = link_jobs(name);
+    let (jobs, jobs_file, _scratch) = link_jobs(name);
     let text = run_ok(
         linker
             .arg(workspace_root().join("shader_lib/wesl/lodkit"))

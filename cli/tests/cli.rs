@@ -1,20 +1,17 @@
 //! The `lodkit` command line: exit codes, diagnostics with file:line:col, JSON output.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use crate::support::Scratch;
 use std::process::{Command, Output};
 
 fn lodkit() -> Command {
     Command::new(env!("CARGO_BIN_EXE_lodkit"))
 }
 
-/// A fresh folder holding `files` (name, bytes).
-pub(crate) fn fixture(files: &[(&str, &[u8])]) -> PathBuf {
-    static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let dir = std::env::temp_dir().join(format!(
-        "lodkit-cli-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-    ));
+/// A fresh temporary folder holding `files` (name, bytes), removed when dropped.
+pub(crate) fn fixture(files: &[(&str, &[u8])]) -> Scratch {
+    let dir = Scratch::folder();
     for (name, bytes) in files {
         let path = dir.join(name);
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
@@ -394,7 +391,8 @@ fn an_include_line_may_end_with_a_comment() {
 
 #[test]
 fn wesl_writes_the_committed_package() {
-    let out = fixture(&[]).join("pkg");
+    let scratch = fixture(&[]);
+    let out = scratch.join("pkg");
     let (code, stdout, stderr) = run(Path::new("."), &["wesl", "--out", out.to_str().unwrap()]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let committed = crate::support::workspace_root().join("shader_lib/wesl/lodkit");
@@ -406,7 +404,8 @@ fn wesl_writes_the_committed_package() {
         );
     }
     // A file where the folder should be: exit 2 naming the path.
-    let blocked = fixture(&[("pkg", b"not a folder")]).join("pkg");
+    let blocked_dir = fixture(&[("pkg", b"not a folder")]);
+    let blocked = blocked_dir.join("pkg");
     let (code, _, stderr) = run(
         Path::new("."),
         &["wesl", "--out", blocked.to_str().unwrap()],

@@ -190,7 +190,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     let out = scratch("demo");
     let frames = 8;
     let options = DemoOptions {
-        out: out.clone(),
+        out: out.to_path_buf(),
         size: (96, 64),
         frames,
         scene: None,

@@ -20,7 +20,7 @@ const USES_BROKEN: &[u8] = b"#import engine::broken::broken
 @fragment fn main() -> @location(0) vec4<f32> { return vec4<f32>(broken()); }
 ";
 
-fn tree() -> std::path::PathBuf {
+fn tree() -> crate::support::Scratch {
     fixture(&[
         ("engine/real/thing.wgsl", REAL),
         ("engine/dummy/thing.wgsl", DUMMY),

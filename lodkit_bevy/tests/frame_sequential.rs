@@ -63,8 +63,14 @@ fn tags_round_trip() {
     assert!((tau + 0.25).abs() < 1e-3 && (tau_next - 0.5).abs() < 1e-3);
 }
 
+/// Runs the example with `args` in a temporary folder (removed afterwards) and returns its
+/// report, once the PNG strips it names are found written.
 fn report(args: &[&str]) -> Option<Value> {
-    let dir = tempdir(args.join("_").replace('-', ""));
+    let folder = tempfile::Builder::new()
+        .prefix("lodkit-bevy-fs-")
+        .tempdir()
+        .expect("a temporary folder");
+    let dir = folder.path();
     let path = dir.join("report.json");
     let mut all: Vec<&OsStr> = vec![OsStr::new("--out"), dir.as_os_str()];
     all.push(OsStr::new("--report"));
@@ -77,13 +83,12 @@ fn report(args: &[&str]) -> Option<Value> {
         String::from_utf8_lossy(&output.stderr)
     );
     let text = std::fs::read_to_string(&path).expect("the report");
-    Some(serde_json::from_str(&text).expect("the report is JSON"))
-}
-
-fn tempdir(name: String) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("lodkit-bevy-fs-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("a temporary folder");
-    dir
+    let r: Value = serde_json::from_str(&text).expect("the report is JSON");
+    for key in ["png_strip_frame_sequential", "png_strip_bevy_crossfade"] {
+        let png = r[key].as_str().expect("a strip path");
+        assert!(std::path::Path::new(png).is_file(), "{png} was not written");
+    }
+    Some(r)
 }
 
 fn num(r: &Value, key: &str) -> f64 {
@@ -115,10 +120,6 @@ fn frame_sequential_beats_bevy_crossfade_in_the_same_run() {
     );
     let ratio = num(&r, "fragments_frame_sequential") / num(&r, "fragments_bevy_crossfade");
     assert!(ratio <= 0.8, "fragments {ratio} of Bevy's crossfade");
-    for key in ["png_strip_frame_sequential", "png_strip_bevy_crossfade"] {
-        let png = r[key].as_str().expect("a strip path");
-        assert!(std::path::Path::new(png).is_file(), "{png} was not written");
-    }
 }
 
 /// The paper's schedule with the pattern on the object: no see-through either.
