@@ -17,6 +17,7 @@ mod gpu_twins;
 mod harness;
 mod host_errors;
 mod object_motion;
+mod packed_gbuffer;
 mod portability;
 mod robustness;
 mod screen_space;

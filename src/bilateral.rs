@@ -1,7 +1,7 @@
 //! Geometry-aware upsampling (Yang, Sander & Lawrence 2008, eq. 1): Rust twins of
 //! `lodkit::bilateral`.
 
-use glam::{UVec2, Vec2, Vec3, Vec4};
+use glam::{UVec2, UVec4, Vec2, Vec3, Vec4};
 
 use crate::normal_distance::foreshortened_normal;
 
@@ -62,7 +62,7 @@ pub fn bilateral_weight(
 ///
 /// ```
 /// # use lodkit::bilateral::bilateral_upsample;
-/// # use glam::{UVec2, Vec2, Vec3, Vec4};
+/// # use glam::{UVec2, UVec4, Vec2, Vec3, Vec4};
 /// let values = [Vec4::ZERO, Vec4::ONE, Vec4::ZERO, Vec4::ONE];
 /// let flat = [Vec3::Z; 4];
 /// // A flat region: bilinear.
@@ -83,11 +83,36 @@ pub fn bilateral_upsample(
     sigma_z: f32,
     sigma_n: f32,
 ) -> Vec4 {
+    bilateral_upsample_projected(
+        f,
+        values,
+        depths,
+        &normals.map(foreshortened_normal),
+        depth,
+        foreshortened_normal(normal),
+        sigma_z,
+        sigma_n,
+    )
+}
+
+/// [`bilateral_upsample`] with the samples' and the pixel's normals given through the
+/// foreshortening map (`projected`, `here`: [`foreshortened_normal`] of each), as the packed
+/// layout stores them.
+#[allow(clippy::too_many_arguments)]
+pub fn bilateral_upsample_projected(
+    f: Vec2,
+    values: &[Vec4; 4],
+    depths: Vec4,
+    projected: &[Vec2; 4],
+    depth: f32,
+    here: Vec2,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> Vec4 {
     let tent = bilateral_tent(f);
-    let here = foreshortened_normal(normal);
     let (mut sum, mut total, mut closest) = (Vec4::ZERO, 0.0f32, 0usize);
     for i in 0..4 {
-        let n = foreshortened_normal(normals[i]).distance(here);
+        let n = projected[i].distance(here);
         let w = bilateral_weight(tent[i], depths[i] - depth, n, sigma_z, sigma_n);
         sum += w * values[i];
         total += w;
@@ -98,7 +123,7 @@ pub fn bilateral_upsample(
     if total < BILATERAL_MIN_WEIGHT {
         values[closest]
     } else {
-        sum / total
+        sum * (1.0 / total)
     }
 }
 
@@ -143,6 +168,24 @@ pub fn bilateral_cell_texel(
         .as_uvec2()
 }
 
+/// Texels 0 and 3 of the 2x2 cell whose top-left texel is `origin` ([`bilateral_cell_origin`]),
+/// as (x0, y0, x1, y1), clamped to the viewport; texel 1 is (x1, y0), texel 2 (x0, y1).
+///
+/// ```
+/// # use lodkit::bilateral::*;
+/// # use glam::{UVec2, Vec2};
+/// let (frag, vp, full) = (Vec2::new(9.5, 0.5), Vec2::new(5.0, 4.0), Vec2::new(10.0, 8.0));
+/// let origin = bilateral_cell_origin(bilateral_low_position(frag, vp, full), vp);
+/// let c = bilateral_cell_corners(origin, vp);
+/// assert_eq!(UVec2::new(c.z, c.y), bilateral_cell_texel(frag, vp, full, 1));
+/// ```
+pub fn bilateral_cell_corners(origin: Vec2, low_viewport: Vec2) -> UVec4 {
+    let last = (low_viewport - 1.0).max(Vec2::ZERO).as_uvec2();
+    let first = origin.as_uvec2();
+    let (t0, t3) = (first.min(last), (first + 1).min(last));
+    UVec4::new(t0.x, t0.y, t3.x, t3.y)
+}
+
 /// Eq. 1 from four fetched L texels: `colors` and `geometry` (gbuffer layout).
 #[allow(clippy::too_many_arguments)]
 pub fn bilateral_upsample_texels(
@@ -168,18 +211,24 @@ pub fn bilateral_upsample_texels(
     )
 }
 
-/// An image on the CPU: `width` and row-major texels.
+/// An image on the CPU: `width` and row-major texels (`Vec4` for float textures, `UVec4` for
+/// the packed layout).
 #[derive(Clone, Copy, Debug)]
-pub struct Image<'a> {
+pub struct Image<'a, T = Vec4> {
     /// Width in texels.
     pub width: u32,
     /// Texels, row-major.
-    pub texels: &'a [Vec4],
+    pub texels: &'a [T],
 }
 
-impl Image<'_> {
-    fn at(&self, t: UVec2) -> Vec4 {
+impl<T: Copy> Image<'_, T> {
+    fn at(&self, t: UVec2) -> T {
         self.texels[(t.y * self.width + t.x) as usize]
+    }
+
+    /// The 2x2 cell's texels (order 0..3) of the full-res pixel at `frag_coord`.
+    fn cell(&self, frag_coord: Vec2, low_viewport: Vec2, full_size: Vec2) -> [T; 4] {
+        [0, 1, 2, 3].map(|i| self.at(bilateral_cell_texel(frag_coord, low_viewport, full_size, i)))
     }
 }
 
@@ -197,9 +246,67 @@ pub fn bilateral_upsample_at(
     sigma_z: f32,
     sigma_n: f32,
 ) -> Vec4 {
-    let texel = |i| bilateral_cell_texel(frag_coord, low_viewport, full_size, i);
-    let colors = [0, 1, 2, 3].map(|i| low_color.at(texel(i)));
-    let geometry = [0, 1, 2, 3].map(|i| low_geometry.at(texel(i)));
+    let colors = low_color.cell(frag_coord, low_viewport, full_size);
+    let geometry = low_geometry.cell(frag_coord, low_viewport, full_size);
     let f = bilateral_cell_fraction(frag_coord, low_viewport, full_size);
     bilateral_upsample_texels(f, &colors, &geometry, depth, normal, sigma_z, sigma_n)
+}
+
+/// Eq. 1 from four packed L texels ([`crate::gbuffer::gbuffer_pack_texel`]) for a full-res
+/// pixel at fraction `f` with `depth` and screen `normal`.
+pub fn bilateral_upsample_packed(
+    f: Vec2,
+    texels: &[UVec4; 4],
+    depth: f32,
+    normal: Vec3,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> Vec4 {
+    use crate::gbuffer::{
+        gbuffer_texel_color, gbuffer_texel_depth, gbuffer_texel_projected_normal,
+    };
+    bilateral_upsample_projected(
+        f,
+        &texels.map(gbuffer_texel_color),
+        Vec4::from_array(texels.map(gbuffer_texel_depth)),
+        &texels.map(gbuffer_texel_projected_normal),
+        depth,
+        foreshortened_normal(normal),
+        sigma_z,
+        sigma_n,
+    )
+}
+
+/// The whole lookup from a packed L on the CPU, as `bilateral_upsample_packed_at` does on the
+/// GPU (four texel loads): the fold-in upsample of a composite pass.
+///
+/// ```
+/// # use lodkit::bilateral::{Image, bilateral_upsample_packed_at};
+/// # use lodkit::gbuffer::gbuffer_pack_texel;
+/// # use glam::{Vec2, Vec3, Vec4};
+/// // A 2x1 L, near on the left and far on the right, for a 4x2 target (r = 2).
+/// let texels = [
+///     gbuffer_pack_texel(Vec4::new(1.0, 0.0, 0.0, 1.0), 2.0, Vec3::Z),
+///     gbuffer_pack_texel(Vec4::new(0.0, 0.0, 1.0, 1.0), 9.0, Vec3::Z),
+/// ];
+/// let low = Image { width: 2, texels: &texels };
+/// let (viewport, full) = (Vec2::new(2.0, 1.0), Vec2::new(4.0, 2.0));
+/// // Pixel 2 sits between the texels; on the far surface it takes only the far one.
+/// let c = bilateral_upsample_packed_at(low, viewport, full, Vec2::new(2.5, 0.5), 9.0, Vec3::Z, 0.1, 0.5);
+/// assert_eq!(c, Vec4::new(0.0, 0.0, 1.0, 1.0));
+/// ```
+#[allow(clippy::too_many_arguments)]
+pub fn bilateral_upsample_packed_at(
+    low: Image<UVec4>,
+    low_viewport: Vec2,
+    full_size: Vec2,
+    frag_coord: Vec2,
+    depth: f32,
+    normal: Vec3,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> Vec4 {
+    let texels = low.cell(frag_coord, low_viewport, full_size);
+    let f = bilateral_cell_fraction(frag_coord, low_viewport, full_size);
+    bilateral_upsample_packed(f, &texels, depth, normal, sigma_z, sigma_n)
 }

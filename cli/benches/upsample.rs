@@ -4,10 +4,12 @@
 //! same ratio, and whole-frame speed-ups per resize factor, for its report.
 //!
 //! Then the same for a pass that only makes eq. 1's nine texel loads: the floor of any per-pixel
-//! eq. 1 on this GPU.
+//! eq. 1 on this GPU; and the packed L's upsample (4 + 1 loads), its loads alone, and the fold-in
+//! upsample inside a composite pass against the same composite with a bilinear sample.
 //!
 //! `cargo bench -p lodkit-cli --bench upsample [-- WIDTH HEIGHT PAIRS]` (default 1280 x 720, 60 pairs)
 
+use lodkit_cli::demo::packed_timing::packed_upsample_vs_bilinear;
 use lodkit_cli::demo::{open_gpu, timing::upsample_vs_bilinear};
 
 fn main() {
@@ -25,7 +27,11 @@ fn main() {
         }
     };
     println!("adapter: {}", gpu.adapter_summary());
-    match upsample_vs_bilinear(&gpu, size, 2.0, pairs) {
+    let ratios = upsample_vs_bilinear(&gpu, size, 2.0, pairs).and_then(|r| {
+        let packed = packed_upsample_vs_bilinear(&gpu, size, 2.0, pairs)?;
+        Ok(r.into_iter().chain(packed).collect::<Vec<_>>())
+    });
+    match ratios {
         Ok(ratios) => {
             for r in ratios {
                 println!(

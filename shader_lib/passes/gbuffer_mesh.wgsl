@@ -10,7 +10,8 @@
 //
 // Entry points:
 //   vs_main   @location(0) position, @location(1) normal (object space)
-//   fs_main   GBufferOutput (location 0 color, location 1 rgba16float geometry)
+//   fs_main   GBufferOutput (location 0 color, location 1 rgba16float geometry); with
+//             GBUFFER_MESH_PACKED, location 0 the packed rgba32uint texel
 // Bindings: group 0: 0 `camera: GCamera` (uniform); group 1: 0 `draw: GDraw` (uniform, dynamic
 // offset).
 // Shader defs: (with neither set, color is the full shading, albedo x lighting)
@@ -18,7 +19,9 @@
 //   worth resizing).
 //   GBUFFER_MESH_ALBEDO_ONLY (bool) — color holds only the striped albedo (detailed, cheap at full
 //   resolution). Fine-grained resizing (sec. 2.3) upsamples the first and multiplies by the second.
-#import lodkit::gbuffer::{GBufferOutput, gbuffer_output}
+//   GBUFFER_MESH_PACKED (bool) — one rgba32uint target at location 0: lodkit::gbuffer's packed
+//   texel (gbuffer_pack_texel) instead of color and geometry.
+#import lodkit::gbuffer::{GBufferOutput, gbuffer_output, gbuffer_pack_texel}
 
 /// Per-view data.
 struct GCamera {
@@ -52,9 +55,15 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
     return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz, view_pos, position);
 }
 
+#ifdef GBUFFER_MESH_PACKED
+/// Stripes over Lambert; writes color, view depth and the screen-space normal.
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<u32> {
+#else
 /// Stripes over Lambert; writes color, view depth and the screen-space normal.
 @fragment
 fn fs_main(in: VertexOut) -> GBufferOutput {
+#endif
     let n = normalize(in.world_normal);
     let lambert = max(dot(n, normalize(camera.light_dir.xyz)), 0.0);
     let stripes = 0.5 + 0.5 * sin(18.0 * (in.object_pos.x + in.object_pos.y));
@@ -75,5 +84,9 @@ fn fs_main(in: VertexOut) -> GBufferOutput {
     let color = albedo * lighting;
 #endif
     let view_normal = normalize((camera.view * vec4<f32>(n, 0.0)).xyz);
+#ifdef GBUFFER_MESH_PACKED
+    return gbuffer_pack_texel(vec4<f32>(color, 1.0), -in.view_pos.z, view_normal);
+#else
     return gbuffer_output(vec4<f32>(color, 1.0), -in.view_pos.z, view_normal);
+#endif
 }

@@ -5,7 +5,10 @@
 // bilateral_upsample_at (its 2x2 nearest L samples, clamped to the viewport, and eq. 1).
 // sigma_z = sigma_n = +inf gives plain bilinear upsampling through the same pass. With
 // LODKIT_UPSAMPLE_MODULATE the upsampled color is multiplied by the full-resolution albedo: the
-// composite of fine-grained resizing (sec. 4), where only the lighting went through L.
+// composite of fine-grained resizing (sec. 4), where only the lighting went through L. With
+// LODKIT_UPSAMPLE_PACKED, L is lodkit::gbuffer's packed layout (one rgba32uint texture) and the
+// lookup is bilateral_upsample_packed_at: 4 low-resolution loads and 1 full-resolution load per
+// pixel instead of 8 and 1.
 // Built only from lodkit::fullscreen, lodkit::gbuffer, lodkit::bilateral.
 //
 // Entry points:
@@ -13,11 +16,15 @@
 //   fs_main   @location(0) upsampled color
 // Bindings (group 0): 0 low_color texture_2d<f32>, 1 low_geometry texture_2d<f32>,
 //   2 full_geometry texture_2d<f32> (the prepass, gbuffer layout), 3 params: UpsampleParams;
-//   with LODKIT_UPSAMPLE_MODULATE: 3 full_albedo texture_2d<f32>, 4 params.
-// Shader defs: LODKIT_UPSAMPLE_MODULATE (bool).
+//   with LODKIT_UPSAMPLE_MODULATE: 3 full_albedo texture_2d<f32>, 4 params. With
+//   LODKIT_UPSAMPLE_PACKED the first two are one: 0 low texture_2d<u32>, and the rest move down
+//   by one.
+// Shader defs:
+//   LODKIT_UPSAMPLE_MODULATE (bool) — multiply by full_albedo (the fine-grained composite).
+//   LODKIT_UPSAMPLE_PACKED (bool) — L is one packed rgba32uint texture (lodkit::gbuffer).
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 #import lodkit::gbuffer::{gbuffer_depth, gbuffer_normal}
-#import lodkit::bilateral::bilateral_upsample_at
+#import lodkit::bilateral::{bilateral_upsample_at, bilateral_upsample_packed_at}
 
 /// Per-frame parameters.
 struct UpsampleParams {
@@ -32,6 +39,16 @@ struct UpsampleParams {
     _pad1: f32,
 }
 
+#ifdef LODKIT_UPSAMPLE_PACKED
+@group(0) @binding(0) var low: texture_2d<u32>;
+@group(0) @binding(1) var full_geometry: texture_2d<f32>;
+#ifdef LODKIT_UPSAMPLE_MODULATE
+@group(0) @binding(2) var full_albedo: texture_2d<f32>;
+@group(0) @binding(3) var<uniform> params: UpsampleParams;
+#else
+@group(0) @binding(2) var<uniform> params: UpsampleParams;
+#endif
+#else
 @group(0) @binding(0) var low_color: texture_2d<f32>;
 @group(0) @binding(1) var low_geometry: texture_2d<f32>;
 @group(0) @binding(2) var full_geometry: texture_2d<f32>;
@@ -40,6 +57,7 @@ struct UpsampleParams {
 @group(0) @binding(4) var<uniform> params: UpsampleParams;
 #else
 @group(0) @binding(3) var<uniform> params: UpsampleParams;
+#endif
 #endif
 
 /// Fullscreen triangle.
@@ -54,6 +72,18 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(v.position.xy);
     let full = textureLoad(full_geometry, pixel, 0);
+#ifdef LODKIT_UPSAMPLE_PACKED
+    let color = bilateral_upsample_packed_at(
+        low,
+        params.low_viewport,
+        params.full_size,
+        v.position.xy,
+        gbuffer_depth(full),
+        gbuffer_normal(full),
+        params.sigma_z,
+        params.sigma_n,
+    );
+#else
     let color = bilateral_upsample_at(
         low_color,
         low_geometry,
@@ -65,6 +95,7 @@ fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
         params.sigma_z,
         params.sigma_n,
     );
+#endif
 #ifdef LODKIT_UPSAMPLE_MODULATE
     return vec4<f32>(color.rgb * textureLoad(full_albedo, pixel, 0).rgb, color.a);
 #else

@@ -277,6 +277,22 @@ pub(crate) fn check_color_format(
     check_format_usages(gpu, call, parameter, format, usages)
 }
 
+/// [`check_color_format`], also accepting `lodkit::gbuffer`'s packed low-resolution format
+/// ([`crate::gbuffer::PACKED_FORMAT`]), which lodkit's framebuffer-LOD passes write and read as
+/// integers.
+pub(crate) fn check_low_res_format(
+    gpu: &GpuContext,
+    call: &'static str,
+    parameter: &'static str,
+    format: wgpu::TextureFormat,
+    usages: wgpu::TextureUsages,
+) -> Result<(), GpuError> {
+    if format == crate::gbuffer::PACKED_FORMAT {
+        return check_format_usages(gpu, call, parameter, format, usages);
+    }
+    check_color_format(gpu, call, parameter, format, usages)
+}
+
 /// Checks that the device has the features `format` needs and allows it with `usages`.
 pub(crate) fn check_format_usages(
     gpu: &GpuContext,

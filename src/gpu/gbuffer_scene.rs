@@ -4,14 +4,14 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::error::{check_color_format, same_color_format};
+use super::error::{check_low_res_format, same_color_format};
 use super::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
 use super::resources::{
     DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, uniform_buffer,
 };
 use super::scene::GpuMesh;
 use super::{GpuContext, GpuError};
-use crate::gbuffer::GEOMETRY_FORMAT;
+use crate::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
 
 /// Rust mirror of `GCamera` in `passes/gbuffer_mesh.wgsl`.
 #[repr(C)]
@@ -76,6 +76,8 @@ impl GBufferRenderer {
     pub const MAX_DRAWS: usize = 256;
 
     /// Builds the pipeline for color format `color_format`, writing `term` into the color target.
+    /// With [`PACKED_FORMAT`] it draws into a packed L ([`LowResBuffer::packed`]): `term` and the
+    /// geometry packed into one texel (`gbuffer_pack_texel`).
     pub fn new(
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,
@@ -83,7 +85,7 @@ impl GBufferRenderer {
     ) -> Result<Self, GpuError> {
         const CALL: &str = "GBufferRenderer::new";
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        check_color_format(gpu, CALL, "color_format", color_format, usage)?;
+        check_low_res_format(gpu, CALL, "color_format", color_format, usage)?;
         gpu.guarded(CALL, || Self::build(gpu, color_format, term))
     }
 
@@ -92,19 +94,30 @@ impl GBufferRenderer {
         color_format: wgpu::TextureFormat,
         term: ShadingTerm,
     ) -> Result<Self, GpuError> {
-        let defs: &[&str] = match term {
-            ShadingTerm::Full => &[],
-            ShadingTerm::Lighting => &["GBUFFER_MESH_LIGHTING_ONLY"],
-            ShadingTerm::Albedo => &["GBUFFER_MESH_ALBEDO_ONLY"],
+        let packed = color_format == PACKED_FORMAT;
+        let defs: Vec<&str> = [
+            match term {
+                ShadingTerm::Full => None,
+                ShadingTerm::Lighting => Some("GBUFFER_MESH_LIGHTING_ONLY"),
+                ShadingTerm::Albedo => Some("GBUFFER_MESH_ALBEDO_ONLY"),
+            },
+            packed.then_some("GBUFFER_MESH_PACKED"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let module = gpu.pass_module("gbuffer_mesh", &defs)?;
+        let targets = match packed {
+            true => vec![Some(color_format.into())],
+            false => vec![Some(color_format.into()), Some(GEOMETRY_FORMAT.into())],
         };
-        let module = gpu.pass_module("gbuffer_mesh", defs)?;
         let device = &gpu.device;
         let (camera_layout, draw_layout, layout) = camera_draw_layouts(gpu, "gbuffer_mesh", &[])?;
         let pipeline = mesh_pipeline(
             gpu,
             &module,
             &layout,
-            &[Some(color_format.into()), Some(GEOMETRY_FORMAT.into())],
+            &targets,
             depth_write_state(LOW_DEPTH_FORMAT, wgpu::CompareFunction::Less),
             "gbuffer_mesh",
         )?;
@@ -196,10 +209,14 @@ impl GBufferRenderer {
 }
 
 /// An edge-heavy test scene: boxes and spheres of different depths and orientations in front of
-/// a far wall, with striped shading; the framebuffer-LOD quality tests and examples render it.
+/// a far wall, with striped shading; the framebuffer-LOD quality tests and examples render it,
+/// into an L of its color format or a packed L ([`LowResBuffer::packed`]).
 #[derive(Debug)]
 pub struct EdgeScene {
     renderers: [GBufferRenderer; 3],
+    /// The renderers for a packed L, built on first use.
+    packed: std::sync::OnceLock<[GBufferRenderer; 3]>,
+    shading_work: u32,
     sphere: GpuMesh,
     cube: GpuMesh,
     aspect: f32,
@@ -209,8 +226,8 @@ impl EdgeScene {
     /// View depth of the background (cleared geometry).
     pub const FAR_VIEW_DEPTH: f32 = 40.0;
 
-    /// Uploads the meshes and builds the renderer for targets of `color_format` and `aspect`
-    /// (width / height: finite and positive).
+    /// Uploads the meshes and builds the renderer for targets of `color_format` (and, on first
+    /// use, for packed ones) and `aspect` (width / height: finite and positive).
     pub fn new(
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,
@@ -226,14 +243,12 @@ impl EdgeScene {
             });
         }
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        check_color_format(gpu, CALL, "color_format", color_format, usage)?;
+        check_low_res_format(gpu, CALL, "color_format", color_format, usage)?;
         gpu.guarded(CALL, || {
             Ok(Self {
-                renderers: [
-                    GBufferRenderer::new(gpu, color_format, ShadingTerm::Full)?,
-                    GBufferRenderer::new(gpu, color_format, ShadingTerm::Lighting)?,
-                    GBufferRenderer::new(gpu, color_format, ShadingTerm::Albedo)?,
-                ],
+                renderers: Self::renderers(gpu, color_format, 0)?,
+                packed: std::sync::OnceLock::new(),
+                shading_work: 0,
                 sphere: GpuMesh::new(gpu, &super::scene::Mesh::sphere(24, 48))?,
                 cube: GpuMesh::new(gpu, &super::scene::Mesh::cube())?,
                 aspect,
@@ -241,9 +256,27 @@ impl EdgeScene {
         })
     }
 
+    fn renderers(
+        gpu: &GpuContext,
+        color_format: wgpu::TextureFormat,
+        work: u32,
+    ) -> Result<[GBufferRenderer; 3], GpuError> {
+        let mut renderers = [
+            GBufferRenderer::new(gpu, color_format, ShadingTerm::Full)?,
+            GBufferRenderer::new(gpu, color_format, ShadingTerm::Lighting)?,
+            GBufferRenderer::new(gpu, color_format, ShadingTerm::Albedo)?,
+        ];
+        for r in &mut renderers {
+            r.set_shading_work(work);
+        }
+        Ok(renderers)
+    }
+
     /// Sets the synthetic shading work of every term (see [`GBufferRenderer::set_shading_work`]).
     pub fn set_shading_work(&mut self, n: u32) {
-        for r in &mut self.renderers {
+        self.shading_work = n;
+        let packed = self.packed.get_mut().into_iter().flatten();
+        for r in self.renderers.iter_mut().chain(packed) {
             r.set_shading_work(n);
         }
     }
@@ -308,10 +341,20 @@ impl EdgeScene {
             b: 0.15,
             a: 1.0,
         };
+        let renderers = match target.is_packed() {
+            false => &self.renderers,
+            true => match self.packed.get() {
+                Some(packed) => packed,
+                None => {
+                    let built = Self::renderers(gpu, PACKED_FORMAT, self.shading_work)?;
+                    self.packed.get_or_init(|| built)
+                }
+            },
+        };
         let (renderer, clear) = match term {
-            ShadingTerm::Full => (&self.renderers[0], clear),
-            ShadingTerm::Lighting => (&self.renderers[1], wgpu::Color::WHITE),
-            ShadingTerm::Albedo => (&self.renderers[2], clear),
+            ShadingTerm::Full => (&renderers[0], clear),
+            ShadingTerm::Lighting => (&renderers[1], wgpu::Color::WHITE),
+            ShadingTerm::Albedo => (&renderers[2], clear),
         };
         renderer.render(
             gpu,

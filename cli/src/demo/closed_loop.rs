@@ -85,7 +85,7 @@ impl ClosedLoop {
 /// Runs lodkit's controller, the paper's and the step heuristic on the edge scene at `size`.
 pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedLoop, DemoError> {
     let (frame, mut scene) = Frame::new(gpu, size)?;
-    let frame = |scene: &EdgeScene, r: f32| frame.whole(scene, r).map(|ms| ms as f32);
+    let frame = |scene: &EdgeScene, r: f32| frame.whole(scene, r, 0).map(|ms| ms as f32);
     let times = |scene: &EdgeScene, r: f32| -> Result<Vec<f32>, GpuError> {
         let mut t = (0..CALIBRATION)
             .map(|_| frame(scene, r))

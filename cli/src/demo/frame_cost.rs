@@ -7,7 +7,9 @@
 //! and normal, with the cheap albedo term), the low-resolution shading pass at r, and the
 //! upsample pass. The fine-grained route shades only the lighting at low resolution; its
 //! full-resolution albedo pass writes the geometry, so it is the same pass as the prepass, and its
-//! upsample multiplies by that albedo (the composite, inside the pass).
+//! upsample multiplies by that albedo (the composite, inside the pass). Each route also runs from
+//! a packed L (`lodkit::gbuffer`'s packed texel: 4 low-resolution loads per pixel instead of 8;
+//! in the fine-grained route the upsample is folded into the composite).
 
 use std::path::Path;
 
@@ -37,7 +39,7 @@ pub const PASSES: [&str; 3] = ["geometry prepass", "low-res shading", "upsample"
 /// The median time of each pass of one frame configuration.
 #[derive(Clone, Debug, Serialize)]
 pub struct PassTimes {
-    /// `full resolution`, `bilateral` or `fine-grained`.
+    /// `full resolution`, `bilateral` or `fine-grained`, the last two also `..., packed L`.
     pub route: String,
     /// Resize factor (1 for the full-resolution frame).
     pub r: f32,
@@ -54,12 +56,19 @@ pub struct SweepRow {
     pub full_ms: f64,
     /// Median framebuffer-LOD frame at each of [`SWEEP_FACTORS`] (ms).
     pub lod_ms: [f64; 2],
+    /// The same from a packed L (ms).
+    pub packed_ms: [f64; 2],
 }
 
 impl SweepRow {
     /// Whole-frame speed-up at `SWEEP_FACTORS[k]`.
     pub fn speedup(&self, k: usize) -> f64 {
         self.full_ms / self.lod_ms[k]
+    }
+
+    /// Whole-frame speed-up at `SWEEP_FACTORS[k]` from a packed L.
+    pub fn packed_speedup(&self, k: usize) -> f64 {
+        self.full_ms / self.packed_ms[k]
     }
 }
 
@@ -107,11 +116,13 @@ fn timed(gpu: &GpuContext, f: impl Fn() -> Result<(), GpuError>) -> Result<f64, 
 /// the full-resolution prepass, the upsample pass and the target; each pass timed on request.
 pub(super) struct Frame<'a> {
     gpu: &'a GpuContext,
-    low: LowResBuffer,
+    /// L, unpacked and packed.
+    low: [LowResBuffer; 2],
     prepass: LowResBuffer,
-    upsample: UpsamplePass,
-    /// The fine-grained route's upsample, which multiplies by the prepass's albedo.
-    fine: UpsamplePass,
+    /// The upsample of each L.
+    upsample: [UpsamplePass; 2],
+    /// The fine-grained route's upsample of each L, which multiplies by the prepass's albedo.
+    fine: [UpsamplePass; 2],
     view: wgpu::TextureView,
 }
 
@@ -126,17 +137,35 @@ impl<'a> Frame<'a> {
         let scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
         let frame = Self {
             gpu,
-            low: LowResBuffer::new(gpu, w, h, format)?,
+            low: [
+                LowResBuffer::new(gpu, w, h, format)?,
+                LowResBuffer::packed(gpu, w, h)?,
+            ],
             prepass: LowResBuffer::new(gpu, w, h, format)?,
-            upsample: UpsamplePass::new(gpu, format)?,
-            fine: UpsamplePass::fine_grained(gpu, format)?,
+            upsample: [
+                UpsamplePass::new(gpu, format)?,
+                UpsamplePass::packed(gpu, format)?,
+            ],
+            fine: [
+                UpsamplePass::fine_grained(gpu, format)?,
+                UpsamplePass::packed_fine_grained(gpu, format)?,
+            ],
             view: texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default()),
         };
         Ok((frame, scene))
     }
 
-    fn shade(&self, scene: &EdgeScene, r: f32, term: ShadingTerm) -> Result<f64, GpuError> {
-        timed(self.gpu, || scene.render_term(self.gpu, &self.low, r, term))
+    /// The low-resolution shading at `r` into L (`p`: 0 unpacked, 1 packed).
+    fn shade(
+        &self,
+        scene: &EdgeScene,
+        r: f32,
+        term: ShadingTerm,
+        p: usize,
+    ) -> Result<f64, GpuError> {
+        timed(self.gpu, || {
+            scene.render_term(self.gpu, &self.low[p], r, term)
+        })
     }
 
     fn prepass(&self, scene: &EdgeScene) -> Result<f64, GpuError> {
@@ -146,43 +175,49 @@ impl<'a> Frame<'a> {
         })
     }
 
-    /// Records the upsample at `r`; `term` is what L holds (the lighting alone: fine-grained).
-    fn record_upsample(&self, r: f32, term: ShadingTerm) -> Result<(), GpuError> {
+    /// Records the upsample of L `p` at `r`; `term` is what L holds (the lighting alone:
+    /// fine-grained).
+    fn record_upsample(&self, r: f32, term: ShadingTerm, p: usize) -> Result<(), GpuError> {
         let gpu = self.gpu;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let (low, g, view) = (&self.low, self.prepass.geometry(), &self.view);
+        let (low, g, view) = (&self.low[p], self.prepass.geometry(), &self.view);
         let (sz, sn) = (SIGMA_Z, SIGMA_N);
         if term == ShadingTerm::Lighting {
             let albedo = self.prepass.color();
-            self.fine
-                .encode_fine_grained(gpu, &mut encoder, low, r, g, albedo, sz, sn, view)?;
+            self.fine[p].encode_fine_grained(gpu, &mut encoder, low, r, g, albedo, sz, sn, view)?;
         } else {
-            self.upsample
-                .encode(gpu, &mut encoder, low, r, g, sz, sn, view)?;
+            self.upsample[p].encode(gpu, &mut encoder, low, r, g, sz, sn, view)?;
         }
         gpu.queue.submit([encoder.finish()]);
         Ok(())
     }
 
-    fn upsample(&self, r: f32, term: ShadingTerm) -> Result<f64, GpuError> {
-        timed(self.gpu, || self.record_upsample(r, term))
+    fn upsample(&self, r: f32, term: ShadingTerm, p: usize) -> Result<f64, GpuError> {
+        timed(self.gpu, || self.record_upsample(r, term, p))
     }
 
-    /// A whole frame at `r`, waited for once at its end; its wall time in ms.
-    pub(super) fn whole(&self, scene: &EdgeScene, r: f32) -> Result<f64, GpuError> {
+    /// A whole frame at `r` from L `p` (0 unpacked, 1 packed), waited for once at its end; its
+    /// wall time in ms.
+    pub(super) fn whole(&self, scene: &EdgeScene, r: f32, p: usize) -> Result<f64, GpuError> {
         timed(self.gpu, || {
             scene.render_term(self.gpu, &self.prepass, 1.0, ShadingTerm::Albedo)?;
-            scene.render_term(self.gpu, &self.low, r, ShadingTerm::Full)?;
-            self.record_upsample(r, ShadingTerm::Full)
+            scene.render_term(self.gpu, &self.low[p], r, ShadingTerm::Full)?;
+            self.record_upsample(r, ShadingTerm::Full, p)
         })
     }
 
-    /// The three passes of a frame at `r`, each waited for.
-    fn passes(&self, scene: &EdgeScene, r: f32, term: ShadingTerm) -> Result<[f64; 3], GpuError> {
+    /// The three passes of a frame at `r` from L `p`, each waited for.
+    fn passes(
+        &self,
+        scene: &EdgeScene,
+        r: f32,
+        term: ShadingTerm,
+        p: usize,
+    ) -> Result<[f64; 3], GpuError> {
         Ok([
             self.prepass(scene)?,
-            self.shade(scene, r, term)?,
-            self.upsample(r, term)?,
+            self.shade(scene, r, term, p)?,
+            self.upsample(r, term, p)?,
         ])
     }
 }
@@ -197,18 +232,21 @@ pub fn measure_frame_cost(
     let (frame, mut scene) = Frame::new(gpu, size)?;
     // Pass by pass, rounds interleaved over the configurations; round 0 warms up.
     scene.set_shading_work(BREAKDOWN_WORK);
-    let full = ("full resolution", 1.0, ShadingTerm::Full);
-    let configs: Vec<(&str, f32, ShadingTerm)> = std::iter::once(full)
-        .chain(BREAKDOWN_FACTORS.map(|r| ("bilateral", r, ShadingTerm::Full)))
-        .chain(BREAKDOWN_FACTORS.map(|r| ("fine-grained", r, ShadingTerm::Lighting)))
+    let full = ("full resolution", 1.0, ShadingTerm::Full, 0);
+    let (bilateral, fine) = (ShadingTerm::Full, ShadingTerm::Lighting);
+    let configs: Vec<(&str, f32, ShadingTerm, usize)> = std::iter::once(full)
+        .chain(BREAKDOWN_FACTORS.map(|r| ("bilateral", r, bilateral, 0)))
+        .chain(BREAKDOWN_FACTORS.map(|r| ("fine-grained", r, fine, 0)))
+        .chain(BREAKDOWN_FACTORS.map(|r| ("bilateral, packed L", r, bilateral, 1)))
+        .chain(BREAKDOWN_FACTORS.map(|r| ("fine-grained, packed L", r, fine, 1)))
         .collect();
     let mut samples = vec![[Vec::new(), Vec::new(), Vec::new()]; configs.len()];
     for round in 0..=rounds {
-        for (c, &(route, r, term)) in configs.iter().enumerate() {
+        for (c, &(route, r, term, p)) in configs.iter().enumerate() {
             let times = if route == full.0 {
-                [0.0, frame.shade(&scene, 1.0, term)?, 0.0]
+                [0.0, frame.shade(&scene, 1.0, term, 0)?, 0.0]
             } else {
-                frame.passes(&scene, r, term)?
+                frame.passes(&scene, r, term, p)?
             };
             for (k, t) in times.into_iter().enumerate().filter(|_| round > 0) {
                 samples[c][k].push(t);
@@ -218,7 +256,7 @@ pub fn measure_frame_cost(
     let breakdown = configs
         .iter()
         .zip(&samples)
-        .map(|(&(route, r, _), s)| PassTimes {
+        .map(|(&(route, r, _, _), s)| PassTimes {
             route: route.to_owned(),
             r,
             ms: [median(&s[0]), median(&s[1]), median(&s[2])],
@@ -228,19 +266,24 @@ pub fn measure_frame_cost(
     let mut sweep = Vec::new();
     for work in SWEEP_WORK {
         scene.set_shading_work(work);
-        let lod_frame = |r: f32| frame.whole(&scene, r);
-        lod_frame(SWEEP_FACTORS[0])?;
-        let (mut full_ms, mut lod) = (Vec::new(), [Vec::new(), Vec::new()]);
+        let lod_frame = |r: f32, p: usize| frame.whole(&scene, r, p);
+        lod_frame(SWEEP_FACTORS[0], 0)?;
+        lod_frame(SWEEP_FACTORS[0], 1)?;
+        let mut full_ms = Vec::new();
+        let mut lod = [[Vec::new(), Vec::new()], [Vec::new(), Vec::new()]];
         for _ in 0..rounds {
-            full_ms.push(frame.shade(&scene, 1.0, ShadingTerm::Full)?);
+            full_ms.push(frame.shade(&scene, 1.0, ShadingTerm::Full, 0)?);
             for (k, &r) in SWEEP_FACTORS.iter().enumerate() {
-                lod[k].push(lod_frame(r)?);
+                for (p, times) in lod.iter_mut().enumerate() {
+                    times[k].push(lod_frame(r, p)?);
+                }
             }
         }
         sweep.push(SweepRow {
             work,
             full_ms: median(&full_ms),
-            lod_ms: [median(&lod[0]), median(&lod[1])],
+            lod_ms: [median(&lod[0][0]), median(&lod[0][1])],
+            packed_ms: [median(&lod[1][0]), median(&lod[1][1])],
         });
     }
     Ok(FrameCost {
@@ -289,6 +332,8 @@ pub(super) fn sweep_table(cost: &FrameCost) -> Table {
             "r = 2 speed-up",
             "r = 3 frame ms",
             "r = 3 speed-up",
+            "r = 2 speed-up, packed L",
+            "r = 3 speed-up, packed L",
         ],
         rows: cost
             .sweep
@@ -301,6 +346,8 @@ pub(super) fn sweep_table(cost: &FrameCost) -> Table {
                     format!("{:.2}x", s.speedup(0)),
                     format!("{:.1}", s.lod_ms[1]),
                     format!("{:.2}x", s.speedup(1)),
+                    format!("{:.2}x", s.packed_speedup(0)),
+                    format!("{:.2}x", s.packed_speedup(1)),
                 ]
             })
             .collect(),
@@ -319,13 +366,25 @@ pub fn summary(cost: &FrameCost) -> String {
     let (work, full, s2, s3) = last.map_or((0, 0.0, 0.0, 0.0), |s| {
         (s.work, s.full_ms, s.speedup(0), s.speedup(1))
     });
+    let at = |w: u32| cost.sweep.iter().find(|s| s.work == w);
+    let packed = at(BREAKDOWN_WORK).map_or(String::new(), |s| {
+        format!(
+            " At shading work {}, from a packed L: {:.2}x at r = 2 and {:.2}x at r = 3 (unpacked \
+             {:.2}x and {:.2}x).",
+            s.work,
+            s.packed_speedup(0),
+            s.packed_speedup(1),
+            s.speedup(0),
+            s.speedup(1)
+        )
+    });
     let (w, h) = cost.size;
     let mpix = f64::from(w) * f64::from(h) / 1e6;
     format!(
         "Framebuffer LOD pays (speed-up above 1) at r = 2 {}, at r = 3 {}. At the most \
          pixel-bound point of the sweep (shading work {work}: the full-resolution frame takes \
          {full:.0} ms, {:.0} ms per megapixel of shading) the whole-frame speed-up is {s2:.2}x \
-         at r = 2 and {s3:.2}x at r = 3.",
+         at r = 2 and {s3:.2}x at r = 3.{packed}",
         cross(0),
         cross(1),
         full / mpix
@@ -341,6 +400,8 @@ pub fn write_plots(cost: &FrameCost, out: &Path) -> Result<(), DemoError> {
             let label = match p.route.as_str() {
                 "full resolution" => "full res".to_owned(),
                 "fine-grained" => format!("fine {}", p.r),
+                "bilateral, packed L" => format!("packed {}", p.r),
+                "fine-grained, packed L" => format!("fine packed {}", p.r),
                 _ => format!("r = {}", p.r),
             };
             (label, p.ms.map(|t| t as f32).to_vec())
@@ -356,15 +417,27 @@ pub fn write_plots(cost: &FrameCost, out: &Path) -> Result<(), DemoError> {
             bars,
         },
     )?;
-    let series = SWEEP_FACTORS
-        .iter()
-        .enumerate()
-        .map(|(k, r)| Series {
-            name: format!("r = {r}"),
+    let series = [false, true]
+        .into_iter()
+        .flat_map(|packed| {
+            SWEEP_FACTORS
+                .iter()
+                .enumerate()
+                .map(move |(k, r)| (packed, k, r))
+        })
+        .map(|(packed, k, r)| Series {
+            name: format!("r = {r}{}", if packed { ", packed L" } else { "" }),
             points: cost
                 .sweep
                 .iter()
-                .map(|s| (s.work as f32, s.speedup(k) as f32))
+                .map(|s| {
+                    let x = if packed {
+                        s.packed_speedup(k)
+                    } else {
+                        s.speedup(k)
+                    };
+                    (s.work as f32, x as f32)
+                })
                 .collect(),
         })
         .collect();

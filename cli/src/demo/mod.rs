@@ -15,6 +15,7 @@ pub mod cpu;
 pub mod doc_pictures;
 pub mod frame_cost;
 pub mod impostor;
+pub mod packed_timing;
 pub mod plots;
 pub mod reads;
 pub mod render;
@@ -331,6 +332,12 @@ pub fn run_on(
     let mut pass_ratios =
         timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?.to_vec();
     pass_ratios.extend(timing::upsample_vs_bilinear(
+        gpu,
+        options.fb_size,
+        2.0,
+        options.timing_pairs,
+    )?);
+    pass_ratios.extend(packed_timing::packed_upsample_vs_bilinear(
         gpu,
         options.fb_size,
         2.0,

@@ -50,7 +50,12 @@ impl Reads {
 
     /// The reads of `fs_main` of lodkit's pass `shader_lib/passes/<pass>.wgsl`.
     pub fn of_pass(pass: &str, bound: &[Bound]) -> Result<Self, GpuError> {
-        let composed = compose_pass(pass, &[])?;
+        Self::of_pass_with(pass, &[], bound)
+    }
+
+    /// [`Self::of_pass`] with shader defs `defs` set.
+    pub fn of_pass_with(pass: &str, defs: &[&str], bound: &[Bound]) -> Result<Self, GpuError> {
+        let composed = compose_pass(pass, defs)?;
         Self::of_module(&composed.module, pass, bound)
     }
 

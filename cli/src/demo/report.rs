@@ -6,7 +6,9 @@ use std::path::Path;
 
 use super::plots::{Chart, Series, line_chart};
 use super::reads::Reads;
-use super::upsampling::{CONTROLLER_SEEDS, METHODS, SHADING_WORK, SIGMA_N, SIGMA_Z, TARGET_MS};
+use super::upsampling::{
+    CONTROLLER_SEEDS, METHODS, ROUTES, SHADING_WORK, SIGMA_N, SIGMA_Z, TARGET_MS,
+};
 use super::{DemoError, DemoReport};
 
 fn write(path: &Path, text: &str) -> Result<(), DemoError> {
@@ -70,7 +72,7 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
         }
     }
     let u = &report.upsampling;
-    let by_r = (0..3)
+    let by_r = (0..METHODS.len())
         .map(|k| Series {
             name: METHODS[k].to_owned(),
             points: u.iter().map(|row| (row.r, row.psnr[k])).collect(),
@@ -88,9 +90,10 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
             y_from_zero: false,
         },
     )?;
-    let by_speed = [(1usize, 0usize), (2, 1)]
+    let by_speed = ROUTES
         .iter()
-        .map(|&(k, s)| Series {
+        .enumerate()
+        .map(|(s, &(_, k))| Series {
             name: METHODS[k].to_owned(),
             points: u
                 .iter()
@@ -242,9 +245,13 @@ fn upsample_table(report: &DemoReport) -> Table {
             "PSNR bilinear",
             "PSNR bilateral",
             "PSNR fine-grained",
+            "PSNR bilateral, packed L",
+            "PSNR fine-grained, packed L",
             "SSIM bilinear",
             "SSIM bilateral",
             "SSIM fine-grained",
+            "SSIM bilateral, packed L",
+            "SSIM fine-grained, packed L",
         ],
         rows: report
             .upsampling
@@ -265,6 +272,8 @@ fn speed_table(report: &DemoReport) -> Table {
             "r",
             "whole frame, bilateral route",
             "whole frame, fine-grained route",
+            "whole frame, bilateral route, packed L",
+            "whole frame, fine-grained route, packed L",
         ],
         rows: report
             .upsampling
@@ -393,7 +402,7 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     q.push_str("\n## Framebuffer LOD\n\n");
     let _ = writeln!(
         q,
-        "Edge scene with synthetic shading work (a smooth sky term summed over {SHADING_WORK} directions per fragment, the expensive low-frequency shading framebuffer LOD is for), full-resolution frame as reference; bilateral sigma_z = {SIGMA_Z}, sigma_n = {SIGMA_N}; fine-grained resizing sends only the lighting through the low-res buffer, and its upsample pass multiplies by the full-resolution albedo (the image measured is the one the timed frame produces).\n"
+        "Edge scene with synthetic shading work (a smooth sky term summed over {SHADING_WORK} directions per fragment, the expensive low-frequency shading framebuffer LOD is for), full-resolution frame as reference; bilateral sigma_z = {SIGMA_Z}, sigma_n = {SIGMA_N}; fine-grained resizing sends only the lighting through the low-res buffer, and its upsample pass multiplies by the full-resolution albedo (the image measured is the one the timed frame produces); \"packed L\" reads lodkit::gbuffer's packed texel (HDR color as halves, depth, normal: 4 low-res loads per pixel instead of 8).\n"
     );
     q.push_str(&upsample_table(report).markdown());
     // The controllers on the real frame are the headline; the simulation stands beside them.

@@ -113,7 +113,8 @@ pub fn plain_pass(
     fullscreen_pipeline(gpu, &module, FORMAT, name)
 }
 
-const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Target format of the timed passes.
+pub(super) const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// A fullscreen pass reading color, id word and depth of both buffers and the object motion at
 /// the pixel, summed so none is optimized away; `$depth` adds more to the depth sum.
@@ -151,7 +152,8 @@ const COPY7: &str = buffer_reads!("");
 const LOADS8: &str =
     buffer_reads!(" + textureLoad(f, min(p + 1u, textureDimensions(f, 0) - 1u), 0).x");
 
-const BILINEAR: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
+/// The bilinear baseline: one hardware-filtered sample of L.
+pub(super) const BILINEAR: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 @group(0) @binding(0) var low_color: texture_2d<f32>;
 @group(0) @binding(1) var low_sampler: sampler;
@@ -187,7 +189,7 @@ struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 /// A baseline pass timed as lodkit's passes run: its bind group built and its uniform (if any)
 /// written per call inside the same error scopes ([`GpuContext::guarded`]), then submit and
 /// wait. The lodkit pass and its baseline so do the same host work per call.
-fn draw_fullscreen(
+pub(super) fn draw_fullscreen(
     gpu: &GpuContext,
     pipeline: &wgpu::RenderPipeline,
     group: &dyn Fn() -> Result<wgpu::BindGroup, GpuError>,

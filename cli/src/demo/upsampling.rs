@@ -1,6 +1,7 @@
 //! Framebuffer LOD on the edge scene: PSNR and SSIM against the full-resolution reference at
-//! several resize factors for bilinear, bilateral and fine-grained resizing, comparison sheets
-//! with difference heat maps, whole-frame speed-ups, and the framerate controllers.
+//! several resize factors for bilinear, bilateral and fine-grained resizing (the last two also
+//! from a packed L, read with 4 loads per pixel instead of 8), comparison sheets with difference
+//! heat maps, whole-frame speed-ups, and the framerate controllers.
 
 use std::path::Path;
 
@@ -36,17 +37,31 @@ pub const SIGMA_N: f32 = 0.4;
 pub struct UpsampleRow {
     /// Resize factor r (the low-res buffer is 1/r of the size in each direction).
     pub r: f32,
-    /// PSNR (dB) of bilinear, bilateral and fine-grained resizing.
-    pub psnr: [f32; 3],
-    /// SSIM of the same three.
-    pub ssim: [f32; 3],
-    /// Whole-frame speed-up over rendering at full resolution (median wall time ratio) for the
-    /// bilateral route and the fine-grained route.
-    pub speedup: [f64; 2],
+    /// PSNR (dB) of each of [`METHODS`].
+    pub psnr: [f32; 5],
+    /// SSIM of the same.
+    pub ssim: [f32; 5],
+    /// Whole-frame speed-up over rendering at full resolution (median wall time ratio) for each
+    /// of [`ROUTES`].
+    pub speedup: [f64; 4],
 }
 
-/// Method names in the order of [`UpsampleRow::psnr`].
-pub const METHODS: [&str; 3] = ["bilinear", "bilateral", "fine-grained"];
+/// Method names in the order of [`UpsampleRow::psnr`]: the last two read a packed L.
+pub const METHODS: [&str; 5] = [
+    "bilinear",
+    "bilateral",
+    "fine-grained",
+    "bilateral, packed L",
+    "fine-grained, packed L",
+];
+
+/// Whole-frame routes in the order of [`UpsampleRow::speedup`], and the method of each.
+pub const ROUTES: [(&str, usize); 4] = [
+    ("bilateral route", 1),
+    ("fine-grained route", 2),
+    ("bilateral route, packed L", 3),
+    ("fine-grained route, packed L", 4),
+];
 
 fn heat(image: &[u8], reference: &[u8]) -> Vec<u8> {
     image
@@ -77,46 +92,63 @@ pub fn measure_upsampling(
     let full = LowResBuffer::new(gpu, w, h, format)?;
     scene.render(gpu, &full, 1.0)?;
     let reference = read_texture_rgba8(gpu, full.color())?;
-    let low = LowResBuffer::new(gpu, w, h, format)?;
+    let lows = [
+        LowResBuffer::new(gpu, w, h, format)?,
+        LowResBuffer::packed(gpu, w, h)?,
+    ];
     let albedo = LowResBuffer::new(gpu, w, h, format)?;
-    let upsample = UpsamplePass::new(gpu, format)?;
-    let fine_pass = UpsamplePass::fine_grained(gpu, format)?;
+    let upsample = [
+        UpsamplePass::new(gpu, format)?,
+        UpsamplePass::packed(gpu, format)?,
+    ];
+    let fine_pass = [
+        UpsamplePass::fine_grained(gpu, format)?,
+        UpsamplePass::packed_fine_grained(gpu, format)?,
+    ];
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = texture_2d(gpu, size, format, usage, "upsampled")?;
     let view = target.create_view(&Default::default());
-    let upsample_with = |r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
+    // `p` picks the layout of L: 0 color + geometry, 1 packed.
+    let upsample_with = |p: usize, r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        upsample.encode(gpu, &mut encoder, &low, r, geometry, sz, sn, &view)?;
+        upsample[p].encode(gpu, &mut encoder, &lows[p], r, geometry, sz, sn, &view)?;
         gpu.queue.submit([encoder.finish()]);
         Ok::<(), GpuError>(())
     };
     // Fine-grained: the upsampled lighting times the full-resolution albedo, in the upsample.
-    let fine_with = |r: f32| {
+    let fine_with = |p: usize, r: f32| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let (g, a, (sz, sn)) = (albedo.geometry(), albedo.color(), (SIGMA_Z, SIGMA_N));
-        fine_pass.encode_fine_grained(gpu, &mut encoder, &low, r, g, a, sz, sn, &view)?;
+        fine_pass[p].encode_fine_grained(gpu, &mut encoder, &lows[p], r, g, a, sz, sn, &view)?;
         gpu.queue.submit([encoder.finish()]);
         Ok::<(), GpuError>(())
     };
     let mut rows = Vec::new();
     for r in RESIZE_FACTORS {
-        scene.render(gpu, &low, r)?;
-        upsample_with(r, full.geometry(), f32::INFINITY, f32::INFINITY)?;
-        let bilinear = read_texture_rgba8(gpu, &target)?;
-        upsample_with(r, full.geometry(), SIGMA_Z, SIGMA_N)?;
-        let bilateral = read_texture_rgba8(gpu, &target)?;
+        let mut images = Vec::new();
+        scene.render(gpu, &lows[0], r)?;
+        upsample_with(0, r, full.geometry(), f32::INFINITY, f32::INFINITY)?;
+        images.push(read_texture_rgba8(gpu, &target)?);
+        upsample_with(0, r, full.geometry(), SIGMA_Z, SIGMA_N)?;
+        images.push(read_texture_rgba8(gpu, &target)?);
         // Fine-grained: only the lighting goes through the low-res buffer; the upsample pass
         // multiplies it by the full-res albedo (the frame the timing below measures).
         scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
-        scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
-        fine_with(r)?;
-        let fine = read_texture_rgba8(gpu, &target)?;
-        let images = [bilinear, bilateral, fine];
-        let psnr = images.clone().map(|i| psnr_rgba8(&i, &reference));
-        let ssim = images.clone().map(|i| ssim_rgba8(&i, &reference, w));
+        scene.render_term(gpu, &lows[0], r, ShadingTerm::Lighting)?;
+        fine_with(0, r)?;
+        images.push(read_texture_rgba8(gpu, &target)?);
+        // The same two from a packed L.
+        scene.render(gpu, &lows[1], r)?;
+        upsample_with(1, r, full.geometry(), SIGMA_Z, SIGMA_N)?;
+        images.push(read_texture_rgba8(gpu, &target)?);
+        scene.render_term(gpu, &lows[1], r, ShadingTerm::Lighting)?;
+        fine_with(1, r)?;
+        images.push(read_texture_rgba8(gpu, &target)?);
+        let psnr: [f32; 5] = std::array::from_fn(|k| psnr_rgba8(&images[k], &reference));
+        let ssim: [f32; 5] = std::array::from_fn(|k| ssim_rgba8(&images[k], &reference, w));
         let mut sheet = image::RgbaImage::from_pixel(w * 4, h * 2, image::Rgba([24, 24, 32, 255]));
         let mut tiles = vec![(0, 0, reference.clone())];
-        for (k, img) in images.iter().enumerate() {
+        for (k, img) in images.iter().take(3).enumerate() {
             tiles.push((k as u32 + 1, 0, img.clone()));
             tiles.push((k as u32 + 1, 1, heat(img, &reference)));
         }
@@ -130,14 +162,14 @@ pub fn measure_upsampling(
             r,
             psnr,
             ssim,
-            speedup: [0.0; 2],
+            speedup: [0.0; 4],
         });
         tick(&format!("r = {r}"));
     }
     // Whole frames, interleaved round by round: full-res shading against a full-res geometry
     // prepass (with the cheap albedo) + low-res shading + upsample, and against the fine-grained
     // route (full-res albedo, which writes the geometry too, + low-res lighting + the upsample
-    // that multiplies them: the frame whose image is measured above).
+    // that multiplies them: the frame whose image is measured above); each from both layouts.
     let prepass = LowResBuffer::new(gpu, w, h, format)?;
     let time = |f: &dyn Fn() -> Result<(), GpuError>| {
         wall_ms(&|| {
@@ -146,34 +178,34 @@ pub fn measure_upsampling(
         })
     };
     let mut base = Vec::new();
-    let mut times = vec![[Vec::new(), Vec::new()]; RESIZE_FACTORS.len()];
+    let mut times = vec![vec![Vec::new(); ROUTES.len()]; RESIZE_FACTORS.len()];
     for round in 0..rounds + 2 {
         let t0 = time(&|| scene.render(gpu, &full, 1.0))?;
         let mut ts = Vec::new();
         for &r in &RESIZE_FACTORS {
-            let a = time(&|| {
-                scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo)?;
-                scene.render(gpu, &low, r)?;
-                upsample_with(r, prepass.geometry(), SIGMA_Z, SIGMA_N)
-            })?;
-            let b = time(&|| {
-                scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
-                scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
-                fine_with(r)
-            })?;
-            ts.push([a, b]);
+            for (p, low) in lows.iter().enumerate() {
+                ts.push(time(&|| {
+                    scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo)?;
+                    scene.render(gpu, low, r)?;
+                    upsample_with(p, r, prepass.geometry(), SIGMA_Z, SIGMA_N)
+                })?);
+                ts.push(time(&|| {
+                    scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
+                    scene.render_term(gpu, low, r, ShadingTerm::Lighting)?;
+                    fine_with(p, r)
+                })?);
+            }
         }
         if round >= 2 {
             base.push(t0);
             for (k, t) in ts.into_iter().enumerate() {
-                times[k][0].push(t[0]);
-                times[k][1].push(t[1]);
+                times[k / ROUTES.len()][k % ROUTES.len()].push(t);
             }
         }
     }
     let base = median(&base);
     for (row, t) in rows.iter_mut().zip(&times) {
-        row.speedup = [base / median(&t[0]), base / median(&t[1])];
+        row.speedup = std::array::from_fn(|k| base / median(&t[k]));
     }
     tick("timing");
     Ok(rows)

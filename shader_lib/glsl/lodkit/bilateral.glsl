@@ -10,14 +10,21 @@
 //   lodkit_bilateral_tent(f) -> vec4
 //   lodkit_bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> float
 //   lodkit_bilateral_upsample(f, values, depths, normals, depth, normal, sigma_z, sigma_n) -> vec4
+//   lodkit_bilateral_upsample_projected(f, values, depths, projected, depth, here, sigma_z,
+//       sigma_n) -> vec4
 //   lodkit_bilateral_low_position(frag_coord, low_viewport, full_size) -> vec2
 //   lodkit_bilateral_cell_origin(p, low_viewport) -> vec2
 //   lodkit_bilateral_cell_fraction(frag_coord, low_viewport, full_size) -> vec2
 //   lodkit_bilateral_cell_texel(frag_coord, low_viewport, full_size, i) -> uvec2
+//   lodkit_bilateral_cell_corners(origin, low_viewport) -> uvec4
 //   lodkit_bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n) -> vec4
 //   lodkit_bilateral_upsample_at(low_color, low_geometry, low_viewport, full_size, frag_coord,
 //       depth, normal, sigma_z, sigma_n) -> vec4   a macro: takes a sampler2D (OpenGL) or
 //       sampler2D(texture, sampler) (Vulkan) for each texture
+//   lodkit_bilateral_upsample_packed(f, texels, depth, normal, sigma_z, sigma_n) -> vec4
+//   lodkit_bilateral_upsample_packed_at(low, low_viewport, full_size, frag_coord, depth, normal,
+//       sigma_z, sigma_n) -> vec4   a macro: takes a usampler2D (OpenGL) or
+//       usampler2D(texture, sampler) (Vulkan); four texel fetches (the fold-in upsample)
 // Shader defs: none.
 #ifndef LODKIT_BILATERAL_GLSL
 #define LODKIT_BILATERAL_GLSL
@@ -46,19 +53,19 @@ float lodkit_bilateral_weight(float tent, float depth_diff, float normal_dist, f
     return tent * exp(-0.5 * (z * z + n * n));
 }
 
-/// Eq. 1 over the 2x2 low-res samples, with the closest-depth fallback (the first of equals);
-/// no loop or dynamic indexing, the normal distance squared.
-vec4 lodkit_bilateral_upsample(vec2 f, vec4 values[4], vec4 depths, vec3 normals[4], float depth, vec3 normal, float sigma_z, float sigma_n) {
+/// Eq. 1 with the normals already through the foreshortening map (`projected`, `here`), with the
+/// closest-depth fallback (the first of equals); no loop or dynamic indexing, the normal distance
+/// squared.
+vec4 lodkit_bilateral_upsample_projected(vec2 f, vec4 values[4], vec4 depths, vec2 projected[4], float depth, vec2 here, float sigma_z, float sigma_n) {
     // Differences scaled by 1 / sigma (0 for sigma = +inf: no range term).
     float inv_z = 1.0 / sigma_z;
     float inv_n = 1.0 / sigma_n;
-    vec2 here = lodkit_foreshortened_normal(normal);
     vec4 dz = depths - depth;
     vec4 z = dz * inv_z;
-    vec2 n0 = (lodkit_foreshortened_normal(normals[0]) - here) * inv_n;
-    vec2 n1 = (lodkit_foreshortened_normal(normals[1]) - here) * inv_n;
-    vec2 n2 = (lodkit_foreshortened_normal(normals[2]) - here) * inv_n;
-    vec2 n3 = (lodkit_foreshortened_normal(normals[3]) - here) * inv_n;
+    vec2 n0 = (projected[0] - here) * inv_n;
+    vec2 n1 = (projected[1] - here) * inv_n;
+    vec2 n2 = (projected[2] - here) * inv_n;
+    vec2 n3 = (projected[3] - here) * inv_n;
     vec4 nn = vec4(dot(n0, n0), dot(n1, n1), dot(n2, n2), dot(n3, n3));
     vec4 w = lodkit_bilateral_tent(f) * exp(-0.5 * (z * z + nn));
     float total = w.x + w.y + w.z + w.w;
@@ -67,7 +74,13 @@ vec4 lodkit_bilateral_upsample(vec2 f, vec4 values[4], vec4 depths, vec3 normals
         float m = min(min(a.x, a.y), min(a.z, a.w));
         return a.x == m ? values[0] : (a.y == m ? values[1] : (a.z == m ? values[2] : values[3]));
     }
-    return (w.x * values[0] + w.y * values[1] + w.z * values[2] + w.w * values[3]) / total;
+    return (w.x * values[0] + w.y * values[1] + w.z * values[2] + w.w * values[3]) * (1.0 / total);
+}
+
+/// Eq. 1 over the 2x2 low-res samples; the sample closest in depth when the weights vanish.
+vec4 lodkit_bilateral_upsample(vec2 f, vec4 values[4], vec4 depths, vec3 normals[4], float depth, vec3 normal, float sigma_z, float sigma_n) {
+    vec2 projected[4] = vec2[4](lodkit_foreshortened_normal(normals[0]), lodkit_foreshortened_normal(normals[1]), lodkit_foreshortened_normal(normals[2]), lodkit_foreshortened_normal(normals[3]));
+    return lodkit_bilateral_upsample_projected(f, values, depths, projected, depth, lodkit_foreshortened_normal(normal), sigma_z, sigma_n);
 }
 
 /// Continuous position of a full-res pixel in L's texel grid (texel centers at integers).
@@ -110,6 +123,33 @@ vec4 lodkit_bilateral_upsample_texels(vec2 f, vec4 colors[4], vec4 geometry[4], 
                 LODKIT_BILATERAL_FETCH_(low_color, frag_coord, low_viewport, full_size, 2u), LODKIT_BILATERAL_FETCH_(low_color, frag_coord, low_viewport, full_size, 3u)), \
         vec4[4](LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 0u), LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 1u), \
                 LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 2u), LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 3u)), \
+        (depth), (normal), (sigma_z), (sigma_n))
+
+/// Texels 0 and 3 of the cell at `origin`, (x0, y0, x1, y1), clamped to the viewport.
+uvec4 lodkit_bilateral_cell_corners(vec2 origin, vec2 low_viewport) {
+    uvec2 last = uvec2(max(low_viewport - 1.0, vec2(0.0)));
+    return uvec4(min(uvec2(origin), last), min(uvec2(origin) + 1u, last));
+}
+
+/// Eq. 1 from four packed L texels (lodkit gbuffer packed layout).
+vec4 lodkit_bilateral_upsample_packed(vec2 f, uvec4 texels[4], float depth, vec3 normal, float sigma_z, float sigma_n) {
+    vec4 values[4] = vec4[4](lodkit_gbuffer_texel_color(texels[0]), lodkit_gbuffer_texel_color(texels[1]), lodkit_gbuffer_texel_color(texels[2]), lodkit_gbuffer_texel_color(texels[3]));
+    vec4 depths = vec4(lodkit_gbuffer_texel_depth(texels[0]), lodkit_gbuffer_texel_depth(texels[1]), lodkit_gbuffer_texel_depth(texels[2]), lodkit_gbuffer_texel_depth(texels[3]));
+    vec2 projected[4] = vec2[4](lodkit_gbuffer_texel_projected_normal(texels[0]), lodkit_gbuffer_texel_projected_normal(texels[1]), lodkit_gbuffer_texel_projected_normal(texels[2]), lodkit_gbuffer_texel_projected_normal(texels[3]));
+    return lodkit_bilateral_upsample_projected(f, values, depths, projected, depth, lodkit_foreshortened_normal(normal), sigma_z, sigma_n);
+}
+
+#define LODKIT_BILATERAL_CORNERS_(fc, vp, fs) lodkit_bilateral_cell_corners(lodkit_bilateral_cell_origin(lodkit_bilateral_low_position((fc), (vp), (fs)), (vp)), (vp))
+#define LODKIT_BILATERAL_CORNER_(tex, c, cx, cy) texelFetch((tex), ivec2((c).cx, (c).cy), 0)
+
+/// The full lookup from a packed L: four texel fetches, then eq. 1 (the fold-in upsample).
+#define lodkit_bilateral_upsample_packed_at(low, low_viewport, full_size, frag_coord, depth, normal, sigma_z, sigma_n) \
+    lodkit_bilateral_upsample_packed( \
+        lodkit_bilateral_cell_fraction((frag_coord), (low_viewport), (full_size)), \
+        uvec4[4](LODKIT_BILATERAL_CORNER_(low, LODKIT_BILATERAL_CORNERS_(frag_coord, low_viewport, full_size), x, y), \
+                 LODKIT_BILATERAL_CORNER_(low, LODKIT_BILATERAL_CORNERS_(frag_coord, low_viewport, full_size), z, y), \
+                 LODKIT_BILATERAL_CORNER_(low, LODKIT_BILATERAL_CORNERS_(frag_coord, low_viewport, full_size), x, w), \
+                 LODKIT_BILATERAL_CORNER_(low, LODKIT_BILATERAL_CORNERS_(frag_coord, low_viewport, full_size), z, w)), \
         (depth), (normal), (sigma_z), (sigma_n))
 
 #endif // LODKIT_BILATERAL_GLSL

@@ -18,21 +18,32 @@
 //   bilateral_tent(f) -> vec4<f32>   bilinear weights of the 2x2 samples at fraction f
 //   bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> f32   one term of eq. 1
 //   bilateral_upsample(f, values, depths, normals, depth, normal, sigma_z, sigma_n) -> vec4<f32>
+//   bilateral_upsample_projected(f, values, depths, projected, depth, here, sigma_z, sigma_n)
+//       -> vec4<f32>   eq. 1 with the normals already through the foreshortening map
 //   bilateral_low_position(frag_coord, low_viewport, full_size) -> vec2<f32>   position in L's grid
 //   bilateral_cell_origin(p, low_viewport) -> vec2<f32>   top-left texel of the 2x2 cell
 //   bilateral_cell_fraction(frag_coord, low_viewport, full_size) -> vec2<f32>   f of a full-res pixel
 //   bilateral_cell_texel(frag_coord, low_viewport, full_size, i) -> vec2<u32>   its 2x2 L texels
+//   bilateral_cell_corners(origin, low_viewport) -> vec4<u32>   (x0, y0, x1, y1): texels 0 and 3
+//       of the cell at `origin` (bilateral_cell_origin), clamped to the viewport
+//       (1 = (x1, y0), 2 = (x0, y1))
 //   bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n) -> vec4<f32>
 //       eq. 1 from four fetched L color and geometry texels (lodkit::gbuffer layout)
 //   bilateral_upsample_at(low_color, low_geometry, low_viewport, full_size, frag_coord, depth,
 //       normal, sigma_z, sigma_n) -> vec4<f32>   the whole lookup, for a geometry pass that
 //       re-renders the scene at full resolution (the paper's route) or a fullscreen pass
+//   bilateral_upsample_packed(f, texels, depth, normal, sigma_z, sigma_n) -> vec4<f32>
+//       eq. 1 from four packed L texels (lodkit::gbuffer's packed layout)
+//   bilateral_upsample_packed_at(low, low_viewport, full_size, frag_coord, depth, normal,
+//       sigma_z, sigma_n) -> vec4<f32>   the whole lookup from a packed L: four texel loads. The
+//       fold-in upsample: a composite or tonemap pass that already holds the pixel's depth and
+//       normal calls it and needs no upsample pass of its own
 // L is drawn into the top-left `low_viewport` texels of textures of any size; full_size is the
 // full-resolution target's size.
 // Shader defs: none.
 #define_import_path lodkit::bilateral
 #import lodkit::normal_distance::foreshortened_normal
-#import lodkit::gbuffer::{gbuffer_depth, gbuffer_normal}
+#import lodkit::gbuffer::{gbuffer_depth, gbuffer_normal, gbuffer_texel_color, gbuffer_texel_depth, gbuffer_texel_projected_normal}
 
 /// Sum of weights below which eq. 1 falls back to the sample closest in depth.
 const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
@@ -56,11 +67,43 @@ fn bilateral_weight(tent: f32, depth_diff: f32, normal_dist: f32, sigma_z: f32, 
     return tent * exp(-0.5 * (z * z + n * n));
 }
 
+/// Eq. 1 as bilateral_upsample, with the samples' and the pixel's normals given through the
+/// foreshortening map (`projected`, `here`: foreshortened_normal of each).
+/// Written without loops or dynamic indexing (four lanes of one vec4), and with the squared
+/// normal distance instead of a square root: a software rasterizer runs this per pixel.
+fn bilateral_upsample_projected(
+    f: vec2<f32>,
+    values: array<vec4<f32>, 4>,
+    depths: vec4<f32>,
+    projected: array<vec2<f32>, 4>,
+    depth: f32,
+    here: vec2<f32>,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> vec4<f32> {
+    // Differences scaled by 1 / sigma (0 for sigma = +inf: no range term).
+    let inv_z = 1.0 / sigma_z;
+    let inv_n = 1.0 / sigma_n;
+    let dz = depths - depth;
+    let z = dz * inv_z;
+    let n0 = (projected[0] - here) * inv_n;
+    let n1 = (projected[1] - here) * inv_n;
+    let n2 = (projected[2] - here) * inv_n;
+    let n3 = (projected[3] - here) * inv_n;
+    let nn = vec4<f32>(dot(n0, n0), dot(n1, n1), dot(n2, n2), dot(n3, n3));
+    let w = bilateral_tent(f) * exp(-0.5 * (z * z + nn));
+    let total = w.x + w.y + w.z + w.w;
+    if (total < BILATERAL_MIN_WEIGHT) {
+        let a = abs(dz);
+        let m = min(min(a.x, a.y), min(a.z, a.w));
+        return select(select(select(values[3], values[2], a.z == m), values[1], a.y == m), values[0], a.x == m);
+    }
+    return (w.x * values[0] + w.y * values[1] + w.z * values[2] + w.w * values[3]) * (1.0 / total);
+}
+
 /// Eq. 1 over the 2x2 low-res samples (`values`, `depths`, `normals`) for a full-res pixel at
 /// fraction `f` between them with depth `depth` and normal `normal`. Falls back to the sample
 /// closest in depth (the first of equals) when the weights sum below BILATERAL_MIN_WEIGHT.
-/// Written without loops or dynamic indexing (four lanes of one vec4), and with the squared
-/// normal distance instead of a square root: a software rasterizer runs this per pixel.
 fn bilateral_upsample(
     f: vec2<f32>,
     values: array<vec4<f32>, 4>,
@@ -71,25 +114,8 @@ fn bilateral_upsample(
     sigma_z: f32,
     sigma_n: f32,
 ) -> vec4<f32> {
-    // Differences scaled by 1 / sigma (0 for sigma = +inf: no range term).
-    let inv_z = 1.0 / sigma_z;
-    let inv_n = 1.0 / sigma_n;
-    let here = foreshortened_normal(normal);
-    let dz = depths - depth;
-    let z = dz * inv_z;
-    let n0 = (foreshortened_normal(normals[0]) - here) * inv_n;
-    let n1 = (foreshortened_normal(normals[1]) - here) * inv_n;
-    let n2 = (foreshortened_normal(normals[2]) - here) * inv_n;
-    let n3 = (foreshortened_normal(normals[3]) - here) * inv_n;
-    let nn = vec4<f32>(dot(n0, n0), dot(n1, n1), dot(n2, n2), dot(n3, n3));
-    let w = bilateral_tent(f) * exp(-0.5 * (z * z + nn));
-    let total = w.x + w.y + w.z + w.w;
-    if (total < BILATERAL_MIN_WEIGHT) {
-        let a = abs(dz);
-        let m = min(min(a.x, a.y), min(a.z, a.w));
-        return select(select(select(values[3], values[2], a.z == m), values[1], a.y == m), values[0], a.x == m);
-    }
-    return (w.x * values[0] + w.y * values[1] + w.z * values[2] + w.w * values[3]) / total;
+    let projected = array<vec2<f32>, 4>(foreshortened_normal(normals[0]), foreshortened_normal(normals[1]), foreshortened_normal(normals[2]), foreshortened_normal(normals[3]));
+    return bilateral_upsample_projected(f, values, depths, projected, depth, foreshortened_normal(normal), sigma_z, sigma_n);
 }
 
 /// Continuous position of a full-res pixel in L's texel grid (texel centers at integers).
@@ -132,7 +158,7 @@ fn bilateral_upsample_texels(
 
 /// The full lookup for the full-res pixel at `frag_coord` with `depth` and screen `normal`:
 /// fetches the 2x2 L texels from `low_color` and `low_geometry` and applies eq. 1. Eight texel
-/// loads, the cell computed once.
+/// loads.
 fn bilateral_upsample_at(
     low_color: texture_2d<f32>,
     low_geometry: texture_2d<f32>,
@@ -146,23 +172,69 @@ fn bilateral_upsample_at(
 ) -> vec4<f32> {
     let p = bilateral_low_position(frag_coord, low_viewport, full_size);
     let origin = bilateral_cell_origin(p, low_viewport);
-    let f = clamp(p - origin, vec2<f32>(0.0), vec2<f32>(1.0));
-    let last = vec2<u32>(max(low_viewport - 1.0, vec2<f32>(0.0)));
-    let t0 = min(vec2<u32>(origin), last);
-    let t3 = min(vec2<u32>(origin) + 1u, last);
-    let t1 = vec2<u32>(t3.x, t0.y);
-    let t2 = vec2<u32>(t0.x, t3.y);
+    let c = bilateral_cell_corners(origin, low_viewport);
     let colors = array<vec4<f32>, 4>(
-        textureLoad(low_color, t0, 0),
-        textureLoad(low_color, t1, 0),
-        textureLoad(low_color, t2, 0),
-        textureLoad(low_color, t3, 0),
+        textureLoad(low_color, c.xy, 0),
+        textureLoad(low_color, c.zy, 0),
+        textureLoad(low_color, c.xw, 0),
+        textureLoad(low_color, c.zw, 0),
     );
     let geometry = array<vec4<f32>, 4>(
-        textureLoad(low_geometry, t0, 0),
-        textureLoad(low_geometry, t1, 0),
-        textureLoad(low_geometry, t2, 0),
-        textureLoad(low_geometry, t3, 0),
+        textureLoad(low_geometry, c.xy, 0),
+        textureLoad(low_geometry, c.zy, 0),
+        textureLoad(low_geometry, c.xw, 0),
+        textureLoad(low_geometry, c.zw, 0),
     );
+    let f = clamp(p - origin, vec2<f32>(0.0), vec2<f32>(1.0));
     return bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n);
+}
+
+/// Texels 0 and 3 of the 2x2 cell whose top-left texel is `origin` (bilateral_cell_origin), as
+/// (x0, y0, x1, y1), clamped to the viewport; texel 1 is (x1, y0), texel 2 (x0, y1).
+fn bilateral_cell_corners(origin: vec2<f32>, low_viewport: vec2<f32>) -> vec4<u32> {
+    let last = vec2<u32>(max(low_viewport - 1.0, vec2<f32>(0.0)));
+    return vec4<u32>(min(vec2<u32>(origin), last), min(vec2<u32>(origin) + 1u, last));
+}
+
+/// Eq. 1 from four packed L texels (lodkit::gbuffer's packed layout) for a full-res pixel at
+/// fraction `f` with `depth` and screen `normal`.
+fn bilateral_upsample_packed(
+    f: vec2<f32>,
+    texels: array<vec4<u32>, 4>,
+    depth: f32,
+    normal: vec3<f32>,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> vec4<f32> {
+    let values = array<vec4<f32>, 4>(gbuffer_texel_color(texels[0]), gbuffer_texel_color(texels[1]), gbuffer_texel_color(texels[2]), gbuffer_texel_color(texels[3]));
+    let depths = vec4<f32>(gbuffer_texel_depth(texels[0]), gbuffer_texel_depth(texels[1]), gbuffer_texel_depth(texels[2]), gbuffer_texel_depth(texels[3]));
+    let projected = array<vec2<f32>, 4>(gbuffer_texel_projected_normal(texels[0]), gbuffer_texel_projected_normal(texels[1]), gbuffer_texel_projected_normal(texels[2]), gbuffer_texel_projected_normal(texels[3]));
+    return bilateral_upsample_projected(f, values, depths, projected, depth, foreshortened_normal(normal), sigma_z, sigma_n);
+}
+
+/// The full lookup from a packed L (rgba32uint, lodkit::gbuffer's packed layout) for the
+/// full-res pixel at `frag_coord` with `depth` and screen `normal`: four texel loads. Call it
+/// from the pass that already has the pixel's depth and normal (a composite or tonemap pass) and
+/// the upsample needs no pass of its own.
+fn bilateral_upsample_packed_at(
+    low: texture_2d<u32>,
+    low_viewport: vec2<f32>,
+    full_size: vec2<f32>,
+    frag_coord: vec2<f32>,
+    depth: f32,
+    normal: vec3<f32>,
+    sigma_z: f32,
+    sigma_n: f32,
+) -> vec4<f32> {
+    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
+    let origin = bilateral_cell_origin(p, low_viewport);
+    let c = bilateral_cell_corners(origin, low_viewport);
+    let texels = array<vec4<u32>, 4>(
+        textureLoad(low, c.xy, 0),
+        textureLoad(low, c.zy, 0),
+        textureLoad(low, c.xw, 0),
+        textureLoad(low, c.zw, 0),
+    );
+    let f = clamp(p - origin, vec2<f32>(0.0), vec2<f32>(1.0));
+    return bilateral_upsample_packed(f, texels, depth, normal, sigma_z, sigma_n);
 }
