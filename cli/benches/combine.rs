@@ -1,7 +1,9 @@
 //! GPU cost of the frame-sequential combine pass against a plain fullscreen pass that reads the
-//! same four textures (two colors, two id/depth) and writes one: the pass's own overhead.
+//! same seven textures (color, id and depth of both buffers, the object motion) and writes one:
+//! the pass's own overhead.
 //! Wall time per pass including submit and wait, so read the ratio, not the absolute figures,
-//! on a software GPU. `lodkit demo` measures the same ratio for its report.
+//! on a software GPU. `lodkit demo` measures the same ratio for its report. Then its floors: the
+//! 8 main-path loads alone, and those with the 4 loads of its id-mismatch branch all made.
 //!
 //! `cargo bench -p lodkit-cli --bench combine [-- SIZE PAIRS]` (default 512 x 512, 200 pairs)
 

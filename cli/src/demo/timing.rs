@@ -152,6 +152,17 @@ const COPY7: &str = buffer_reads!("");
 const LOADS8: &str =
     buffer_reads!(" + textureLoad(f, min(p + 1u, textureDimensions(f, 0) - 1u), 0).x");
 
+/// LOADS8 and the four older-id loads the combine makes under its id-mismatch branch (three side
+/// texels and the matched one), all made for every pixel: on a GPU that runs both sides of a
+/// divergent branch under a mask (llvmpipe), the floor of the combine as it is written.
+const LOADS12: &str = buffer_reads!(
+    " + textureLoad(f, min(p + 1u, textureDimensions(f, 0) - 1u), 0).x
+        + f32((textureLoad(e, min(p + vec2<u32>(1u, 0u), textureDimensions(e, 0) - 1u), 0).x
+        ^ textureLoad(e, min(p + vec2<u32>(0u, 1u), textureDimensions(e, 0) - 1u), 0).x
+        ^ textureLoad(e, min(p + 1u, textureDimensions(e, 0) - 1u), 0).x
+        ^ textureLoad(e, min(p + vec2<u32>(2u, 0u), textureDimensions(e, 0) - 1u), 0).x) & 1u)"
+);
+
 /// The bilinear baseline: one hardware-filtered sample of L.
 pub(super) const BILINEAR: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
@@ -219,12 +230,14 @@ pub const HOST_WORK: &str = "each call builds its bind group, writes its uniform
 /// The combine pass against a plain pass reading the same seven textures (color, id and depth of
 /// each buffer, the object motion) at `size` x `size`, on two LOD buffers of a grid of spheres
 /// and boxes with a third of them in transition and the camera moved between the frames; then,
-/// against the same baseline, the combine's eight main-path loads alone: its floor.
+/// against the same baseline, the combine's eight main-path loads alone (its floor), and those
+/// with the four loads of its id-mismatch branch all made (its floor where both sides of a
+/// divergent branch run).
 pub fn combine_vs_copy(
     gpu: &GpuContext,
     size: u32,
     pairs: usize,
-) -> Result<[PassRatio; 2], GpuError> {
+) -> Result<[PassRatio; 3], GpuError> {
     let buffers = LodBuffers::new(gpu, size, size, FORMAT)?;
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
     let renderer = LodBufferRenderer::new(gpu, FORMAT, &vis, 0.25)?;
@@ -278,23 +291,22 @@ pub fn combine_vs_copy(
     let target_view = target.create_view(&Default::default());
     let combine = CombinePass::new(gpu, FORMAT, false)?;
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
-    let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-        source: COPY7,
-        file_path: "copy7.wgsl",
-        ..Default::default()
-    })?;
-    let module = gpu.shader_module("copy7.wgsl", &composed)?;
     let mut entries = CombinePass::buffer_layout_entries(0);
     entries.push(CombinePass::motion_layout_entry(6));
     let (layout, pipeline_layout) = one_group_layout(gpu, &entries, "copy7");
-    let copy7 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "copy7")?;
-    let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-        source: LOADS8,
-        file_path: "loads8.wgsl",
-        ..Default::default()
-    })?;
-    let module = gpu.shader_module("loads8.wgsl", &composed)?;
-    let loads8 = fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), "loads8")?;
+    // The baselines bind the combine's textures in its layout.
+    let pipeline = |source: &str, name: &str| {
+        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
+            source,
+            file_path: name,
+            ..Default::default()
+        })?;
+        let module = gpu.shader_module(name, &composed)?;
+        fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), name)
+    };
+    let copy7 = pipeline(COPY7, "copy7.wgsl")?;
+    let loads8 = pipeline(LOADS8, "loads8.wgsl")?;
+    let loads12 = pipeline(LOADS12, "loads12.wgsl")?;
     let textures = [1, 0].map(|i| [buffers.color(i), buffers.id(i), buffers.depth(i)]);
     let mut textures = textures.as_flattened().to_vec();
     // LodBuffers::new has the motion target.
@@ -308,6 +320,7 @@ pub fn combine_vs_copy(
     };
     let run_copy = || draw_fullscreen(gpu, &copy7, &group, None, &target_view);
     let run_loads = || draw_fullscreen(gpu, &loads8, &group, None, &target_view);
+    let run_loads12 = || draw_fullscreen(gpu, &loads12, &group, None, &target_view);
     // Counted from the shaders: the copy reads color, id and depth of each buffer and the object
     // motion; the combine the same, the older depth at its first estimate, and under branches
     // the older ids of its search.
@@ -329,6 +342,7 @@ pub fn combine_vs_copy(
     combine_formats.push(("object_motion", MOTION_FORMAT, Texels::One));
     let combine_reads = Reads::of_pass("combine", &combine_formats)?;
     let loads_reads = Reads::of_source(LOADS8, "loads8.wgsl", &copy_formats)?;
+    let loads12_reads = Reads::of_source(LOADS12, "loads12.wgsl", &copy_formats)?;
     let time = |pass: &str, reads: Reads, run: &dyn Fn() -> Result<(), GpuError>| {
         let (pass_ms, baseline_ms, ratio) = interleaved(run, &run_copy, pairs)?;
         Ok::<_, GpuError>(PassRatio {
@@ -349,6 +363,11 @@ pub fn combine_vs_copy(
             "the combine's 8 main-path loads alone",
             loads_reads,
             &run_loads,
+        )?,
+        time(
+            "the same and the 4 loads of its id-mismatch branch, all made",
+            loads12_reads,
+            &run_loads12,
         )?,
     ])
 }
