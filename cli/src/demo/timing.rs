@@ -17,8 +17,8 @@ use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::EdgeScene;
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::{
-    begin_color_pass, fullscreen_pipeline, fullscreen_pipeline_with, one_group_layout, texture_2d,
-    textures_and_uniform, uniform_buffer,
+    begin_color_pass, fullscreen_pipeline_with, one_group_layout, texture_2d, textures_and_uniform,
+    uniform_buffer,
 };
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::gpu::{GpuContext, GpuError};
@@ -104,13 +104,23 @@ pub fn plain_pass(
     source: &str,
     name: &str,
 ) -> Result<wgpu::RenderPipeline, GpuError> {
+    plain_pass_with(gpu, source, name, None)
+}
+
+/// [`plain_pass`] with an explicit pipeline `layout` (`None`: derived from the shader).
+fn plain_pass_with(
+    gpu: &GpuContext,
+    source: &str,
+    name: &str,
+    layout: Option<&wgpu::PipelineLayout>,
+) -> Result<wgpu::RenderPipeline, GpuError> {
     let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
         source,
         file_path: name,
         ..Default::default()
     })?;
     let module = gpu.shader_module(name, &composed)?;
-    fullscreen_pipeline(gpu, &module, FORMAT, name)
+    fullscreen_pipeline_with(gpu, &module, FORMAT, layout, name)
 }
 
 /// Target format of the timed passes.
@@ -295,15 +305,7 @@ pub fn combine_vs_copy(
     entries.push(CombinePass::motion_layout_entry(6));
     let (layout, pipeline_layout) = one_group_layout(gpu, &entries, "copy7");
     // The baselines bind the combine's textures in its layout.
-    let pipeline = |source: &str, name: &str| {
-        let composed = ShaderLibrary::new()?.compose(&ComposeDescriptor {
-            source,
-            file_path: name,
-            ..Default::default()
-        })?;
-        let module = gpu.shader_module(name, &composed)?;
-        fullscreen_pipeline_with(gpu, &module, FORMAT, Some(&pipeline_layout), name)
-    };
+    let pipeline = |source, name| plain_pass_with(gpu, source, name, Some(&pipeline_layout));
     let copy7 = pipeline(COPY7, "copy7.wgsl")?;
     let loads8 = pipeline(LOADS8, "loads8.wgsl")?;
     let loads12 = pipeline(LOADS12, "loads12.wgsl")?;
