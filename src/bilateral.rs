@@ -147,10 +147,41 @@ pub fn bilateral_cell_origin(p: Vec2, low_viewport: Vec2) -> Vec2 {
         .clamp(Vec2::ZERO, (low_viewport - 2.0).max(Vec2::ZERO))
 }
 
+/// The 2x2 cell of a full-res pixel (Rust twin of the shaders' `BilateralCell`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BilateralCell {
+    /// Texels 0 and 3 as (x0, y0, x1, y1), clamped to the viewport; texel 1 is (x1, y0),
+    /// texel 2 (x0, y1).
+    pub corners: UVec4,
+    /// The pixel's fraction between them.
+    pub fraction: Vec2,
+}
+
+/// The cell of the full-res pixel at `frag_coord`: what every lookup fetches.
+///
+/// ```
+/// # use lodkit::bilateral::*;
+/// # use glam::{UVec4, Vec2};
+/// // r = 2, the last full-res column: the cell is clamped to the 5-texel viewport.
+/// let cell = bilateral_cell(Vec2::new(9.5, 0.5), Vec2::new(5.0, 4.0), Vec2::new(10.0, 8.0));
+/// assert_eq!(cell.corners, UVec4::new(3, 0, 4, 1));
+/// assert_eq!(cell.fraction, Vec2::new(1.0, 0.0));
+/// ```
+pub fn bilateral_cell(frag_coord: Vec2, low_viewport: Vec2, full_size: Vec2) -> BilateralCell {
+    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
+    let origin = bilateral_cell_origin(p, low_viewport);
+    let last = (low_viewport - 1.0).max(Vec2::ZERO).as_uvec2();
+    let first = origin.as_uvec2();
+    let (t0, t3) = (first.min(last), (first + 1).min(last));
+    BilateralCell {
+        corners: UVec4::new(t0.x, t0.y, t3.x, t3.y),
+        fraction: (p - origin).clamp(Vec2::ZERO, Vec2::ONE),
+    }
+}
+
 /// Fraction between the 2x2 L texels of the full-res pixel at `frag_coord`.
 pub fn bilateral_cell_fraction(frag_coord: Vec2, low_viewport: Vec2, full_size: Vec2) -> Vec2 {
-    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
-    (p - bilateral_cell_origin(p, low_viewport)).clamp(Vec2::ZERO, Vec2::ONE)
+    bilateral_cell(frag_coord, low_viewport, full_size).fraction
 }
 
 /// L texel `i` (0..3) of the 2x2 cell of the full-res pixel at `frag_coord`.
@@ -160,30 +191,11 @@ pub fn bilateral_cell_texel(
     full_size: Vec2,
     i: u32,
 ) -> UVec2 {
-    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
-    let origin = bilateral_cell_origin(p, low_viewport);
-    let last = (low_viewport - 1.0).max(Vec2::ZERO);
-    (origin + Vec2::new((i & 1) as f32, (i >> 1) as f32))
-        .min(last)
-        .as_uvec2()
-}
-
-/// Texels 0 and 3 of the 2x2 cell whose top-left texel is `origin` ([`bilateral_cell_origin`]),
-/// as (x0, y0, x1, y1), clamped to the viewport; texel 1 is (x1, y0), texel 2 (x0, y1).
-///
-/// ```
-/// # use lodkit::bilateral::*;
-/// # use glam::{UVec2, Vec2};
-/// let (frag, vp, full) = (Vec2::new(9.5, 0.5), Vec2::new(5.0, 4.0), Vec2::new(10.0, 8.0));
-/// let origin = bilateral_cell_origin(bilateral_low_position(frag, vp, full), vp);
-/// let c = bilateral_cell_corners(origin, vp);
-/// assert_eq!(UVec2::new(c.z, c.y), bilateral_cell_texel(frag, vp, full, 1));
-/// ```
-pub fn bilateral_cell_corners(origin: Vec2, low_viewport: Vec2) -> UVec4 {
-    let last = (low_viewport - 1.0).max(Vec2::ZERO).as_uvec2();
-    let first = origin.as_uvec2();
-    let (t0, t3) = (first.min(last), (first + 1).min(last));
-    UVec4::new(t0.x, t0.y, t3.x, t3.y)
+    let c = bilateral_cell(frag_coord, low_viewport, full_size).corners;
+    UVec2::new(
+        if i & 1 != 0 { c.z } else { c.x },
+        if i & 2 != 0 { c.w } else { c.y },
+    )
 }
 
 /// Eq. 1 from four fetched L texels: `colors` and `geometry` (gbuffer layout).
@@ -226,9 +238,10 @@ impl<T: Copy> Image<'_, T> {
         self.texels[(t.y * self.width + t.x) as usize]
     }
 
-    /// The 2x2 cell's texels (order 0..3) of the full-res pixel at `frag_coord`.
-    fn cell(&self, frag_coord: Vec2, low_viewport: Vec2, full_size: Vec2) -> [T; 4] {
-        [0, 1, 2, 3].map(|i| self.at(bilateral_cell_texel(frag_coord, low_viewport, full_size, i)))
+    /// The texels (order 0..3) of `cell`.
+    fn cell(&self, cell: &BilateralCell) -> [T; 4] {
+        let c = cell.corners;
+        [(c.x, c.y), (c.z, c.y), (c.x, c.w), (c.z, c.w)].map(|(x, y)| self.at(UVec2::new(x, y)))
     }
 }
 
@@ -246,10 +259,17 @@ pub fn bilateral_upsample_at(
     sigma_z: f32,
     sigma_n: f32,
 ) -> Vec4 {
-    let colors = low_color.cell(frag_coord, low_viewport, full_size);
-    let geometry = low_geometry.cell(frag_coord, low_viewport, full_size);
-    let f = bilateral_cell_fraction(frag_coord, low_viewport, full_size);
-    bilateral_upsample_texels(f, &colors, &geometry, depth, normal, sigma_z, sigma_n)
+    let cell = bilateral_cell(frag_coord, low_viewport, full_size);
+    let (colors, geometry) = (low_color.cell(&cell), low_geometry.cell(&cell));
+    bilateral_upsample_texels(
+        cell.fraction,
+        &colors,
+        &geometry,
+        depth,
+        normal,
+        sigma_z,
+        sigma_n,
+    )
 }
 
 /// Eq. 1 from four packed L texels ([`crate::gbuffer::gbuffer_pack_texel`]) for a full-res
@@ -306,7 +326,13 @@ pub fn bilateral_upsample_packed_at(
     sigma_z: f32,
     sigma_n: f32,
 ) -> Vec4 {
-    let texels = low.cell(frag_coord, low_viewport, full_size);
-    let f = bilateral_cell_fraction(frag_coord, low_viewport, full_size);
-    bilateral_upsample_packed(f, &texels, depth, normal, sigma_z, sigma_n)
+    let cell = bilateral_cell(frag_coord, low_viewport, full_size);
+    bilateral_upsample_packed(
+        cell.fraction,
+        &low.cell(&cell),
+        depth,
+        normal,
+        sigma_z,
+        sigma_n,
+    )
 }

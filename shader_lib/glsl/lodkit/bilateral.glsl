@@ -14,9 +14,10 @@
 //       sigma_n) -> vec4
 //   lodkit_bilateral_low_position(frag_coord, low_viewport, full_size) -> vec2
 //   lodkit_bilateral_cell_origin(p, low_viewport) -> vec2
+//   lodkit_BilateralCell { corners, fraction }
+//   lodkit_bilateral_cell(frag_coord, low_viewport, full_size) -> lodkit_BilateralCell
 //   lodkit_bilateral_cell_fraction(frag_coord, low_viewport, full_size) -> vec2
 //   lodkit_bilateral_cell_texel(frag_coord, low_viewport, full_size, i) -> uvec2
-//   lodkit_bilateral_cell_corners(origin, low_viewport) -> uvec4
 //   lodkit_bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n) -> vec4
 //   lodkit_bilateral_upsample_at(low_color, low_geometry, low_viewport, full_size, frag_coord,
 //       depth, normal, sigma_z, sigma_n) -> vec4   a macro: takes a sampler2D (OpenGL) or
@@ -93,17 +94,32 @@ vec2 lodkit_bilateral_cell_origin(vec2 p, vec2 low_viewport) {
     return clamp(floor(p), vec2(0.0), max(low_viewport - 2.0, vec2(0.0)));
 }
 
+/// The 2x2 cell of a full-res pixel: texels 0 and 3 as (x0, y0, x1, y1), clamped to the
+/// viewport, and the pixel's fraction between them.
+struct lodkit_BilateralCell {
+    uvec4 corners;
+    vec2 fraction;
+};
+
+/// The cell of the full-res pixel at `frag_coord`: what every lookup of this module fetches.
+lodkit_BilateralCell lodkit_bilateral_cell(vec2 frag_coord, vec2 low_viewport, vec2 full_size) {
+    vec2 p = lodkit_bilateral_low_position(frag_coord, low_viewport, full_size);
+    vec2 origin = lodkit_bilateral_cell_origin(p, low_viewport);
+    uvec2 last = uvec2(max(low_viewport - 1.0, vec2(0.0)));
+    uvec2 first = uvec2(origin);
+    uvec4 corners = uvec4(min(first, last), min(first + 1u, last));
+    return lodkit_BilateralCell(corners, clamp(p - origin, vec2(0.0), vec2(1.0)));
+}
+
 /// Fraction `f` between the 2x2 L texels of the full-res pixel at `frag_coord`.
 vec2 lodkit_bilateral_cell_fraction(vec2 frag_coord, vec2 low_viewport, vec2 full_size) {
-    vec2 p = lodkit_bilateral_low_position(frag_coord, low_viewport, full_size);
-    return clamp(p - lodkit_bilateral_cell_origin(p, low_viewport), vec2(0.0), vec2(1.0));
+    return lodkit_bilateral_cell(frag_coord, low_viewport, full_size).fraction;
 }
 
 /// L texel `i` (0..3) of the 2x2 cell of the full-res pixel at `frag_coord`.
 uvec2 lodkit_bilateral_cell_texel(vec2 frag_coord, vec2 low_viewport, vec2 full_size, uint i) {
-    vec2 origin = lodkit_bilateral_cell_origin(lodkit_bilateral_low_position(frag_coord, low_viewport, full_size), low_viewport);
-    vec2 last = max(low_viewport - 1.0, vec2(0.0));
-    return uvec2(min(origin + vec2(float(i & 1u), float(i >> 1u)), last));
+    uvec4 c = lodkit_bilateral_cell(frag_coord, low_viewport, full_size).corners;
+    return uvec2((i & 1u) != 0u ? c.z : c.x, (i & 2u) != 0u ? c.w : c.y);
 }
 
 /// Eq. 1 from four fetched L texels (lodkit gbuffer layout).
@@ -125,12 +141,6 @@ vec4 lodkit_bilateral_upsample_texels(vec2 f, vec4 colors[4], vec4 geometry[4], 
                 LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 2u), LODKIT_BILATERAL_FETCH_(low_geometry, frag_coord, low_viewport, full_size, 3u)), \
         (depth), (normal), (sigma_z), (sigma_n))
 
-/// Texels 0 and 3 of the cell at `origin`, (x0, y0, x1, y1), clamped to the viewport.
-uvec4 lodkit_bilateral_cell_corners(vec2 origin, vec2 low_viewport) {
-    uvec2 last = uvec2(max(low_viewport - 1.0, vec2(0.0)));
-    return uvec4(min(uvec2(origin), last), min(uvec2(origin) + 1u, last));
-}
-
 /// Eq. 1 from four packed L texels (lodkit gbuffer packed layout).
 vec4 lodkit_bilateral_upsample_packed(vec2 f, uvec4 texels[4], float depth, vec3 normal, float sigma_z, float sigma_n) {
     vec4 values[4] = vec4[4](lodkit_gbuffer_texel_color(texels[0]), lodkit_gbuffer_texel_color(texels[1]), lodkit_gbuffer_texel_color(texels[2]), lodkit_gbuffer_texel_color(texels[3]));
@@ -139,7 +149,7 @@ vec4 lodkit_bilateral_upsample_packed(vec2 f, uvec4 texels[4], float depth, vec3
     return lodkit_bilateral_upsample_projected(f, values, depths, projected, depth, lodkit_foreshortened_normal(normal), sigma_z, sigma_n);
 }
 
-#define LODKIT_BILATERAL_CORNERS_(fc, vp, fs) lodkit_bilateral_cell_corners(lodkit_bilateral_cell_origin(lodkit_bilateral_low_position((fc), (vp), (fs)), (vp)), (vp))
+#define LODKIT_BILATERAL_CORNERS_(fc, vp, fs) lodkit_bilateral_cell((fc), (vp), (fs)).corners
 #define LODKIT_BILATERAL_CORNER_(tex, c, cx, cy) texelFetch((tex), ivec2((c).cx, (c).cy), 0)
 
 /// The full lookup from a packed L: four texel fetches, then eq. 1 (the fold-in upsample).

@@ -22,11 +22,12 @@
 //       -> vec4<f32>   eq. 1 with the normals already through the foreshortening map
 //   bilateral_low_position(frag_coord, low_viewport, full_size) -> vec2<f32>   position in L's grid
 //   bilateral_cell_origin(p, low_viewport) -> vec2<f32>   top-left texel of the 2x2 cell
+//   BilateralCell { corners: vec4<u32>, fraction: vec2<f32> }
+//   bilateral_cell(frag_coord, low_viewport, full_size) -> BilateralCell   the 2x2 cell of a
+//       full-res pixel: texels 0 and 3 as (x0, y0, x1, y1), clamped to the viewport
+//       (1 = (x1, y0), 2 = (x0, y1)), and the pixel's fraction f between them
 //   bilateral_cell_fraction(frag_coord, low_viewport, full_size) -> vec2<f32>   f of a full-res pixel
 //   bilateral_cell_texel(frag_coord, low_viewport, full_size, i) -> vec2<u32>   its 2x2 L texels
-//   bilateral_cell_corners(origin, low_viewport) -> vec4<u32>   (x0, y0, x1, y1): texels 0 and 3
-//       of the cell at `origin` (bilateral_cell_origin), clamped to the viewport
-//       (1 = (x1, y0), 2 = (x0, y1))
 //   bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n) -> vec4<f32>
 //       eq. 1 from four fetched L color and geometry texels (lodkit::gbuffer layout)
 //   bilateral_upsample_at(low_color, low_geometry, low_viewport, full_size, frag_coord, depth,
@@ -128,17 +129,32 @@ fn bilateral_cell_origin(p: vec2<f32>, low_viewport: vec2<f32>) -> vec2<f32> {
     return clamp(floor(p), vec2<f32>(0.0), max(low_viewport - 2.0, vec2<f32>(0.0)));
 }
 
+/// The 2x2 cell of a full-res pixel: its texels 0 and 3 as (x0, y0, x1, y1), clamped to the
+/// viewport (texel 1 is (x1, y0), texel 2 (x0, y1)), and the pixel's fraction between them.
+struct BilateralCell {
+    corners: vec4<u32>,
+    fraction: vec2<f32>,
+}
+
+/// The cell of the full-res pixel at `frag_coord`: what every lookup of this module fetches.
+fn bilateral_cell(frag_coord: vec2<f32>, low_viewport: vec2<f32>, full_size: vec2<f32>) -> BilateralCell {
+    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
+    let origin = bilateral_cell_origin(p, low_viewport);
+    let last = vec2<u32>(max(low_viewport - 1.0, vec2<f32>(0.0)));
+    let first = vec2<u32>(origin);
+    let corners = vec4<u32>(min(first, last), min(first + 1u, last));
+    return BilateralCell(corners, clamp(p - origin, vec2<f32>(0.0), vec2<f32>(1.0)));
+}
+
 /// Fraction `f` between the 2x2 L texels of the full-res pixel at `frag_coord`.
 fn bilateral_cell_fraction(frag_coord: vec2<f32>, low_viewport: vec2<f32>, full_size: vec2<f32>) -> vec2<f32> {
-    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
-    return clamp(p - bilateral_cell_origin(p, low_viewport), vec2<f32>(0.0), vec2<f32>(1.0));
+    return bilateral_cell(frag_coord, low_viewport, full_size).fraction;
 }
 
 /// L texel `i` (0..3, order as above) of the 2x2 cell of the full-res pixel at `frag_coord`.
 fn bilateral_cell_texel(frag_coord: vec2<f32>, low_viewport: vec2<f32>, full_size: vec2<f32>, i: u32) -> vec2<u32> {
-    let origin = bilateral_cell_origin(bilateral_low_position(frag_coord, low_viewport, full_size), low_viewport);
-    let last = max(low_viewport - 1.0, vec2<f32>(0.0));
-    return vec2<u32>(min(origin + vec2<f32>(f32(i & 1u), f32(i >> 1u)), last));
+    let c = bilateral_cell(frag_coord, low_viewport, full_size).corners;
+    return vec2<u32>(select(c.x, c.z, (i & 1u) != 0u), select(c.y, c.w, (i & 2u) != 0u));
 }
 
 /// Eq. 1 from four fetched L texels: `colors` and `geometry` (lodkit::gbuffer layout).
@@ -170,9 +186,8 @@ fn bilateral_upsample_at(
     sigma_z: f32,
     sigma_n: f32,
 ) -> vec4<f32> {
-    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
-    let origin = bilateral_cell_origin(p, low_viewport);
-    let c = bilateral_cell_corners(origin, low_viewport);
+    let cell = bilateral_cell(frag_coord, low_viewport, full_size);
+    let c = cell.corners;
     let colors = array<vec4<f32>, 4>(
         textureLoad(low_color, c.xy, 0),
         textureLoad(low_color, c.zy, 0),
@@ -185,15 +200,7 @@ fn bilateral_upsample_at(
         textureLoad(low_geometry, c.xw, 0),
         textureLoad(low_geometry, c.zw, 0),
     );
-    let f = clamp(p - origin, vec2<f32>(0.0), vec2<f32>(1.0));
-    return bilateral_upsample_texels(f, colors, geometry, depth, normal, sigma_z, sigma_n);
-}
-
-/// Texels 0 and 3 of the 2x2 cell whose top-left texel is `origin` (bilateral_cell_origin), as
-/// (x0, y0, x1, y1), clamped to the viewport; texel 1 is (x1, y0), texel 2 (x0, y1).
-fn bilateral_cell_corners(origin: vec2<f32>, low_viewport: vec2<f32>) -> vec4<u32> {
-    let last = vec2<u32>(max(low_viewport - 1.0, vec2<f32>(0.0)));
-    return vec4<u32>(min(vec2<u32>(origin), last), min(vec2<u32>(origin) + 1u, last));
+    return bilateral_upsample_texels(cell.fraction, colors, geometry, depth, normal, sigma_z, sigma_n);
 }
 
 /// Eq. 1 from four packed L texels (lodkit::gbuffer's packed layout) for a full-res pixel at
@@ -226,15 +233,13 @@ fn bilateral_upsample_packed_at(
     sigma_z: f32,
     sigma_n: f32,
 ) -> vec4<f32> {
-    let p = bilateral_low_position(frag_coord, low_viewport, full_size);
-    let origin = bilateral_cell_origin(p, low_viewport);
-    let c = bilateral_cell_corners(origin, low_viewport);
+    let cell = bilateral_cell(frag_coord, low_viewport, full_size);
+    let c = cell.corners;
     let texels = array<vec4<u32>, 4>(
         textureLoad(low, c.xy, 0),
         textureLoad(low, c.zy, 0),
         textureLoad(low, c.xw, 0),
         textureLoad(low, c.zw, 0),
     );
-    let f = clamp(p - origin, vec2<f32>(0.0), vec2<f32>(1.0));
-    return bilateral_upsample_packed(f, texels, depth, normal, sigma_z, sigma_n);
+    return bilateral_upsample_packed(cell.fraction, texels, depth, normal, sigma_z, sigma_n);
 }
