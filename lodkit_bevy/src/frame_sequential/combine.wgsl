@@ -8,8 +8,11 @@
 // The steps are lodkit::combine's combine_at_moved with the id words read from alpha: reproject
 // the pixel into the older frame (refined at the older depth found there), moved by the object
 // motion; where a t-instance's read lands on another id, the side and diagonal texels holding
-// it (combine_match_texel), else the 3x3 block around the read (as combine_search_texel);
-// then combine_texels.
+// it (combine_match_texel), else the 3x3 block around the read (in combine_search_texel's
+// order); then combine_texels. One difference: combine_at_moved searches the 3x3 block only
+// for a pixel that moved by itself, around where the camera alone puts it; this pass searches
+// around the moved read whenever the side texels miss, since a camera moving along its view
+// axis moves silhouettes further than they reach.
 #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
 #import lodkit::combine::{combine_uv, combine_texel, combine_side_texel, combine_match_texel, combine_ring_texel, combine_texels, combine_object_motion}
 #import lodkit::reproject::{reproject_base, reproject_from_base, reproject_refine, in_viewport}
@@ -56,19 +59,20 @@ fn fragment(in: FullscreenVertexOutput) -> @location(0) vec4<f32> {
     let refined = reproject_refine(base, depth, first_depth, params.new_to_old).xy + motion;
     let at = select(first, refined, in_viewport(refined));
     let id = lod_buffer_id(newer_word);
-    var texel = combine_texel(at, size);
-    if (id != 0u && older_id(texel) != id) {
+    let read = combine_texel(at, size);
+    let read_id = older_id(read);
+    var texel = read;
+    if (id != 0u && read_id != id) {
         let x = combine_side_texel(at, size, 0u);
         let y = combine_side_texel(at, size, 1u);
-        let ids = vec4<u32>(older_id(texel), older_id(x), older_id(y), older_id(vec2<u32>(x.x, y.y)));
+        let ids = vec4<u32>(read_id, older_id(x), older_id(y), older_id(vec2<u32>(x.x, y.y)));
         texel = combine_match_texel(id, ids, texel, x, y);
         // Still another object: the 3x3 block around the read (combine_search_texel's order),
         // for a silhouette that moved by more than the side texels reach (a camera moving
         // along its view axis, an object moving by itself).
         if (older_id(texel) != id) {
-            let center = combine_texel(at, size);
             for (var k = 1u; k < 9u; k++) {
-                let t = combine_ring_texel(center, size, k);
+                let t = combine_ring_texel(read, size, k);
                 if (older_id(t) == id) {
                     texel = t;
                     break;

@@ -50,9 +50,10 @@
 //!   frame, through a child entity of the group, in Bevy's normal prepass and main pass. A
 //!   group not in transition is an ordinary Bevy mesh.
 //! - Levels use [`FrameSequentialMaterial`] (Bevy's `StandardMaterial`, lit by Bevy's PBR
-//!   functions) or any material whose fragment shader ends with
+//!   functions), whose fragment shader ends with
 //!   `lodkit_bevy::frame_sequential::lod_fragment_alpha`: the main pass's HDR color is the LOD
-//!   buffer, its alpha the id word.
+//!   buffer, its alpha the id word. The WGSL module offers that function to materials of your
+//!   own, but the plugin drives only `FrameSequentialMaterial` levels for now.
 //! - After Bevy's opaque pass, before the transparent pass and post-processing, the plugin
 //!   copies the main texture and depth (the next frame's older buffer) and runs lodkit's
 //!   combine over the screen rectangles of the groups in transition.
@@ -198,7 +199,8 @@ pub struct FrameSequentialGroup {
     /// The box that holds every level's vertices (object space; None: the union of the level
     /// meshes' bounds, computed once they are loaded). Give it for vertex animation that moves
     /// vertices beyond the meshes' bounds (`lodkit::combine::displaced_bounds`): the combine
-    /// only works inside the box's screen rectangle.
+    /// only works inside the box's screen rectangle. Read once, when the group's levels are
+    /// first drawn; a change to its [`LodLevels`] reads it again.
     pub bounds: Option<(Vec3, Vec3)>,
 }
 

@@ -22,7 +22,15 @@ use bevy::render::{GpuResourceAppExt, Render, RenderSystems};
 pub const COMBINE_PASS: &str = "lodkit_frame_sequential_combine";
 
 /// What the render world needs of the camera's frame (inserted every frame by the plugin).
+/// When it goes, the render world drops the camera's ping-pong textures, bind group and
+/// pipeline with it.
 #[derive(Component, ExtractComponent, Clone, Debug)]
+#[extract_component_sync_target((
+    FrameSequentialView,
+    FrameSequentialTextures,
+    CombineBindGroup,
+    CombinePipelineId,
+))]
 pub struct FrameSequentialView {
     /// This frame's view_from_world (next frame's reprojection source).
     pub view_from_world: Mat4,

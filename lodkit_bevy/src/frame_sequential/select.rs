@@ -79,14 +79,22 @@ pub struct FrameSequentialStats {
     pub frames: u64,
 }
 
-/// Spawns the drawing child of every new or changed [`LodLevels`].
+/// Spawns the drawing child of every new or changed [`LodLevels`]. A changed group starts over:
+/// its old drawer goes, and so do its transition slot and t-instance id in the scheduler.
 fn spawn_levels(
     mut commands: Commands,
+    mut scheduler: ResMut<Scheduler>,
     groups: Query<(Entity, &LodLevels, Option<&FrameSequentialLevels>), Changed<LodLevels>>,
 ) {
+    let Scheduler(scheduler, keys) = &mut *scheduler;
     for (group, levels, old) in &groups {
         if let Some(old) = old {
             commands.entity(old.entity).despawn();
+            if let Some(key) = old.key {
+                let _ = scheduler.remove(key);
+            }
+            keys.retain(|&(g, _)| g != group);
+            commands.entity(group).remove::<FrameSequentialLevels>();
         }
         if levels.0.len() > 256 {
             warn_once!("a LOD group has more than 256 levels: the rest are ignored");
@@ -473,4 +481,56 @@ fn update(
             .collect(),
         frame,
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::ecs::system::RunSystemOnce;
+
+    use super::*;
+    use crate::frame_sequential::LodLevel;
+
+    /// A group whose levels change while it is in transition gives its t-instance id and slot
+    /// back to the scheduler, and its old drawer goes.
+    #[test]
+    fn changed_levels_release_the_groups_transition() {
+        let mut world = World::new();
+        let mut scheduler = TransitionScheduler::new();
+        let key = scheduler.insert(0);
+        scheduler
+            .begin_transition(key, 1, Drive::Time { seconds: 1.0 })
+            .unwrap();
+        assert_eq!(scheduler.live_ids().len(), 1);
+        let level = || LodLevel::new(Handle::default(), Handle::default());
+        let drawer = world.spawn_empty().id();
+        let group = world
+            .spawn((
+                LodLevels(vec![level(), level()]),
+                FrameSequentialLevels {
+                    entity: drawer,
+                    drawn: 0,
+                    selection: None,
+                    transition: Some((0, 1)),
+                    key: Some(key),
+                    state: LodState::NEW,
+                    previous_model: None,
+                    bounds: None,
+                },
+            ))
+            .id();
+        world.insert_resource(Scheduler(scheduler, vec![(group, key)]));
+        world.run_system_once(spawn_levels).unwrap();
+        let Scheduler(scheduler, keys) = world.resource::<Scheduler>();
+        assert!(
+            scheduler.live_ids().is_empty(),
+            "the t-instance id is still taken"
+        );
+        assert!(keys.is_empty());
+        assert!(
+            world.get_entity(drawer).is_err(),
+            "the old drawer is still there"
+        );
+        let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+        assert_eq!((levels.key, levels.transition), (None, None));
+    }
 }
