@@ -33,14 +33,14 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use lodkit::frame_sequential::Schedule;
-use lodkit_bevy::frame_sequential::PatternAnchor;
+use lodkit_bevy::frame_sequential::VisibilitySpace;
 
 /// Parsed command line.
 pub struct Args {
     out: PathBuf,
     report: Option<PathBuf>,
     schedule: Schedule,
-    anchor: PatternAnchor,
+    anchor: VisibilitySpace,
     reprojection: bool,
 }
 
@@ -52,7 +52,7 @@ fn parse() -> Result<Option<Args>, String> {
         out: PathBuf::from("lodkit-bevy-frame-sequential"),
         report: None,
         schedule: Schedule::Complementary,
-        anchor: PatternAnchor::Screen,
+        anchor: VisibilitySpace::Screen,
         reprojection: true,
     };
     let mut it = std::env::args().skip(1);
@@ -71,8 +71,8 @@ fn parse() -> Result<Option<Args>, String> {
             }
             "--anchor" => {
                 args.anchor = match value()?.as_str() {
-                    "screen" => PatternAnchor::Screen,
-                    "object" => PatternAnchor::Object,
+                    "screen" => VisibilitySpace::Screen,
+                    "object" => VisibilitySpace::Object,
                     other => return Err(format!("unknown anchor `{other}`")),
                 }
             }

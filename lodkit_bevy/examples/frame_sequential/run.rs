@@ -347,6 +347,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     report.insert("reprojection".into(), args.reprojection.into());
     let stats = h.app.world().resource::<FrameSequentialStats>().clone();
     report.insert("frames_scheduled".into(), stats.frames.into());
+    report.insert("frames_kept".into(), stats.frames_kept.into());
     let json = serde_json::to_string_pretty(&report).expect("a JSON map serializes");
     println!("{json}");
     if let Some(path) = &args.report {

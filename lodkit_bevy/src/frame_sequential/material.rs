@@ -45,7 +45,7 @@ pub struct FrameSequentialExtension {
     #[texture(100, sample_type = "float", filterable = false)]
     pub visibility: Handle<Image>,
     /// x: texture repeats per object-space unit where the pattern sticks to the object
-    /// ([`PatternAnchor::Object`](super::PatternAnchor::Object)); y, z, w unused.
+    /// ([`VisibilitySpace::Object`](super::VisibilitySpace::Object)); y, z, w unused.
     #[uniform(101)]
     pub pattern_scale: Vec4,
 }

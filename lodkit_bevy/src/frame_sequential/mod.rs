@@ -74,11 +74,13 @@ use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass};
 use bevy::pbr::MaterialPlugin;
 use bevy::prelude::*;
 use bevy::render::RenderApp;
-use bevy::render::extract_component::ExtractComponentPlugin;
+use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPlugin};
 use bevy::shader::load_shader_library;
 use lodkit::frame_sequential::Schedule;
 use lodkit::select::{LodGroup, LodSettings};
 
+/// Where lodkit's visibility pattern is anchored: [`FrameSequentialLod::anchor`].
+pub use lodkit::visibility::VisibilitySpace;
 pub use material::{
     FrameSequentialExtension, FrameSequentialMaterial, VISIBILITY_TEXTURE, VISIBILITY_TEXTURE_SEED,
     VISIBILITY_TEXTURE_SIZE,
@@ -118,6 +120,7 @@ impl Plugin for FrameSequentialLodPlugin {
         app.add_plugins((
             MaterialPlugin::<FrameSequentialMaterial>::default(),
             ExtractComponentPlugin::<render::FrameSequentialView>::default(),
+            UniformComponentPlugin::<render::CombineParams>::default(),
         ));
         select::build(app);
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
@@ -130,18 +133,6 @@ impl Plugin for FrameSequentialLodPlugin {
             render::finish(render_app);
         }
     }
-}
-
-/// Where lodkit's visibility pattern is anchored.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
-pub enum PatternAnchor {
-    /// To the screen, one texel per pixel, like a dither: the pattern holds still while objects
-    /// and camera move (`lodkit::visibility::visibility_flags_screen`).
-    #[default]
-    Screen,
-    /// To the object, looked up at the object-space position (the paper's choice): the pattern
-    /// moves with the object (`lodkit::visibility::visibility_flags`).
-    Object,
 }
 
 /// Frame-sequential LOD on a 3D camera: the camera that selects the levels of every
@@ -158,8 +149,11 @@ pub struct FrameSequentialLod {
     /// transition).
     #[reflect(ignore)]
     pub schedule: Schedule,
-    /// Where the pattern is anchored (default: the screen).
-    pub anchor: PatternAnchor,
+    /// Where the pattern is anchored (default `VisibilitySpace::Screen`: one texel per pixel,
+    /// holding still like a dither; `Object`: at the object-space position, the paper's
+    /// choice, moving with the object).
+    #[reflect(ignore)]
+    pub anchor: VisibilitySpace,
     /// Selection settings shared by every group: global bias, hysteresis band and how a switch
     /// is staged (`TransitionMode::Distance` blends across the band, `Time` over a duration,
     /// `Hard` switches at once).
@@ -176,7 +170,7 @@ impl Default for FrameSequentialLod {
     fn default() -> Self {
         Self {
             schedule: Schedule::default(),
-            anchor: PatternAnchor::default(),
+            anchor: VisibilitySpace::default(),
             settings: LodSettings {
                 hysteresis: 0.5,
                 ..default()

@@ -7,13 +7,15 @@ use bevy::core_pipeline::core_3d::{
 };
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::core_pipeline::{Core3d, FullscreenShader};
+use bevy::ecs::query::QueryItem;
 use bevy::log::warn_once;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RecordDiagnostics;
-use bevy::render::extract_component::ExtractComponent;
+use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex, ExtractComponent};
 use bevy::render::render_resource::binding_types::{texture_2d, texture_depth_2d, uniform_buffer};
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
+use bevy::render::sync_component::SyncComponent;
 use bevy::render::view::{ExtractedView, ViewDepthTexture, ViewTarget};
 use bevy::render::{GpuResourceAppExt, Render, RenderSystems};
 
@@ -24,31 +26,53 @@ pub const COMBINE_PASS: &str = "lodkit_frame_sequential_combine";
 /// What the render world needs of the camera's frame (inserted every frame by the plugin).
 /// When it goes, the render world drops the camera's ping-pong textures, bind group and
 /// pipeline with it.
-#[derive(Component, ExtractComponent, Clone, Debug)]
-#[extract_component_sync_target((
-    FrameSequentialView,
-    FrameSequentialTextures,
-    CombineBindGroup,
-    CombinePipelineId,
-))]
+#[derive(Component, Clone, Debug)]
 pub struct FrameSequentialView {
     /// This frame's view_from_world (next frame's reprojection source).
     pub view_from_world: Mat4,
     /// This frame's clip_from_view.
     pub clip_from_view: Mat4,
-    /// Last frame's clip_from_world times this frame's world_from_clip.
+    /// This frame's clip space to last frame's (`lodkit::reproject::new_to_old_matrix`).
     pub new_to_old: Mat4,
     /// Whether the combine reads Bevy's motion vectors.
     pub motion_vectors: bool,
     /// The combine's rectangles (pixels, top left origin), not overlapping.
     pub rects: Vec<URect>,
-    /// Frames the plugin has run: the ping-pong parity.
-    pub frame: u64,
+    /// Whether this frame is kept (its color and depth copied) as the next frame's older one.
+    pub keep: bool,
+    /// Which copy of the pair this frame writes (`TransitionScheduler::buffer_index`); the
+    /// other holds the older frame.
+    pub buffer: usize,
 }
 
-/// The uniform of combine.wgsl.
-#[derive(ShaderType, Clone, Copy)]
-struct CombineParams {
+impl SyncComponent for FrameSequentialView {
+    type Target = (
+        FrameSequentialView,
+        CombineParams,
+        FrameSequentialTextures,
+        CombineBindGroup,
+        CombinePipelineId,
+    );
+}
+
+impl ExtractComponent for FrameSequentialView {
+    type QueryData = &'static FrameSequentialView;
+    type QueryFilter = ();
+    type Out = (FrameSequentialView, CombineParams);
+
+    fn extract_component(view: QueryItem<'_, '_, Self::QueryData>) -> Option<Self::Out> {
+        let params = CombineParams {
+            new_to_old: view.new_to_old,
+            flags: UVec4::new(u32::from(view.motion_vectors), 0, 0, 0),
+        };
+        Some((view.clone(), params))
+    }
+}
+
+/// The uniform of combine.wgsl (one dynamic-offset slot per camera, written by Bevy's
+/// `UniformComponentPlugin`).
+#[derive(Component, ShaderType, Clone, Copy, Debug)]
+pub struct CombineParams {
     new_to_old: Mat4,
     flags: UVec4,
 }
@@ -97,7 +121,7 @@ impl FromWorld for CombinePipeline {
                     color,
                     texture_depth_2d(),
                     color,
-                    uniform_buffer::<CombineParams>(false),
+                    uniform_buffer::<CombineParams>(true),
                 ),
             ),
         );
@@ -155,8 +179,8 @@ fn prepare_pipelines(
 pub struct FrameSequentialTextures {
     size: UVec2,
     format: TextureFormat,
-    color: [Texture; 2],
-    depth: [Texture; 2],
+    color: [(Texture, TextureView); 2],
+    depth: [(Texture, TextureView); 2],
 }
 
 fn prepare_textures(
@@ -175,7 +199,7 @@ fn prepare_textures(
             continue;
         }
         let make = |label, format| {
-            device.create_texture(&TextureDescriptor {
+            let texture = device.create_texture(&TextureDescriptor {
                 label: Some(label),
                 size: Extent3d {
                     width: size.x,
@@ -188,7 +212,9 @@ fn prepare_textures(
                 format,
                 usage: TextureUsages::COPY_DST | TextureUsages::TEXTURE_BINDING,
                 view_formats: &[],
-            })
+            });
+            let view = texture.create_view(&TextureViewDescriptor::default());
+            (texture, view)
         };
         let color = || make("lodkit_frame_sequential_color", format);
         let depth = || make("lodkit_frame_sequential_depth", CORE_3D_DEPTH_FORMAT);
@@ -210,6 +236,7 @@ fn prepare_bind_groups(
     device: Res<RenderDevice>,
     cache: Res<PipelineCache>,
     pipeline: Res<CombinePipeline>,
+    params: Res<ComponentUniforms<CombineParams>>,
     views: Query<(
         Entity,
         &FrameSequentialView,
@@ -217,6 +244,9 @@ fn prepare_bind_groups(
         Option<&ViewPrepassTextures>,
     )>,
 ) {
+    let Some(params) = params.uniforms().binding() else {
+        return;
+    };
     for (entity, view, textures, prepass) in &views {
         let Some(motion) = prepass.and_then(ViewPrepassTextures::motion_vectors_view) else {
             warn_once!(
@@ -224,32 +254,17 @@ fn prepare_bind_groups(
             );
             continue;
         };
-        let newer = (view.frame % 2) as usize;
-        let older = 1 - newer;
-        let params = CombineParams {
-            new_to_old: view.new_to_old,
-            flags: UVec4::new(u32::from(view.motion_vectors), 0, 0, 0),
-        };
-        let mut buffer = encase::UniformBuffer::new(Vec::new());
-        buffer
-            .write(&params)
-            .expect("a fixed-size uniform always encodes");
-        let uniform = device.create_buffer_with_data(&BufferInitDescriptor {
-            label: Some("lodkit_frame_sequential_combine"),
-            contents: &buffer.into_inner(),
-            usage: BufferUsages::UNIFORM,
-        });
-        let views = |t: &Texture| t.create_view(&TextureViewDescriptor::default());
+        let (newer, older) = (view.buffer, 1 - view.buffer);
         let bind_group = device.create_bind_group(
             "lodkit_frame_sequential_combine",
             &cache.get_bind_group_layout(&pipeline.layout),
             &BindGroupEntries::sequential((
-                &views(&textures.color[newer]),
-                &views(&textures.depth[newer]),
-                &views(&textures.color[older]),
-                &views(&textures.depth[older]),
+                &textures.color[newer].1,
+                &textures.depth[newer].1,
+                &textures.color[older].1,
+                &textures.depth[older].1,
                 motion,
-                uniform.as_entire_binding(),
+                params.clone(),
             )),
         );
         commands.entity(entity).insert(CombineBindGroup(bind_group));
@@ -262,31 +277,35 @@ type PassView = (
     &'static ViewDepthTexture,
     &'static FrameSequentialView,
     &'static FrameSequentialTextures,
+    &'static DynamicUniformIndex<CombineParams>,
     Option<&'static CombineBindGroup>,
     Option<&'static CombinePipelineId>,
 );
 
-/// Copies this frame's main color and depth (the next frame's older buffer), then combines
-/// within the rectangles.
+/// Copies this frame's main color and depth where the frame is kept (the combine's newer input
+/// and the next frame's older buffer), then combines within the rectangles. A frame not kept
+/// has no rectangles: nothing is in transition, and nothing is copied.
 fn combine_pass(view: ViewQuery<PassView>, cache: Res<PipelineCache>, mut ctx: RenderContext) {
-    let (_, target, depth, frame, textures, bind_group, pipeline_id) = view.into_inner();
-    let newer = (frame.frame % 2) as usize;
+    let (_, target, depth, frame, textures, params, bind_group, pipeline_id) = view.into_inner();
+    let newer = frame.buffer;
     let main = target.main_texture();
     let extent = main.size();
     if extent.width != textures.size.x || extent.height != textures.size.y {
         return;
     }
-    let encoder = ctx.command_encoder();
-    encoder.copy_texture_to_texture(
-        main.as_image_copy(),
-        textures.color[newer].as_image_copy(),
-        extent,
-    );
-    encoder.copy_texture_to_texture(
-        depth.texture.as_image_copy(),
-        textures.depth[newer].as_image_copy(),
-        extent,
-    );
+    if frame.keep {
+        let encoder = ctx.command_encoder();
+        encoder.copy_texture_to_texture(
+            main.as_image_copy(),
+            textures.color[newer].0.as_image_copy(),
+            extent,
+        );
+        encoder.copy_texture_to_texture(
+            depth.texture.as_image_copy(),
+            textures.depth[newer].0.as_image_copy(),
+            extent,
+        );
+    }
     let (Some(bind_group), Some(pipeline)) = (
         bind_group,
         pipeline_id.and_then(|id| cache.get_render_pipeline(id.0)),
@@ -313,14 +332,9 @@ fn combine_pass(view: ViewQuery<PassView>, cache: Res<PipelineCache>, mut ctx: R
     });
     let span = diagnostics.pass_span(&mut pass, COMBINE_PASS);
     pass.set_render_pipeline(pipeline);
-    pass.set_bind_group(0, &bind_group.0, &[]);
-    // Frame 0 has no older frame; the pass still runs (empty) so its diagnostics count it.
-    let rects = if frame.frame == 0 {
-        &[][..]
-    } else {
-        &frame.rects[..]
-    };
-    for rect in rects {
+    pass.set_bind_group(0, &bind_group.0, &[params.index()]);
+    // The pass runs even without rectangles, so its diagnostics count every frame.
+    for rect in &frame.rects {
         let r = rect.intersect(URect::new(0, 0, extent.width, extent.height));
         if r.is_empty() {
             continue;

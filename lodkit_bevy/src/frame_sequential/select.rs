@@ -11,12 +11,13 @@ use bevy::prelude::*;
 use bevy::transform::TransformSystems;
 use lodkit::combine::{ScreenRect, merge_rects, screen_rect};
 use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
+use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection, LodState};
 
 use super::render::FrameSequentialView;
-use super::tag::encode_tag;
+use super::tag::{decode_tag, encode_tag};
 use super::{
-    FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, PatternAnchor,
+    FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, VisibilitySpace,
 };
 
 /// Pixels the combine rectangles grow by on each side (rasterization and reprojection reach).
@@ -77,6 +78,11 @@ pub struct FrameSequentialStats {
     pub combine_pixels: u64,
     /// Frames the scheduler has run.
     pub frames: u64,
+    /// Whether the render world keeps this frame (copies its color and depth) for the next
+    /// frame's combine: while a group is in transition, and the frame before one begins.
+    pub frame_kept: bool,
+    /// Frames kept so far (of [`frames`](Self::frames)).
+    pub frames_kept: u64,
 }
 
 /// Spawns the drawing child of every new or changed [`LodLevels`]. A changed group starts over:
@@ -231,12 +237,15 @@ fn group_rect(
     }
 }
 
-/// Brings the scheduler's view of a group in line with lodkit's selection.
+/// Brings the scheduler's view of a group in line with lodkit's selection. A transition the
+/// selection starts begins only where `may_begin` (the older frame was kept); else this returns
+/// true: keep this frame, and the transition begins next frame.
 fn reconcile(
     scheduler: &mut TransitionScheduler,
     levels: &mut FrameSequentialLevels,
     selection: &LodSelection,
-) {
+    may_begin: bool,
+) -> bool {
     let key = *levels
         .key
         .get_or_insert_with(|| scheduler.insert(selection.current));
@@ -247,12 +256,12 @@ fn reconcile(
     if let Some((from, to)) = levels.transition {
         if selection.current == from && selection.next == Some(to) {
             let _ = scheduler.set_progress(key, selection.transition);
-            return;
+            return false;
         }
         if selection.current == to && selection.next.is_none() {
             // Done: the scheduler shows `to` whole this frame and settles on it.
             let _ = scheduler.set_progress(key, 1.0);
-            return;
+            return false;
         }
         // The selection turned back or jumped: settle where it is now.
         let _ = scheduler.remove(key);
@@ -269,6 +278,9 @@ fn reconcile(
         levels.key = Some(scheduler.insert(selection.current));
     }
     if let Some(next) = selection.next {
+        if !may_begin {
+            return true;
+        }
         let key = levels.key.expect("inserted above");
         if scheduler
             .begin_transition(key, next, Drive::Progress)
@@ -278,6 +290,7 @@ fn reconcile(
             levels.transition = Some((selection.current, next));
         }
     }
+    false
 }
 
 type CameraQuery<'w, 's> = Query<
@@ -345,24 +358,25 @@ fn update(
     if stats.frames > 0 {
         scheduler.advance(time.delta_secs());
     }
-    let frame = stats.frames;
-    stats.frames += 1;
+    stats.frames = scheduler.frame() + 1;
     scheduler.set_schedule(settings.schedule);
     let view_from_world = camera_transform.to_matrix().inverse();
     let clip_from_view = camera.clip_from_view();
-    let clip_from_world = clip_from_view * view_from_world;
     let previous_view = last.map_or((view_from_world, clip_from_view), |l| {
         (l.view_from_world, l.clip_from_view)
     });
-    let previous_clip_from_world = previous_view.1 * previous_view.0;
     let size = camera.physical_target_size().unwrap_or(UVec2::ONE);
     let lod_camera = LodCamera::new(
         glam::Vec3::from_array(camera_transform.translation().to_array()),
         to_lodkit(camera.clip_from_view()),
     );
-    let object = settings.anchor == PatternAnchor::Object;
+    let object = settings.anchor == VisibilitySpace::Object;
     let mut rects = Vec::new();
     let mut in_transition = 0;
+    // The combine needs last frame's picture: a transition begins only after a frame that the
+    // render world kept, and frames are kept only while a group is in transition or about to be.
+    let older_kept = last.is_some_and(|l| l.keep);
+    let mut keep_frame = false;
     for (entity, group, levels, transform, mut state) in &mut groups {
         let state = &mut *state;
         let had_key = state.key;
@@ -383,7 +397,7 @@ fn update(
             time.delta_secs(),
             &mut state.state,
         );
-        reconcile(scheduler, state, &selection);
+        keep_frame |= reconcile(scheduler, state, &selection, older_kept);
         if state.key != had_key {
             keys.retain(|&(g, _)| g != entity);
             keys.extend(state.key.map(|k| (entity, k)));
@@ -402,7 +416,8 @@ fn update(
             },
             None => (selection.current, 0),
         };
-        if tag != 0 {
+        // An n-instance's tag is not 0 (it carries tau = 1): its id is.
+        if decode_tag(tag).0 != 0 {
             in_transition += 1;
             if state.bounds.is_none() {
                 state.bounds = match group.bounds {
@@ -463,10 +478,17 @@ fn update(
     }
     let rects = merge_rects(&rects);
     stats.in_transition = in_transition;
+    stats.frame_kept = keep_frame || in_transition > 0;
+    stats.frames_kept += u64::from(stats.frame_kept);
     stats.combine_pixels = rects.iter().map(ScreenRect::area).sum();
-    let world_from_clip = clip_from_world.inverse();
     let new_to_old = if settings.reprojection {
-        previous_clip_from_world * world_from_clip
+        let m = new_to_old_matrix(
+            &to_lodkit(view_from_world),
+            &to_lodkit(clip_from_view),
+            &to_lodkit(previous_view.0),
+            &to_lodkit(previous_view.1),
+        );
+        Mat4::from_cols_array(&m.to_cols_array())
     } else {
         Mat4::IDENTITY
     };
@@ -479,7 +501,8 @@ fn update(
             .iter()
             .map(|r| URect::new(r.x, r.y, r.x + r.width, r.y + r.height))
             .collect(),
-        frame,
+        keep: stats.frame_kept,
+        buffer: scheduler.buffer_index(),
     });
 }
 
@@ -489,6 +512,50 @@ mod tests {
 
     use super::*;
     use crate::frame_sequential::LodLevel;
+    use lodkit::select::LodGroup;
+    use std::f32::consts::FRAC_PI_2;
+
+    /// A transition begins only after a frame the render world kept: the frame the selection
+    /// enters the band after idle frames is kept, with nothing in transition yet, and the
+    /// transition begins the frame after. Idle frames are not kept (no copies).
+    #[test]
+    fn a_transition_begins_after_a_kept_frame() {
+        let mut world = World::new();
+        world.init_resource::<Time>();
+        world.init_resource::<Assets<Mesh>>();
+        world.init_resource::<Scheduler>();
+        world.init_resource::<FrameSequentialStats>();
+        let mut camera = Camera::default();
+        // P[1][1] = 1: lodkit::select's distance is the distance itself.
+        camera.computed.clip_from_view = Mat4::perspective_infinite_reverse_rh(FRAC_PI_2, 1.0, 0.1);
+        world.spawn((
+            camera,
+            GlobalTransform::IDENTITY,
+            FrameSequentialLod::default(),
+        ));
+        let level = || LodLevel::new(Handle::default(), Handle::default());
+        let at = |z: f32| GlobalTransform::from_translation(Vec3::new(0.0, 0.0, -z));
+        let group = world
+            .spawn((
+                LodLevels(vec![level(), level()]),
+                FrameSequentialGroup::new(LodGroup::from_distances(&[0.0, 4.0]).unwrap()),
+                at(1.0),
+            ))
+            .id();
+        world.run_system_once(spawn_levels).unwrap();
+        let frame = |world: &mut World, z: f32| {
+            *world.get_mut::<GlobalTransform>(group).unwrap() = at(z);
+            world.run_system_once(update).unwrap();
+            let stats = world.resource::<FrameSequentialStats>().clone();
+            let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+            (stats.frame_kept, stats.in_transition, levels.transition)
+        };
+        assert_eq!(frame(&mut world, 1.0), (false, 0, None), "idle");
+        assert_eq!(frame(&mut world, 1.0), (false, 0, None), "idle");
+        assert_eq!(frame(&mut world, 4.1), (true, 0, None), "kept, not begun");
+        assert_eq!(frame(&mut world, 4.1), (true, 1, Some((0, 1))), "begun");
+        assert_eq!(world.resource::<FrameSequentialStats>().frames_kept, 2);
+    }
 
     /// A group whose levels change while it is in transition gives its t-instance id and slot
     /// back to the scheduler, and its old drawer goes.
