@@ -3,11 +3,13 @@
 //! the pass's own overhead.
 //! Wall time per pass including submit and wait, so read the ratio, not the absolute figures,
 //! on a software GPU. `lodkit demo` measures the same ratio for its report. Then its floors: the
-//! 8 main-path loads alone, and those with the 4 loads of its id-mismatch branch all made.
+//! 8 main-path loads alone, and those with the 4 loads of its id-mismatch branch all made. Last,
+//! the combine of the same frames in buffers without object motion (`combine_at`) against a copy
+//! of its six textures.
 //!
 //! `cargo bench -p lodkit-cli --bench combine [-- SIZE PAIRS]` (default 512 x 512, 200 pairs)
 
-use lodkit_cli::demo::{open_gpu, timing::combine_vs_copy};
+use lodkit_cli::demo::{combine_timing::combine_vs_copy, open_gpu};
 
 fn main() {
     let args: Vec<u32> = std::env::args().filter_map(|a| a.parse().ok()).collect();

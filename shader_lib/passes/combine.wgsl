@@ -19,8 +19,12 @@
 //   holding 0 for buffers without a motion target: every pixel reads its one texel), 7 params:
 //   CombineParams.
 // Shader defs: LODKIT_REVERSE_Z (bool, default off) — passed on to lodkit::combine.
+//   LODKIT_COMBINE_STILL (bool, default off) — for buffers without object motion: combine_at,
+//   which does not read binding 6 and whose 3x3 search is dead code once the driver folds the
+//   zero motion (one fetch fewer on the main path, and no search for a GPU that runs both sides
+//   of a branch to pay for; `lodkit check --stats` does not fold, so still counts it).
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
-#import lodkit::combine::combine_at_moved
+#import lodkit::combine::{combine_at, combine_at_moved}
 
 /// Per-frame parameters.
 struct CombineParams {
@@ -47,6 +51,10 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 @fragment
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(v.position.xy);
+#ifdef LODKIT_COMBINE_STILL
+    return combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel, params.new_to_old);
+#else
     let motion = textureLoad(object_motion, min(pixel, textureDimensions(object_motion, 0) - 1u), 0).xy;
     return combine_at_moved(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel, params.new_to_old, motion);
+#endif
 }

@@ -214,12 +214,18 @@ pub struct CombineParams {
 }
 
 /// The combine pass (`passes/combine.wgsl`) as a ready object: create once per target format,
-/// call [`encode`](Self::encode) once per frame.
+/// call [`encode`](Self::encode) once per frame. Buffers with an object motion target are
+/// combined with `combine_at_moved`; buffers without one
+/// ([`LodBuffers::without_motion`]) with `combine_at` (`LODKIT_COMBINE_STILL`), which reads no
+/// motion and whose 3x3 search the driver's compiler removes (the motion is a constant 0).
 #[derive(Debug)]
 pub struct CombinePass {
     pipeline: wgpu::RenderPipeline,
+    /// The pipeline for buffers without object motion (`LODKIT_COMBINE_STILL`).
+    still_pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
-    /// 1x1, zero: the object motion of buffers without a motion target.
+    /// 1x1, zero: bound at the motion binding for buffers without a motion target.
     still: wgpu::Texture,
     target_format: wgpu::TextureFormat,
 }
@@ -241,27 +247,31 @@ impl CombinePass {
         const CALL: &str = "CombinePass::new";
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
         check_color_format(gpu, CALL, "target_format", target_format, usage)?;
-        let defs: &[&str] = if reverse_z {
-            &["LODKIT_REVERSE_Z"]
-        } else {
-            &[]
-        };
+        let reverse = reverse_z.then_some("LODKIT_REVERSE_Z");
         gpu.guarded(CALL, || {
-            let module = gpu.pass_module("combine", defs)?;
             let size = std::mem::size_of::<CombineParams>();
             let mut entries = Self::buffer_layout_entries(0);
             entries.push(Self::motion_layout_entry(6));
             entries.push(uniform_entry(7, false));
-            let (_, layout) = one_group_layout(gpu, &entries, "lodkit combine");
-            let label = "lodkit combine";
-            Ok(Self {
-                pipeline: fullscreen_pipeline_with(
+            let (group, layout) = one_group_layout(gpu, &entries, "lodkit combine");
+            let pipeline = |still: bool| {
+                let defs: Vec<&str> = reverse
+                    .into_iter()
+                    .chain(still.then_some("LODKIT_COMBINE_STILL"))
+                    .collect();
+                let module = gpu.pass_module("combine", &defs)?;
+                fullscreen_pipeline_with(
                     gpu,
                     &module,
                     target_format,
                     Some(&layout),
-                    label,
-                )?,
+                    "lodkit combine",
+                )
+            };
+            Ok(Self {
+                pipeline: pipeline(false)?,
+                still_pipeline: pipeline(true)?,
+                layout: group,
                 params: uniform_buffer(gpu, size, "combine params")?,
                 still: texture_2d(
                     gpu,
@@ -438,10 +448,9 @@ impl CombinePass {
                 buffers.depth(newer + 1),
                 buffers.motion().unwrap_or(&self.still),
             ];
-            let layout = self.pipeline.get_bind_group_layout(0);
             let bind_group = textures_and_uniform(
                 gpu,
-                &layout,
+                &self.layout,
                 &textures,
                 Some(&self.params),
                 "lodkit combine",
@@ -451,7 +460,10 @@ impl CombinePass {
                 None => begin_color_pass(encoder, target, wgpu::Color::BLACK, label),
                 Some(_) => begin_load_pass(encoder, target, label),
             };
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(match buffers.motion() {
+                Some(_) => &self.pipeline,
+                None => &self.still_pipeline,
+            });
             pass.set_bind_group(0, &bind_group, &[]);
             match regions {
                 None => pass.draw(0..3, 0..1),

@@ -11,6 +11,7 @@
 //! ```
 
 pub mod closed_loop;
+pub mod combine_timing;
 pub mod cpu;
 pub mod doc_pictures;
 pub mod frame_cost;
@@ -330,7 +331,8 @@ pub fn run_on(
     bar.inc(1);
     bar.set_message("pass time ratios");
     let mut pass_ratios =
-        timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?.to_vec();
+        combine_timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?
+            .to_vec();
     pass_ratios.extend(timing::upsample_vs_bilinear(
         gpu,
         options.fb_size,
