@@ -103,25 +103,26 @@ pub fn combine_vs_copy(
     let proj = glam::camera::rh::proj::directx::perspective(0.8, 1.0, 0.1, 100.0);
     let views = [0.0f32, 0.1]
         .map(|x| glam::camera::rh::view::look_at_mat4(Vec3::new(x, 3.0, 7.0), Vec3::ZERO, Vec3::Y));
+    // Three rows of five, still (the previous model is the model).
+    let grid = |k: usize| {
+        Mat4::from_translation(Vec3::new(
+            (k % 5) as f32 * 2.0 - 4.0,
+            0.0,
+            -((k / 5) as f32) * 2.0,
+        ))
+    };
     for (i, view) in views.iter().enumerate() {
         let items: Vec<LodDrawItem> = (0..15)
-            .map(|k| LodDrawItem {
+            .map(|k| (k, grid(k)))
+            .map(|(k, model)| LodDrawItem {
                 mesh: &meshes[(k + i) % 2],
-                model: Mat4::from_translation(Vec3::new(
-                    (k % 5) as f32 * 2.0 - 4.0,
-                    0.0,
-                    -((k / 5) as f32) * 2.0,
-                )),
+                model,
                 color: Vec4::new(0.8, 0.2, 0.2, 1.0),
                 id: if k % 3 == 0 { k as u32 + 1 } else { 0 },
                 tau: if k % 3 == 0 { 0.5 } else { 1.0 },
                 tau_next: if k % 3 == 0 { 0.55 } else { 1.0 },
                 sway: [0.0; 2],
-                prev_model: Mat4::from_translation(Vec3::new(
-                    (k % 5) as f32 * 2.0 - 4.0,
-                    0.0,
-                    -((k / 5) as f32) * 2.0,
-                )),
+                prev_model: model,
                 prev_sway_phase: 0.0,
                 alpha_rect: Vec4::ZERO,
             })
@@ -189,64 +190,68 @@ pub fn combine_vs_copy(
             (depth, LOD_DEPTH_FORMAT, Texels::One),
         ]
     };
-    let mut copy_formats = [buffer("a", "b", "c"), buffer("d", "e", "f")].concat();
+    let copy6_formats = [buffer("a", "b", "c"), buffer("d", "e", "f")].concat();
+    let mut copy_formats = copy6_formats.clone();
     copy_formats.push(("g", MOTION_FORMAT, Texels::One));
-    let copy = Reads::of_source(COPY7, "copy7.wgsl", &copy_formats)?;
-    let mut combine_formats = [
-        buffer("newer_color", "newer_id", "newer_depth"),
-        buffer("older_color", "older_id", "older_depth"),
-    ]
-    .concat();
-    combine_formats.push(("object_motion", MOTION_FORMAT, Texels::One));
-    let combine_reads = Reads::of_pass("combine", &combine_formats)?;
-    let loads_reads = Reads::of_source(LOADS8, "loads8.wgsl", &copy_formats)?;
-    let loads12_reads = Reads::of_source(LOADS12, "loads12.wgsl", &copy_formats)?;
     let still_formats = [
         buffer("newer_color", "newer_id", "newer_depth"),
         buffer("older_color", "older_id", "older_depth"),
     ]
     .concat();
-    let still_reads = Reads::of_pass_with("combine", &["LODKIT_COMBINE_STILL"], &still_formats)?;
-    let copy6_formats = [buffer("a", "b", "c"), buffer("d", "e", "f")].concat();
-    let copy6_reads = Reads::of_source(COPY6, "copy6.wgsl", &copy6_formats)?;
-    let (pass_ms, baseline_ms, ratio) = interleaved(&run_still, &run_copy6, pairs)?;
-    let still_ratio = PassRatio {
-        pass: "combine, buffers without object motion (combine_at)".to_owned(),
-        baseline: "plain copy of the same 6 textures".to_owned(),
-        size: (size, size),
-        pass_ms,
-        baseline_ms,
-        ratio,
-        pairs,
-        pass_reads: still_reads,
-        baseline_reads: copy6_reads,
-    };
-    let time = |pass: &str, reads: Reads, run: &dyn Fn() -> Result<(), GpuError>| {
-        let (pass_ms, baseline_ms, ratio) = interleaved(run, &run_copy, pairs)?;
+    let mut combine_formats = still_formats.clone();
+    combine_formats.push(("object_motion", MOTION_FORMAT, Texels::One));
+    let against_copy7 = (
+        "plain copy of the same 7 textures",
+        &run_copy as &dyn Fn() -> Result<(), GpuError>,
+        Reads::of_source(COPY7, "copy7.wgsl", &copy_formats)?,
+    );
+    let against_copy6 = (
+        "plain copy of the same 6 textures",
+        &run_copy6 as &dyn Fn() -> Result<(), GpuError>,
+        Reads::of_source(COPY6, "copy6.wgsl", &copy6_formats)?,
+    );
+    type Baseline<'a> = (&'a str, &'a dyn Fn() -> Result<(), GpuError>, Reads);
+    let time = |pass: &str,
+                reads: Reads,
+                run: &dyn Fn() -> Result<(), GpuError>,
+                (baseline, run_baseline, baseline_reads): &Baseline| {
+        let (pass_ms, baseline_ms, ratio) = interleaved(run, *run_baseline, pairs)?;
         Ok::<_, GpuError>(PassRatio {
             pass: pass.to_owned(),
-            baseline: "plain copy of the same 7 textures".to_owned(),
+            baseline: (*baseline).to_owned(),
             size: (size, size),
             pass_ms,
             baseline_ms,
             ratio,
             pairs,
             pass_reads: reads,
-            baseline_reads: copy,
+            baseline_reads: *baseline_reads,
         })
     };
     Ok([
-        time("combine (frame-sequential)", combine_reads, &run_combine)?,
+        time(
+            "combine (frame-sequential)",
+            Reads::of_pass("combine", &combine_formats)?,
+            &run_combine,
+            &against_copy7,
+        )?,
         time(
             "the combine's 8 main-path loads alone",
-            loads_reads,
+            Reads::of_source(LOADS8, "loads8.wgsl", &copy_formats)?,
             &run_loads,
+            &against_copy7,
         )?,
         time(
             "the same and the 4 loads of its id-mismatch branch, all made",
-            loads12_reads,
+            Reads::of_source(LOADS12, "loads12.wgsl", &copy_formats)?,
             &run_loads12,
+            &against_copy7,
         )?,
-        still_ratio,
+        time(
+            "combine, buffers without object motion (combine_at)",
+            Reads::of_pass_with("combine", &["LODKIT_COMBINE_STILL"], &still_formats)?,
+            &run_still,
+            &against_copy6,
+        )?,
     ])
 }
