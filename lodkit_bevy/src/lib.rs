@@ -15,8 +15,9 @@
 //!   [`FrameSequentialGroup`](frame_sequential::FrameSequentialGroup) entities: smooth discrete
 //!   LOD transitions (Scherzer & Wimmer 2008). A group in transition draws one of its two
 //!   levels per frame and a combine pass merges consecutive frames, reprojected with Bevy's
-//!   depth and motion vectors: no see-through, no pop, about one level's cost. See
-//!   [`frame_sequential`].
+//!   depth and motion vectors: no see-through, no pop, one level drawn per frame. The depth and
+//!   motion-vector prepass it needs is its main cost in an app that has no prepass of its own:
+//!   see [`frame_sequential`] for the figures against Bevy's crossfade.
 //!
 //! lodkit is used with `default-features = false`: it brings no naga of its own, Bevy's naga_oil
 //! composes its modules.
