@@ -1,20 +1,33 @@
 //! Costs counted from the IR (`lodkit::shaders::cost`): hand-counted shaders give their counts,
 //! loops of constant trip count multiply out, branches count apart as conditional, calls are
-//! inlined, and lodkit's own passes give the fetches their headers state.
+//! inlined, and lodkit's own passes give the fetches their headers state. The counts never
+//! undercount: GLSL `for` loops, switch fall-through and counters set under branches are
+//! counted on their costliest path (`cost_bounds`), or the loop is reported as unbounded.
 
 use lodkit::shaders::cost::{Counts, EntryCost, FetchKind, entry_point_costs};
-use lodkit::shaders::{ComposeDescriptor, ShaderLibrary, find_module};
+use lodkit::shaders::{ComposeDescriptor, ShaderLibrary, SourceLanguage, find_module};
 
-fn costs(source: &str) -> Vec<EntryCost> {
+/// The cost of every entry point of `source`, composed as `language`.
+pub(crate) fn costs_in(source: &str, language: SourceLanguage) -> Vec<EntryCost> {
+    let file_path = match language {
+        SourceLanguage::Wgsl => "cost.wgsl",
+        SourceLanguage::Wesl => "cost.wesl",
+        SourceLanguage::Glsl(_) => "cost.frag",
+    };
     let composed = ShaderLibrary::new()
         .unwrap()
         .compose(&ComposeDescriptor {
             source,
-            file_path: "cost.wgsl",
+            file_path,
+            language,
             ..Default::default()
         })
         .unwrap_or_else(|e| panic!("{e}"));
     entry_point_costs(&composed.module)
+}
+
+fn costs(source: &str) -> Vec<EntryCost> {
+    costs_in(source, SourceLanguage::Wgsl)
 }
 
 fn only(source: &str) -> EntryCost {

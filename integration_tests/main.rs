@@ -8,6 +8,7 @@ mod support;
 mod alpha_tested;
 mod composition;
 mod cost;
+mod cost_bounds;
 mod display_time;
 mod draw_limits;
 mod frame_sequential;

@@ -6,6 +6,8 @@ use std::process::ExitCode;
 
 use lodkit::shaders;
 
+use crate::output::{Output, emit};
+
 /// `lodkit modules`: every module with its functions and shader defs.
 pub fn modules(json: bool) -> ExitCode {
     use std::fmt::Write as _;
@@ -72,28 +74,11 @@ pub fn write_wesl(out: &Path, npm: bool) -> ExitCode {
         }
     }
     let what = if npm { "npm package" } else { "WESL package" };
-    println!(
+    let mut stdout = Output::default();
+    stdout.println(&format!(
         "wrote {} files of the {what} `lodkit` into {}",
         files.len(),
         out.display()
-    );
-    ExitCode::SUCCESS
-}
-
-/// Writes a command's output to stdout. A reader that stops early (`lodkit modules | head`) is
-/// no error; any other failure to write is an I/O error (exit 2).
-pub fn emit(text: &str) -> ExitCode {
-    use std::io::Write as _;
-    let mut stdout = std::io::stdout().lock();
-    match stdout
-        .write_all(text.as_bytes())
-        .and_then(|()| stdout.flush())
-    {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: cannot write to stdout: {e}");
-            ExitCode::from(2)
-        }
-    }
+    ));
+    stdout.finish(ExitCode::SUCCESS)
 }

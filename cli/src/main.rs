@@ -2,14 +2,18 @@
 //! languages, and run the demo that measures every technique.
 //!
 //! Exit codes: 0 success, 1 a shader is invalid or the demo failed (no GPU adapter included),
-//! 2 usage, scene-file or I/O error.
+//! 2 usage, scene-file or I/O error. A reader that stops early (`lodkit ... | head -1`) changes
+//! none of them: everything printed on stdout goes through `output::Output`.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 mod library;
+mod output;
 mod stats;
+
+use output::Output;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use lodkit::shaders::{
@@ -97,8 +101,10 @@ enum Command {
         /// per resource) and its ALU ops, counted from the IR for one invocation.
         #[arg(long)]
         stats: bool,
-        /// A RON or TOML table of entry points and maxima (RON: `{ "fs_main": { "fetches": 9 } }`):
-        /// exit 1 when an entry point goes over.
+        /// RON or TOML entry points and maxima (`{ "fs_main": { "fetches": 9 } }`): exit 1 when
+        /// one goes over. Keys: ENTRY or FILE:ENTRY, then optional `-D NAME[=VALUE]` defs the run
+        /// must set (most defs wins). A loop of unknown trip count fails the budget unless the
+        /// entry or the file's top sets `allow_unbounded_loops: true`.
         #[arg(long, value_name = "FILE")]
         budget: Option<PathBuf>,
         /// Shaders to check (.wgsl: naga_oil; .wesl: WESL linked by wesl-rs; .glsl/.vert/.frag/.comp).
@@ -205,13 +211,20 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 
 fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
     use lodkit_cli::demo::DemoError;
-    println!("lodkit demo: writing into {}", options.out.display());
-    match lodkit_cli::demo::run(&options) {
+    let mut out = Output::default();
+    out.println(&format!(
+        "lodkit demo: writing into {}",
+        options.out.display()
+    ));
+    let code = match lodkit_cli::demo::run(&options) {
         Ok(report) => {
-            println!("{}", lodkit_cli::demo::report::summary(&report));
-            println!("open {}", options.out.join("index.html").display());
+            out.println(&lodkit_cli::demo::report::summary(&report));
+            out.println(&format!(
+                "open {}",
+                options.out.join("index.html").display()
+            ));
             if !report.plot_text {
-                println!("note: no TrueType font found, plots have no text (set LODKIT_FONT)");
+                out.println("note: no TrueType font found, plots have no text (set LODKIT_FONT)");
             }
             ExitCode::SUCCESS
         }
@@ -225,14 +238,16 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
                 _ => ExitCode::from(1),
             }
         }
-    }
+    };
+    out.finish(code)
 }
 
 fn adapter() -> ExitCode {
     match lodkit_cli::demo::open_gpu() {
         Ok(gpu) => {
-            println!("{}", gpu.adapter_summary());
-            ExitCode::SUCCESS
+            let mut out = Output::default();
+            out.println(&gpu.adapter_summary());
+            out.finish(ExitCode::SUCCESS)
         }
         Err(e) => {
             eprintln!("error: {e}");
@@ -395,7 +410,8 @@ fn check(
     budget: Option<&Path>,
     files: &[PathBuf],
 ) -> ExitCode {
-    let mut budget = match budget.map(stats::Budget::load).transpose() {
+    let defs: HashMap<String, ShaderDefValue> = args.define.iter().cloned().collect();
+    let mut budget = match budget.map(|b| stats::Budget::load(b, &defs)).transpose() {
         Ok(b) => b,
         Err(e) => {
             eprintln!("error[budget]: {e}");
@@ -403,6 +419,7 @@ fn check(
         }
     };
     let mut over = Vec::new();
+    let mut out = Output::default();
     let mut library = match library(args) {
         Ok(l) => l,
         Err(e) => {
@@ -411,8 +428,8 @@ fn check(
             } else {
                 1
             };
-            report_setup_error(format, &e);
-            return ExitCode::from(code);
+            report_setup_error(&mut out, format, &e);
+            return out.finish(ExitCode::from(code));
         }
     };
     let (mut invalid, mut unreadable) = (0, 0);
@@ -429,11 +446,11 @@ fn check(
                     .map(|e| e.name.clone())
                     .collect();
                 if let Format::Human = format {
-                    println!(
+                    out.println(&format!(
                         "ok: {file} ({} entry point{})",
                         entry_points.len(),
                         if entry_points.len() == 1 { "" } else { "s" }
-                    );
+                    ));
                 }
                 let mut report = serde_json::json!({"file": file, "valid": true, "entry_points": entry_points, "diagnostics": []});
                 if stats || budget.is_some() {
@@ -443,7 +460,7 @@ fn check(
                             over.extend(b.check(path, cost));
                         }
                         if stats && matches!(format, Format::Human) {
-                            print!("{}", stats::human(cost));
+                            out.print(&stats::human(cost));
                         }
                     }
                     report["stats"] = costs.iter().map(stats::json).collect();
@@ -480,7 +497,7 @@ fn check(
                 doc["within_budget"] = over.is_empty().into();
                 doc["over_budget"] = over.clone().into();
             }
-            println!("{doc}")
+            out.println(&doc.to_string())
         }
         Format::Human if files.len() > 1 => eprintln!(
             "checked {} files: {} valid, {} invalid, {} unreadable{}",
@@ -496,21 +513,21 @@ fn check(
         ),
         Format::Human => {}
     }
-    ExitCode::from(if unreadable > 0 {
+    out.finish(ExitCode::from(if unreadable > 0 {
         2
     } else if invalid > 0 || !over.is_empty() {
         1
     } else {
         0
-    })
+    }))
 }
 
-fn report_setup_error(format: Format, e: &ShaderError) {
+fn report_setup_error(out: &mut Output, format: Format, e: &ShaderError) {
     match format {
         Format::Human => print_error(e),
-        Format::Json => println!(
-            "{}",
-            serde_json::json!({"valid": false, "files": [], "diagnostics": [error_json(Path::new(""), e)]})
+        Format::Json => out.println(
+            &serde_json::json!({"valid": false, "files": [], "diagnostics": [error_json(Path::new(""), e)]})
+                .to_string(),
         ),
     }
 }
@@ -561,21 +578,19 @@ fn export(
             return ExitCode::from(if usage { 2 } else { 1 });
         }
     };
-    let result = if output == Path::new("-") {
-        use std::io::Write;
-        std::io::stdout().write_all(&exported.to_bytes())
-    } else {
-        std::fs::write(output, exported.to_bytes())
-    };
+    if output == Path::new("-") {
+        let mut out = Output::default();
+        out.write(&exported.to_bytes());
+        return out.finish(ExitCode::SUCCESS);
+    }
+    let result = std::fs::write(output, exported.to_bytes());
     match result {
         Ok(()) => {
-            if output != Path::new("-") {
-                let what = match exported {
-                    Exported::SpirV(w) => format!("{} SPIR-V words", w.len()),
-                    Exported::Text(t) => format!("{} bytes of {target}", t.len()),
-                };
-                eprintln!("wrote {} ({what})", output.display());
-            }
+            let what = match exported {
+                Exported::SpirV(w) => format!("{} SPIR-V words", w.len()),
+                Exported::Text(t) => format!("{} bytes of {target}", t.len()),
+            };
+            eprintln!("wrote {} ({what})", output.display());
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -2,6 +2,8 @@
 //! JSON), a budget it exceeds makes the check exit 1 (RON and TOML), one it meets exits 0, and a
 //! malformed budget is an error that names the file and the line (exit 2).
 
+use std::collections::{BTreeMap, BTreeSet};
+
 use crate::cli::{fixture, run};
 
 /// Hand-counted: 2 texture loads and 1 sample always; under the branch at most 2 more loads
@@ -130,28 +132,210 @@ fn a_malformed_budget_names_its_file_and_line() {
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
 
-/// lodkit's own passes stay within `cli/tests/passes-budget.ron`: the budget CI holds them to.
+/// One loop of a trip count the shader does not fix (`n` comes from a uniform): 1 load counted,
+/// for however many the loop makes.
+const UNBOUNDED: &[u8] = b"
+@group(0) @binding(0) var color: texture_2d<f32>;
+@group(0) @binding(1) var<uniform> n: u32;
+@fragment
+fn fs_main() -> @location(0) vec4<f32> {
+    var c = vec4<f32>(0.0);
+    for (var i = 0u; i < n; i++) {
+        c += textureLoad(color, vec2<u32>(i, 0u), 0);
+    }
+    return c;
+}
+";
+
 #[test]
-fn lodkits_passes_meet_their_budget() {
+fn a_loop_the_counter_cannot_bound_fails_the_budget_unless_allowed() {
+    let dir = fixture(&[
+        ("pass.wgsl", UNBOUNDED),
+        ("budget.ron", b"{ \"fs_main\": { \"fetches\": 100 } }"),
+        (
+            "entry.ron",
+            b"{ \"fs_main\": { \"fetches\": 100, \"allow_unbounded_loops\": true } }",
+        ),
+        (
+            "global.ron",
+            b"{ \"allow_unbounded_loops\": true, \"fs_main\": { \"fetches\": 100 } }",
+        ),
+        (
+            "global.toml",
+            b"allow_unbounded_loops = true\n[fs_main]\nfetches = 100\n",
+        ),
+        (
+            "overridden.ron",
+            b"{ \"allow_unbounded_loops\": true, \"fs_main\": { \"allow_unbounded_loops\": false } }",
+        ),
+        ("not_a_flag.ron", b"{ \"fs_main\": { \"allow_unbounded_loops\": 1 } }"),
+    ]);
+    // 1 fetch counted is far under 100, but the count is no bound: the budget fails.
+    let (code, _, stderr) = run(&dir, &["check", "--budget", "budget.ron", "pass.wgsl"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains(
+            "error[budget]: pass.wgsl: `fs_main` has 1 loop of unknown trip count (in `fs_main`)"
+        ),
+        "{stderr}"
+    );
+    assert!(stderr.contains("allow_unbounded_loops"), "{stderr}");
+    let (code, stdout, _) = run(
+        &dir,
+        &[
+            "check",
+            "--format",
+            "json",
+            "--budget",
+            "budget.ron",
+            "pass.wgsl",
+        ],
+    );
+    assert_eq!(code, 1);
+    let doc: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(doc["within_budget"], false);
+    assert_eq!(doc["files"][0]["stats"][0]["unknown_loops"], 1);
+    for allowed in ["entry.ron", "global.ron", "global.toml"] {
+        let (code, _, stderr) = run(&dir, &["check", "--budget", allowed, "pass.wgsl"]);
+        assert_eq!(code, 0, "{allowed}: {stderr}");
+    }
+    let (code, _, stderr) = run(&dir, &["check", "--budget", "overridden.ron", "pass.wgsl"]);
+    assert_eq!(
+        code, 1,
+        "an entry's own `false` wins over the global: {stderr}"
+    );
+    let (code, _, stderr) = run(&dir, &["check", "--budget", "not_a_flag.ron", "pass.wgsl"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("`allow_unbounded_loops` is true or false"),
+        "{stderr}"
+    );
+}
+
+/// The shader defs a pass reads: its own and those of the lodkit modules it imports, in the
+/// order they are first read.
+fn pass_defs(module: &lodkit::shaders::ModuleInfo, defs: &mut Vec<String>) {
+    for d in &module.shader_defs {
+        if !defs.contains(&d.name) {
+            defs.push(d.name.clone());
+        }
+    }
+    for line in module.source.lines() {
+        let Some(rest) = line.trim().strip_prefix("#import lodkit::") else {
+            continue;
+        };
+        let topic: String = rest
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect();
+        let import = lodkit::shaders::find_module(&format!("lodkit::{topic}"))
+            .unwrap_or_else(|| panic!("no module lodkit::{topic}"));
+        pass_defs(import, defs);
+    }
+}
+
+/// A budget key's entry name and the defs it names (`-D NAME` after the name).
+fn key_parts(key: &str) -> (&str, BTreeSet<&str>) {
+    let mut words = key.split_whitespace();
+    let name = words.next().unwrap_or_default();
+    (name, words.filter(|w| *w != "-D").collect())
+}
+
+/// lodkit's own passes stay within `cli/tests/passes-budget.ron`, the budget CI holds them to,
+/// in every shader-def variant: every subset of the defs each pass reads (through the modules
+/// it imports too) has its own key, which holds the fetches exactly.
+#[test]
+fn lodkits_passes_meet_their_budget_in_every_variant() {
     let root = crate::support::workspace_root();
-    let mut args = vec![
-        "check".to_owned(),
-        "--budget".to_owned(),
-        root.join("cli/tests/passes-budget.ron")
-            .display()
-            .to_string(),
-    ];
+    let budget_path = root.join("cli/tests/passes-budget.ron");
+    let budget: BTreeMap<String, BTreeMap<String, serde_json::Value>> =
+        ron::from_str(&std::fs::read_to_string(&budget_path).unwrap()).unwrap();
     let passes = root.join("shader_lib/passes");
-    let mut files: Vec<String> = std::fs::read_dir(&passes)
+    let mut files: Vec<std::path::PathBuf> = std::fs::read_dir(&passes)
         .unwrap()
-        .map(|e| e.unwrap().path().display().to_string())
-        .filter(|p| p.ends_with(".wgsl"))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "wgsl"))
         .collect();
     files.sort();
     assert_eq!(files.len(), 6, "a new pass needs a budget: {files:?}");
-    args.extend(files);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (code, _, stderr) = run(&root, &args);
-    assert_eq!(code, 0, "{stderr}");
-    assert!(!stderr.contains("warning[budget]"), "{stderr}");
+    // Per pass, its file name and every subset of its defs.
+    let mut variants: Vec<(String, Vec<Vec<String>>)> = Vec::new();
+    let mut seen = BTreeSet::new();
+    for file in &files {
+        let name = file.file_name().unwrap().to_string_lossy().into_owned();
+        let module = lodkit::shaders::modules()
+            .iter()
+            .find(|m| m.path == format!("passes/{name}"))
+            .unwrap_or_else(|| panic!("{name} is not in the registry"));
+        let mut defs = Vec::new();
+        pass_defs(module, &mut defs);
+        for d in &defs {
+            // Runs set several passes' defs at once: a def two passes read would tie them.
+            assert!(seen.insert(d.clone()), "{d} is read by two passes");
+        }
+        let subsets = (0..1usize << defs.len())
+            .map(|bits| {
+                (0..defs.len())
+                    .filter(|i| bits & (1 << i) != 0)
+                    .map(|i| defs[i].clone())
+                    .collect()
+            })
+            .collect();
+        variants.push((name, subsets));
+    }
+    let runs = variants.iter().map(|(_, s)| s.len()).max().unwrap();
+    assert!(runs > 1, "the passes read shader defs: {variants:?}");
+    for run_index in 0..runs {
+        let mut args = vec![
+            "check".to_owned(),
+            "--format=json".to_owned(),
+            "--budget".to_owned(),
+            budget_path.display().to_string(),
+        ];
+        let mut expected = Vec::new();
+        for (name, subsets) in &variants {
+            let defs = &subsets[run_index % subsets.len()];
+            for d in defs {
+                args.extend(["-D".to_owned(), d.clone()]);
+            }
+            let key = budget
+                .iter()
+                .find(|(k, _)| {
+                    let (entry, key_defs) = key_parts(k);
+                    entry == format!("{name}:fs_main")
+                        && key_defs == defs.iter().map(String::as_str).collect()
+                })
+                .unwrap_or_else(|| panic!("no budget key for {name}:fs_main with {defs:?}"));
+            expected.push((
+                name.clone(),
+                defs.clone(),
+                key.1.get("fetches").and_then(serde_json::Value::as_u64),
+            ));
+        }
+        args.extend(files.iter().map(|f| f.display().to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, stdout, stderr) = run(&root, &args);
+        assert_eq!(code, 0, "{args:?}: {stdout}{stderr}");
+        assert!(!stderr.contains("warning[budget]"), "{args:?}: {stderr}");
+        let doc: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        for (file, (name, defs, fetches)) in doc["files"].as_array().unwrap().iter().zip(&expected)
+        {
+            let fs = file["stats"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|s| s["name"] == "fs_main")
+                .unwrap();
+            let w = &fs["worst"];
+            let measured: u64 = ["texture_loads", "samples", "gathers", "storage_reads"]
+                .iter()
+                .map(|k| w[k].as_u64().unwrap())
+                .sum();
+            assert_eq!(
+                Some(measured),
+                *fetches,
+                "{name} with {defs:?}: the budget holds fetches exactly"
+            );
+        }
+    }
 }

@@ -12,4 +12,5 @@ mod docs_figures;
 mod engine_tree;
 mod impostor;
 mod npm_package;
+mod pipes;
 mod wesl_check;

@@ -3,18 +3,34 @@
 //! hold on any GPU (before caches), where timings on one machine do not, so a CI can hold a
 //! shader to a budget (`lodkit check --stats --budget FILE`).
 //!
-//! Calls are inlined by walking the call graph. A loop whose trip count the IR fixes (a counter
-//! from a constant, compared with a constant, stepped by a constant, as `for (var i = 0u; i < 4u;
-//! i++)` gives) multiplies its body; any other loop counts once and is reported in
-//! [`EntryCost::unknown_loops`]. What runs under an `if` or `switch` is counted apart as
-//! `conditional`: the most that any one path through the branches adds (per count, so a sound
-//! upper bound), on top of the `always` part, what runs outside any branch. (What follows an
-//! early `return` inside a branch still counts as `always`: the main path.)
+//! The counts never undercount: where the IR leaves a choice they take the costliest one, and a
+//! loop they cannot bound is reported.
+//!
+//! - Calls are inlined by walking the call graph.
+//! - A loop whose trip count the IR fixes multiplies its body: a counter compared with a
+//!   constant and stepped by a constant, whatever constant it may hold when the loop starts (set
+//!   before the loop, in an enclosing block, or under a branch: the start that gives the most
+//!   trips counts). `for (var i = 0u; i < 4u; i++)`, a GLSL `for` (which naga lowers to
+//!   `loop { if (!(cond)) { break; } ... }`), the same written by hand, and
+//!   `loop { ... continuing { k += 1u; break if k >= 3u; } }` are counted. Counters wrap as
+//!   their type does (a `u32` counting down to `i >= 0u` never stops). The exit test at the top
+//!   of a loop runs once more than its body.
+//! - Any other loop counts once and is reported in [`EntryCost::unknown_loops`] (and, by the
+//!   function it is in, [`EntryCost::unknown_loops_in`]): the counts are then no upper bound.
+//! - What runs under an `if` or `switch` is counted apart as `conditional`: the most that any
+//!   one path through the branches adds (per count, so a sound upper bound), on top of the
+//!   `always` part, what runs outside any branch. A `switch` case that falls through (GLSL)
+//!   pays for the cases it falls into. (What follows an early `return` inside a branch still
+//!   counts as `always`: the main path.)
 
 use std::collections::BTreeMap;
 
 use naga::{Block, Expression, Function, Handle, Module, Statement};
 use serde::Serialize;
+
+mod loops;
+
+use loops::Place;
 
 /// What kind of memory read a fetch is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
@@ -109,12 +125,18 @@ pub struct EntryCost {
     pub conditional: Counts,
     /// Per resource and kind of fetch, in binding order.
     pub resources: Vec<ResourceFetches>,
-    /// Loops whose trip count the IR does not fix: their bodies are counted once.
+    /// Loops the counter could not bound (the IR does not fix their trip count): their bodies
+    /// are counted once, so the counts are then no upper bound. A loop in a function called
+    /// twice counts twice.
     pub unknown_loops: u32,
+    /// The function each of those loops is in (the entry point's own name for its body), in
+    /// the order they were met; as long as `unknown_loops`.
+    pub unknown_loops_in: Vec<String>,
 }
 
 impl EntryCost {
-    /// The most an invocation can execute: `always` plus `conditional`.
+    /// The most an invocation can execute: `always` plus `conditional`. With
+    /// [`unknown_loops`](Self::unknown_loops) above zero, an invocation may execute more.
     pub fn worst(&self) -> Counts {
         self.always.plus(self.conditional)
     }
@@ -128,9 +150,9 @@ pub fn entry_point_costs(module: &Module) -> Vec<EntryCost> {
         .map(|ep| {
             let mut walker = Walker {
                 module,
-                unknown_loops: 0,
+                unknown_loops_in: Vec::new(),
             };
-            let tally = walker.block(&ep.function, &ep.function.body, &[], 0);
+            let tally = walker.block(&ep.function, &ep.name, &ep.function.body, &[], 0, None);
             let mut resources: Vec<ResourceFetches> = tally
                 .fetches
                 .iter()
@@ -154,7 +176,8 @@ pub fn entry_point_costs(module: &Module) -> Vec<EntryCost> {
                 always: tally.always,
                 conditional: tally.conditional,
                 resources,
-                unknown_loops: walker.unknown_loops,
+                unknown_loops: u32::try_from(walker.unknown_loops_in.len()).unwrap_or(u32::MAX),
+                unknown_loops_in: walker.unknown_loops_in,
             }
         })
         .collect()
@@ -216,12 +239,10 @@ impl Tally {
 
 /// Calls deeper than this are not followed (WGSL has no recursion; this bounds bad IR).
 const MAX_CALL_DEPTH: usize = 64;
-/// Loops running longer than this count as unknown.
-const MAX_TRIPS: u64 = 1 << 16;
 
 struct Walker<'a> {
     module: &'a Module,
-    unknown_loops: u32,
+    unknown_loops_in: Vec<String>,
 }
 
 /// For each argument of the function being walked, the global variable it passes on (a texture
@@ -229,43 +250,106 @@ struct Walker<'a> {
 type Args = [Option<Handle<naga::GlobalVariable>>];
 
 impl Walker<'_> {
-    fn block(&mut self, f: &Function, block: &Block, args: &Args, depth: usize) -> Tally {
+    /// The tally of `stmts`, statements of `f` (named `name`); `outer` is where the block sits
+    /// (`None` for a function's body), for what a loop counter holds when its loop starts.
+    fn block(
+        &mut self,
+        f: &Function,
+        name: &str,
+        stmts: &[Statement],
+        args: &Args,
+        depth: usize,
+        outer: Option<&Place<'_>>,
+    ) -> Tally {
+        self.block_in(f, name, stmts, args, depth, outer, None)
+    }
+
+    /// [`block`](Self::block) for a loop's body or continuing block (`in_loop`: the loop's
+    /// body and continuing block).
+    #[allow(clippy::too_many_arguments)]
+    fn block_in(
+        &mut self,
+        f: &Function,
+        name: &str,
+        stmts: &[Statement],
+        args: &Args,
+        depth: usize,
+        outer: Option<&Place<'_>>,
+        in_loop: Option<(&Block, &Block)>,
+    ) -> Tally {
         let mut t = Tally::default();
-        for (i, stmt) in block.iter().enumerate() {
+        for (i, stmt) in stmts.iter().enumerate() {
+            let here = Place {
+                before: &stmts[..i],
+                in_loop,
+                outer,
+            };
+            let inner = Some(&here);
             match stmt {
                 Statement::Emit(range) => {
                     for h in range.clone() {
                         self.expression(f, h, args, &mut t);
                     }
                 }
-                Statement::Block(b) => t.add(&self.block(f, b, args, depth)),
+                Statement::Block(b) => t.add(&self.block(f, name, b, args, depth, inner)),
                 Statement::If { accept, reject, .. } => {
                     let branches = [
-                        self.block(f, accept, args, depth),
-                        self.block(f, reject, args, depth),
+                        self.block(f, name, accept, args, depth, inner),
+                        self.block(f, name, reject, args, depth, inner),
                     ];
                     t.branch(&branches);
                 }
                 Statement::Switch { cases, .. } => {
-                    let branches: Vec<Tally> = cases
+                    let bodies: Vec<Tally> = cases
                         .iter()
-                        .map(|c| self.block(f, &c.body, args, depth))
+                        .map(|c| self.block(f, name, &c.body, args, depth, inner))
                         .collect();
-                    t.branch(&branches);
+                    // A path starts at a case and runs on through the cases it falls into.
+                    let mut paths = bodies.clone();
+                    for j in (0..cases.len().saturating_sub(1)).rev() {
+                        if cases[j].fall_through {
+                            let next = paths[j + 1].clone();
+                            paths[j].add(&next);
+                        }
+                    }
+                    t.branch(&paths);
                 }
                 Statement::Loop {
                     body,
                     continuing,
                     break_if,
                 } => {
-                    let mut once = self.block(f, body, args, depth);
-                    once.add(&self.block(f, continuing, args, depth));
-                    let trips =
-                        trip_count(self.module, f, &block[..i], body, continuing, *break_if);
-                    if trips.is_none() {
-                        self.unknown_loops += 1;
+                    let inside = Some((body, continuing));
+                    let walk = |s: &mut Self, part: &[Statement]| {
+                        s.block_in(f, name, part, args, depth, inner, inside)
+                    };
+                    match loops::trip_count(self.module, f, &here, body, continuing, *break_if) {
+                        Some(loops::Trips {
+                            trips,
+                            test_at: Some(k),
+                        }) => {
+                            // The exit test at the top runs once more than the rest.
+                            let head = walk(self, &body[..=k]);
+                            let mut rest = walk(self, &body[k + 1..]);
+                            rest.add(&walk(self, continuing));
+                            t.add(&head.times(trips + 1));
+                            t.add(&rest.times(trips));
+                        }
+                        Some(loops::Trips {
+                            trips,
+                            test_at: None,
+                        }) => {
+                            let mut once = walk(self, body);
+                            once.add(&walk(self, continuing));
+                            t.add(&once.times(trips));
+                        }
+                        None => {
+                            let mut once = walk(self, body);
+                            once.add(&walk(self, continuing));
+                            self.unknown_loops_in.push(name.to_owned());
+                            t.add(&once);
+                        }
                     }
-                    t.add(&once.times(trips.unwrap_or(1)));
                 }
                 Statement::Call {
                     function,
@@ -275,7 +359,8 @@ impl Walker<'_> {
                     let callee = &self.module.functions[*function];
                     let passed: Vec<_> =
                         arguments.iter().map(|a| global_root(f, *a, args)).collect();
-                    t.add(&self.block(callee, &callee.body, &passed, depth + 1));
+                    let callee_name = callee.name.as_deref().unwrap_or("?");
+                    t.add(&self.block(callee, callee_name, &callee.body, &passed, depth + 1, None));
                 }
                 Statement::Atomic { pointer, .. } => {
                     if let Some(g) = storage_root(self.module, f, *pointer, args) {
@@ -356,204 +441,4 @@ fn storage_root(
         naga::AddressSpace::Storage { .. }
     )
     .then_some(g)
-}
-
-/// An integer the IR fixes: a literal, a constant, a zero value.
-fn constant(
-    module: &Module,
-    exprs: &naga::Arena<Expression>,
-    h: Handle<Expression>,
-) -> Option<i64> {
-    match &exprs[h] {
-        Expression::Literal(l) => literal(*l),
-        Expression::Constant(c) => {
-            let init = module.constants[*c].init;
-            constant(module, &module.global_expressions, init)
-        }
-        Expression::ZeroValue(_) => Some(0),
-        _ => None,
-    }
-}
-
-fn literal(l: naga::Literal) -> Option<i64> {
-    match l {
-        naga::Literal::U32(v) => Some(i64::from(v)),
-        naga::Literal::I32(v) => Some(i64::from(v)),
-        naga::Literal::U64(v) => i64::try_from(v).ok(),
-        naga::Literal::I64(v) | naga::Literal::AbstractInt(v) => Some(v),
-        _ => None,
-    }
-}
-
-/// The local variable a `Load` reads, if it is one.
-fn loaded_local(f: &Function, h: Handle<Expression>) -> Option<Handle<naga::LocalVariable>> {
-    match &f.expressions[h] {
-        Expression::Load { pointer } => match &f.expressions[*pointer] {
-            Expression::LocalVariable(v) => Some(*v),
-            _ => None,
-        },
-        _ => None,
-    }
-}
-
-/// A comparison `counter op bound` with a constant bound: (counter, op, bound), the counter on
-/// the left (a bound on the left is turned around).
-fn comparison(
-    module: &Module,
-    f: &Function,
-    h: Handle<Expression>,
-) -> Option<(Handle<naga::LocalVariable>, naga::BinaryOperator, i64)> {
-    use naga::BinaryOperator as B;
-    let Expression::Binary { op, left, right } = &f.expressions[h] else {
-        return None;
-    };
-    if let (Some(v), Some(b)) = (
-        loaded_local(f, *left),
-        constant(module, &f.expressions, *right),
-    ) {
-        return Some((v, *op, b));
-    }
-    let (v, b) = (
-        loaded_local(f, *right)?,
-        constant(module, &f.expressions, *left)?,
-    );
-    let flipped = match op {
-        B::Less => B::Greater,
-        B::LessEqual => B::GreaterEqual,
-        B::Greater => B::Less,
-        B::GreaterEqual => B::LessEqual,
-        other => *other,
-    };
-    Some((v, flipped, b))
-}
-
-fn holds(op: naga::BinaryOperator, a: i64, b: i64) -> Option<bool> {
-    use naga::BinaryOperator as B;
-    Some(match op {
-        B::Less => a < b,
-        B::LessEqual => a <= b,
-        B::Greater => a > b,
-        B::GreaterEqual => a >= b,
-        B::NotEqual => a != b,
-        B::Equal => a == b,
-        _ => return None,
-    })
-}
-
-/// The trip count of a counted loop, when the IR fixes it. `before` is what precedes the loop
-/// in its block (where the counter is set).
-fn trip_count(
-    module: &Module,
-    f: &Function,
-    before: &[Statement],
-    body: &Block,
-    continuing: &Block,
-    break_if: Option<Handle<Expression>>,
-) -> Option<u64> {
-    // The exit test: `if cond {} else { break; }` (or `if cond { break; }`) first in the body,
-    // or `break if cond` at the end of the continuing block.
-    let (test, stay_when) = body
-        .iter()
-        .find_map(|s| match s {
-            Statement::Emit(_) => None,
-            Statement::If {
-                condition,
-                accept,
-                reject,
-            } => {
-                let is_break =
-                    |b: &Block| b.len() == 1 && matches!(b.iter().next(), Some(Statement::Break));
-                if accept.is_empty() && is_break(reject) {
-                    Some(Some((*condition, true)))
-                } else if reject.is_empty() && is_break(accept) {
-                    Some(Some((*condition, false)))
-                } else {
-                    Some(None)
-                }
-            }
-            _ => Some(None),
-        })
-        .flatten()
-        .or_else(|| break_if.map(|c| (c, false)))?;
-    let (var, op, bound) = comparison(module, f, test)?;
-    // The step: `counter = counter +/- constant` in the continuing block.
-    let step = continuing.iter().find_map(|s| match s {
-        Statement::Store { pointer, value }
-            if matches!(f.expressions[*pointer], Expression::LocalVariable(v) if v == var) =>
-        {
-            match &f.expressions[*value] {
-                Expression::Binary {
-                    op: naga::BinaryOperator::Add,
-                    left,
-                    right,
-                } if loaded_local(f, *left) == Some(var) => constant(module, &f.expressions, *right),
-                Expression::Binary {
-                    op: naga::BinaryOperator::Subtract,
-                    left,
-                    right,
-                } if loaded_local(f, *left) == Some(var) => {
-                    constant(module, &f.expressions, *right).map(|s| -s)
-                }
-                _ => None,
-            }
-        }
-        _ => None,
-    })?;
-    // The start: the last store before the loop, else the variable's initializer, else zero.
-    let start = before
-        .iter()
-        .rev()
-        .find_map(|s| match s {
-            Statement::Store { pointer, value }
-                if matches!(f.expressions[*pointer], Expression::LocalVariable(v) if v == var) =>
-            {
-                Some(constant(module, &f.expressions, *value))
-            }
-            _ => None,
-        })
-        .unwrap_or_else(|| match f.local_variables[var].init {
-            Some(init) => constant(module, &f.expressions, init),
-            None => Some(0),
-        })?;
-    // A body that also stores to the counter is not a counted loop.
-    if stores_to(f, body, var) {
-        return None;
-    }
-    let (mut i, mut trips) = (start, 0u64);
-    // With `break if`, the body runs before the first test.
-    if Some(test) == break_if {
-        loop {
-            trips += 1;
-            i += step;
-            if holds(op, i, bound)? != stay_when || trips > MAX_TRIPS {
-                break;
-            }
-        }
-    } else {
-        while holds(op, i, bound)? == stay_when {
-            trips += 1;
-            i += step;
-            if trips > MAX_TRIPS {
-                return None;
-            }
-        }
-    }
-    (trips <= MAX_TRIPS).then_some(trips)
-}
-
-fn stores_to(f: &Function, block: &Block, var: Handle<naga::LocalVariable>) -> bool {
-    block.iter().any(|s| match s {
-        Statement::Store { pointer, .. } => {
-            matches!(f.expressions[*pointer], Expression::LocalVariable(v) if v == var)
-        }
-        Statement::Block(b) => stores_to(f, b, var),
-        Statement::If { accept, reject, .. } => {
-            stores_to(f, accept, var) || stores_to(f, reject, var)
-        }
-        Statement::Switch { cases, .. } => cases.iter().any(|c| stores_to(f, &c.body, var)),
-        Statement::Loop {
-            body, continuing, ..
-        } => stores_to(f, body, var) || stores_to(f, continuing, var),
-        _ => false,
-    })
 }
