@@ -1,11 +1,11 @@
 //! # lodkit_bevy
 //!
-//! [lodkit](https://docs.rs/lodkit) in Bevy 0.19: its shader modules as Bevy shader assets, and
+//! [lodkit](https://docs.rs/lodkit) in Bevy 0.20: its WESL shader modules as Bevy shader assets, and
 //! its techniques as plugins.
 //!
-//! - [`LodkitShadersPlugin`]: every `lodkit::` WGSL module becomes a `Shader` asset, so your
-//!   materials and post-processing shaders can `#import lodkit::screen_door::screen_door_keep`,
-//!   `#import lodkit::bilateral::bilateral_upsample`, and so on.
+//! - [`LodkitShadersPlugin`]: every `lodkit::` WESL module becomes a `Shader` asset, so your
+//!   materials and post-processing shaders can `import lodkit::screen_door::screen_door_keep;`,
+//!   `import lodkit::bilateral::bilateral_upsample_at;`, and so on.
 //! - [`FramebufferLodPlugin`] with the [`FramebufferLod`] camera component: geometry-aware
 //!   framebuffer LOD (Yang, Sander & Lawrence 2008). Your expensive effect runs at 1/r
 //!   resolution, lodkit's bilateral upsample rebuilds it from the depth and normal prepass
@@ -19,8 +19,8 @@
 //!   motion-vector prepass it needs is its main cost in an app that has no prepass of its own:
 //!   see [`frame_sequential`] for the figures against Bevy's crossfade.
 //!
-//! lodkit is used with `default-features = false`: it brings no naga of its own, Bevy's naga_oil
-//! composes its modules.
+//! lodkit is used with `default-features = false`: it brings no naga of its own; Bevy links its
+//! WESL modules (wesl-rs), as it links its own.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -50,8 +50,8 @@ pub mod prelude {
     };
     pub use crate::framebuffer_lod::{
         FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodComposite,
-        FramebufferLodPlugin, FramebufferLodResolution, FramebufferLodState,
-        FramebufferLodUpsample, FramerateTarget,
+        FramebufferLodFrameTimes, FramebufferLodPlugin, FramebufferLodResolution,
+        FramebufferLodState, FramebufferLodSystems, FramebufferLodUpsample, FramerateTarget,
     };
     pub use crate::shaders::LodkitShadersPlugin;
 }

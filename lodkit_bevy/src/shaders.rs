@@ -1,29 +1,50 @@
-//! lodkit's WGSL modules as Bevy `Shader` assets.
+//! lodkit's WESL modules as Bevy `Shader` assets.
 
 use bevy::prelude::*;
-use lodkit::shaders::{Language, ModuleKind};
 
-/// Registers every lodkit WGSL module (naga_oil form) as a `Shader` asset, so any shader can
-/// `#import lodkit::<topic>::<item>`.
+/// Registers every lodkit WESL module as a `Shader` asset, so any WESL shader of the app can
+/// `import lodkit::<topic>::<item>;` (for example
+/// `import lodkit::bilateral::bilateral_upsample_at;`).
+///
+/// Each module is registered with `Shader::from_wesl(source, "embedded://lodkit/<topic>.wesl")`:
+/// Bevy names a module after that path, `lodkit::<topic>`, the path wesl-js and wesl-rs give the
+/// same package. Inside the package the modules import each other as `package::<topic>`. Shader
+/// defs a module reads (`LODKIT_REVERSE_Z`, `LODKIT_SCREEN_DOOR_BLUE_NOISE`) are WESL conditions:
+/// set them as bool shader defs on the pipeline that imports the module.
 ///
 /// All modules are registered, not only those you import: they import each other, and Bevy
-/// reports a missing module only as a pipeline that never becomes ready.
+/// reports a missing module only as a warning and a pipeline that never becomes ready.
 pub struct LodkitShadersPlugin;
 
-/// Strong handles that keep lodkit's modules loaded for the app's lifetime.
+/// Strong handles that keep lodkit's modules loaded for the app's lifetime, one per module.
 #[derive(Resource)]
 pub struct LodkitShaders(pub Vec<Handle<Shader>>);
 
 impl Plugin for LodkitShadersPlugin {
     fn build(&self, app: &mut App) {
         let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
-        // `from_wgsl` reads `#define_import_path lodkit::<topic>` from the source: that is the
-        // name `#import` resolves, whatever the asset path.
-        let modules = lodkit::shaders::modules()
-            .iter()
-            .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
-            .map(|m| shaders.add(Shader::from_wgsl(m.source, m.path)))
+        let modules = lodkit::shaders::wesl_modules()
+            .filter_map(|m| {
+                let path = m.embedded_path.clone()?;
+                Some(shaders.add(Shader::from_wesl(m.source, path)))
+            })
             .collect();
         app.insert_resource(LodkitShaders(modules));
     }
+}
+
+/// Registers a WESL library module of lodkit_bevy's own under `embedded://lodkit_bevy/<name>.wesl`,
+/// importable as `lodkit_bevy::<name>`, kept loaded for the app's lifetime.
+pub(crate) fn register_library(app: &mut App, name: &str, source: &'static str) {
+    let handle = app
+        .world_mut()
+        .resource_mut::<Assets<Shader>>()
+        .add(Shader::from_wesl(
+            source,
+            format!("embedded://lodkit_bevy/{name}.wesl"),
+        ));
+    app.world_mut()
+        .resource_mut::<LodkitShaders>()
+        .0
+        .push(handle);
 }

@@ -19,12 +19,12 @@ pub struct LodDitherShaderPlugin;
 
 impl Plugin for LodDitherShaderPlugin {
     fn build(&self, app: &mut App) {
-        let source = include_str!("lod_dither.wgsl");
+        let source = include_str!("lod_dither.wesl");
         app.world_mut()
             .resource_mut::<Assets<Shader>>()
             .insert(
                 &LOD_DITHER_SHADER,
-                Shader::from_wgsl(source, "shaders/lod_dither.wgsl"),
+                Shader::from_wesl(source, "shaders/lod_dither.wesl"),
             )
             .expect("UUID handles never fail to insert");
     }
@@ -37,7 +37,7 @@ pub struct LodDitherMaterial {
     pub params: LodDitherParams,
 }
 
-/// The material's uniform (`LodDitherParams` in lod_dither.wgsl).
+/// The material's uniform (`LodDitherParams` in lod_dither.wesl).
 #[derive(ShaderType, Clone, Copy, Debug)]
 pub struct LodDitherParams {
     /// Linear RGB of the level.

@@ -11,7 +11,7 @@
 //! 1. `lodkit_bevy::LodkitShadersPlugin`: every lodkit WGSL module becomes a `Shader` asset, so a
 //!    material can `#import lodkit::screen_door::screen_door_keep` (Bevy's naga_oil resolves
 //!    imports through `Assets<Shader>`; lodkit is used with `default-features = false`).
-//! 2. [`LodDitherMaterial`]: a `Material` whose fragment shader (`assets/shaders/lod_dither.wgsl`)
+//! 2. [`LodDitherMaterial`]: a `Material` whose fragment shader (`assets/shaders/lod_dither.wesl`)
 //!    discards through lodkit's pattern with a signed alpha per level.
 //! 3. [`LodDriver`]: `lodkit::select` decides which level(s) to draw and the transition `t`;
 //!    [`apply_selection`] turns `LodSelection::screen_door_alphas()` into visibility and alphas.

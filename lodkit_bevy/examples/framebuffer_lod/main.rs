@@ -12,7 +12,7 @@
 //! and `figure.png` (reference, bilinear and bilateral at r = 2 above their error maps). With
 //! `--report` also the figures as JSON. Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O.
 //!
-//! The part an application copies is the camera in `spawn_scene` and `fog.wgsl`.
+//! The part an application copies is the camera in `spawn_scene` and `fog.wesl`.
 
 #[path = "../common/frames.rs"]
 #[allow(
@@ -35,7 +35,7 @@ use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use lodkit_bevy::prelude::*;
 
-/// The fog effect (fog.wgsl) and the depth probe (depth_probe.wgsl), under fixed handles.
+/// The fog effect (fog.wesl) and the depth probe (depth_probe.wesl), under fixed handles.
 const FOG: Handle<Shader> = uuid_handle!("3b0e7c1e-5f0a-4d55-9a62-7f1f6c2d8e41");
 const PROBE: Handle<Shader> = uuid_handle!("9d4c2a77-1e3b-4c8f-b0a5-2e6f8d1c3b92");
 
@@ -62,11 +62,11 @@ impl Plugin for EffectShadersPlugin {
     fn build(&self, app: &mut App) {
         let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
         for (handle, source, path) in [
-            (&FOG, include_str!("fog.wgsl"), "fog.wgsl"),
-            (&PROBE, include_str!("depth_probe.wgsl"), "depth_probe.wgsl"),
+            (&FOG, include_str!("fog.wesl"), "fog.wesl"),
+            (&PROBE, include_str!("depth_probe.wesl"), "depth_probe.wesl"),
         ] {
             shaders
-                .insert(handle, Shader::from_wgsl(source, path))
+                .insert(handle, Shader::from_wesl(source, path))
                 .expect("UUID handles never fail to insert");
         }
     }

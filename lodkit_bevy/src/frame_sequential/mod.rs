@@ -66,7 +66,8 @@
 //!   combine over the screen rectangles of the groups in transition.
 //!
 //! Limits: one camera per app drives the selection (the first active one with
-//! [`FrameSequentialLod`]); MSAA must be off; a group in transition casts the shadow of the
+//! [`FrameSequentialLod`]); the combine needs `Msaa::Off` (with MSAA the plugin logs one
+//! warning and its groups switch levels at once, with no transition); a group in transition casts the shadow of the
 //! level drawn that frame (use `NotShadowCaster` on levels if that flickers in your scene);
 //! at most [`MAX_TAG_ID`] groups in transition at once (more switch at once, with a warning).
 
@@ -82,7 +83,6 @@ use bevy::pbr::MaterialPlugin;
 use bevy::prelude::*;
 use bevy::render::RenderApp;
 use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPlugin};
-use bevy::shader::load_shader_library;
 use lodkit::frame_sequential::Schedule;
 use lodkit::select::{LodGroup, LodSettings};
 
@@ -108,15 +108,19 @@ impl Plugin for FrameSequentialLodPlugin {
         if !app.is_plugin_added::<LodkitShadersPlugin>() {
             app.add_plugins(LodkitShadersPlugin);
         }
-        load_shader_library!(app, "frame_sequential.wgsl");
-        embedded_asset!(app, "combine.wgsl");
+        crate::shaders::register_library(
+            app,
+            "frame_sequential",
+            include_str!("frame_sequential.wesl"),
+        );
+        embedded_asset!(app, "combine.wesl");
         app.world_mut()
             .resource_mut::<Assets<Shader>>()
             .insert(
                 &material::LOD_MATERIAL_SHADER,
-                Shader::from_wgsl(
-                    include_str!("lod_material.wgsl"),
-                    "lodkit_bevy/frame_sequential/lod_material.wgsl",
+                Shader::from_wesl(
+                    include_str!("lod_material.wesl"),
+                    "embedded://lodkit_bevy/frame_sequential/lod_material.wesl",
                 ),
             )
             .expect("UUID handles never fail to insert");
@@ -146,7 +150,8 @@ impl Plugin for FrameSequentialLodPlugin {
 /// [`FrameSequentialGroup`] and combines its frames.
 ///
 /// Requires (and adds) [`DepthPrepass`], [`MotionVectorPrepass`] and [`Hdr`]; the camera must
-/// also have `Msaa::Off`.
+/// also have `Msaa::Off`: with another `Msaa` the plugin logs one warning, runs no combine and
+/// lets no transition begin (groups switch levels at once).
 #[derive(Component, Clone, Debug, Reflect)]
 #[reflect(Component, Default, Clone)]
 #[require(DepthPrepass, MotionVectorPrepass, Hdr)]

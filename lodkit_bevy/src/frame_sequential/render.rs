@@ -16,8 +16,8 @@ use bevy::render::render_resource::binding_types::{texture_2d, texture_depth_2d,
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::sync_component::SyncComponent;
-use bevy::render::view::{ExtractedView, ViewDepthTexture, ViewTarget};
-use bevy::render::{GpuResourceAppExt, Render, RenderSystems};
+use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
+use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 
 /// Name of the combine pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
 /// `render/<name>/elapsed_gpu` and `render/<name>/fragment_shader_invocations`.
@@ -45,7 +45,7 @@ pub struct FrameSequentialView {
     pub buffer: usize,
 }
 
-impl SyncComponent for FrameSequentialView {
+impl SyncComponent<RenderApp> for FrameSequentialView {
     type Target = (
         FrameSequentialView,
         CombineParams,
@@ -55,7 +55,7 @@ impl SyncComponent for FrameSequentialView {
     );
 }
 
-impl ExtractComponent for FrameSequentialView {
+impl ExtractComponent<RenderApp> for FrameSequentialView {
     type QueryData = &'static FrameSequentialView;
     type QueryFilter = ();
     type Out = (FrameSequentialView, CombineParams);
@@ -69,7 +69,7 @@ impl ExtractComponent for FrameSequentialView {
     }
 }
 
-/// The uniform of combine.wgsl (one dynamic-offset slot per camera, written by Bevy's
+/// The uniform of combine.wesl (one dynamic-offset slot per camera, written by Bevy's
 /// `UniformComponentPlugin`).
 #[derive(Component, ShaderType, Clone, Copy, Debug)]
 pub struct CombineParams {
@@ -127,7 +127,7 @@ impl FromWorld for CombinePipeline {
         );
         Self {
             layout,
-            shader: load_embedded_asset!(world, "combine.wgsl"),
+            shader: load_embedded_asset!(world, "combine.wesl"),
             fullscreen: world.resource::<FullscreenShader>().clone(),
         }
     }
@@ -151,6 +151,7 @@ impl SpecializedRenderPipeline for CombinePipeline {
                     blend: None,
                     write_mask: ColorWrites::ALL,
                 })],
+                ..default()
             }),
             ..default()
         }
@@ -274,7 +275,7 @@ fn prepare_bind_groups(
 type PassView = (
     &'static ExtractedView,
     &'static ViewTarget,
-    &'static ViewDepthTexture,
+    &'static ViewDepthStencilTexture,
     &'static FrameSequentialView,
     &'static FrameSequentialTextures,
     &'static DynamicUniformIndex<CombineParams>,
@@ -301,7 +302,7 @@ fn combine_pass(view: ViewQuery<PassView>, cache: Res<PipelineCache>, mut ctx: R
             extent,
         );
         encoder.copy_texture_to_texture(
-            depth.texture.as_image_copy(),
+            depth.texture().as_image_copy(),
             textures.depth[newer].0.as_image_copy(),
             extent,
         );

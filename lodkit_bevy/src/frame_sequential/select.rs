@@ -113,7 +113,7 @@ fn spawn_levels(
             .spawn((
                 Mesh3d(first.mesh.clone()),
                 MeshMaterial3d(first.material.clone()),
-                MeshTag(0),
+                MeshTag::new(0),
                 Transform::IDENTITY,
                 Visibility::Hidden,
                 ChildOf(group),
@@ -132,7 +132,7 @@ fn spawn_levels(
     }
 }
 
-/// Bevy 0.19's glam and lodkit's differ in version: matrices cross as arrays.
+/// Bevy 0.20's glam and lodkit's differ in version: matrices cross as arrays.
 fn to_lodkit(m: Mat4) -> glam::Mat4 {
     glam::Mat4::from_cols_array(&m.to_cols_array())
 }
@@ -141,7 +141,7 @@ fn to_lodkit(m: Mat4) -> glam::Mat4 {
 fn level_bounds(levels: &LodLevels, meshes: &Assets<Mesh>) -> Option<Bounds> {
     let mut boxed: Option<(Vec3, Vec3)> = None;
     for level in &levels.0 {
-        let aabb = meshes.get(&level.mesh)?.compute_aabb()?;
+        let aabb = meshes.get(&level.mesh)?.get_aabb()?;
         let (lo, hi) = (Vec3::from(aabb.min()), Vec3::from(aabb.max()));
         boxed = Some(boxed.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
     }
@@ -302,6 +302,7 @@ type CameraQuery<'w, 's> = Query<
         &'static GlobalTransform,
         &'static FrameSequentialLod,
         Option<&'static FrameSequentialView>,
+        Option<&'static Msaa>,
     ),
 >;
 
@@ -347,11 +348,24 @@ fn update(
         }
         live
     });
-    let Some((camera_entity, camera, camera_transform, settings, last)) =
+    let Some((camera_entity, camera, camera_transform, settings, last, msaa)) =
         cameras.iter().find(|(_, c, ..)| c.is_active)
     else {
         return;
     };
+    // The combine reads and copies the main pass per pixel: a multisampled camera gets no
+    // combine, and then no transition may begin (a group switches at once, as with
+    // `TransitionMode::Hard`).
+    let multisampled = msaa.is_some_and(|m| *m != Msaa::Off);
+    if multisampled {
+        warn_once!(
+            "FrameSequentialLod needs Msaa::Off on its camera (the combine reads the main pass \
+             per pixel): its LOD groups switch levels at once"
+        );
+        commands
+            .entity(camera_entity)
+            .remove::<FrameSequentialView>();
+    }
     if cameras.iter().filter(|(_, c, ..)| c.is_active).count() > 1 {
         warn_once!("more than one active camera has FrameSequentialLod: the first one selects");
     }
@@ -375,7 +389,7 @@ fn update(
     let mut in_transition = 0;
     // The combine needs last frame's picture: a transition begins only after a frame that the
     // render world kept, and frames are kept only while a group is in transition or about to be.
-    let older_kept = last.is_some_and(|l| l.keep);
+    let older_kept = !multisampled && last.is_some_and(|l| l.keep);
     let mut keep_frame = false;
     for (entity, group, levels, transform, mut state) in &mut groups {
         let state = &mut *state;
@@ -467,7 +481,7 @@ fn update(
             } else {
                 Visibility::Hidden
             });
-            mesh_tag.set_if_neq(MeshTag(tag));
+            mesh_tag.set_if_neq(MeshTag::new(tag));
             if mesh.0 != level.mesh {
                 mesh.0 = level.mesh.clone();
             }
@@ -478,7 +492,7 @@ fn update(
     }
     let rects = merge_rects(&rects);
     stats.in_transition = in_transition;
-    stats.frame_kept = keep_frame || in_transition > 0;
+    stats.frame_kept = !multisampled && (keep_frame || in_transition > 0);
     stats.frames_kept += u64::from(stats.frame_kept);
     stats.combine_pixels = rects.iter().map(ScreenRect::area).sum();
     let new_to_old = if settings.reprojection {
@@ -492,6 +506,9 @@ fn update(
     } else {
         Mat4::IDENTITY
     };
+    if multisampled {
+        return;
+    }
     commands.entity(camera_entity).insert(FrameSequentialView {
         view_from_world,
         clip_from_view,
@@ -507,97 +524,5 @@ fn update(
 }
 
 #[cfg(test)]
-mod tests {
-    use bevy::ecs::system::RunSystemOnce;
-
-    use super::*;
-    use crate::frame_sequential::LodLevel;
-    use lodkit::select::LodGroup;
-    use std::f32::consts::FRAC_PI_2;
-
-    /// A transition begins only after a frame the render world kept: the frame the selection
-    /// enters the band after idle frames is kept, with nothing in transition yet, and the
-    /// transition begins the frame after. Idle frames are not kept (no copies).
-    #[test]
-    fn a_transition_begins_after_a_kept_frame() {
-        let mut world = World::new();
-        world.init_resource::<Time>();
-        world.init_resource::<Assets<Mesh>>();
-        world.init_resource::<Scheduler>();
-        world.init_resource::<FrameSequentialStats>();
-        let mut camera = Camera::default();
-        // P[1][1] = 1: lodkit::select's distance is the distance itself.
-        camera.computed.clip_from_view = Mat4::perspective_infinite_reverse_rh(FRAC_PI_2, 1.0, 0.1);
-        world.spawn((
-            camera,
-            GlobalTransform::IDENTITY,
-            FrameSequentialLod::default(),
-        ));
-        let level = || LodLevel::new(Handle::default(), Handle::default());
-        let at = |z: f32| GlobalTransform::from_translation(Vec3::new(0.0, 0.0, -z));
-        let group = world
-            .spawn((
-                LodLevels(vec![level(), level()]),
-                FrameSequentialGroup::new(LodGroup::from_distances(&[0.0, 4.0]).unwrap()),
-                at(1.0),
-            ))
-            .id();
-        world.run_system_once(spawn_levels).unwrap();
-        let frame = |world: &mut World, z: f32| {
-            *world.get_mut::<GlobalTransform>(group).unwrap() = at(z);
-            world.run_system_once(update).unwrap();
-            let stats = world.resource::<FrameSequentialStats>().clone();
-            let levels = world.get::<FrameSequentialLevels>(group).unwrap();
-            (stats.frame_kept, stats.in_transition, levels.transition)
-        };
-        assert_eq!(frame(&mut world, 1.0), (false, 0, None), "idle");
-        assert_eq!(frame(&mut world, 1.0), (false, 0, None), "idle");
-        assert_eq!(frame(&mut world, 4.1), (true, 0, None), "kept, not begun");
-        assert_eq!(frame(&mut world, 4.1), (true, 1, Some((0, 1))), "begun");
-        assert_eq!(world.resource::<FrameSequentialStats>().frames_kept, 2);
-    }
-
-    /// A group whose levels change while it is in transition gives its t-instance id and slot
-    /// back to the scheduler, and its old drawer goes.
-    #[test]
-    fn changed_levels_release_the_groups_transition() {
-        let mut world = World::new();
-        let mut scheduler = TransitionScheduler::new();
-        let key = scheduler.insert(0);
-        scheduler
-            .begin_transition(key, 1, Drive::Time { seconds: 1.0 })
-            .unwrap();
-        assert_eq!(scheduler.live_ids().len(), 1);
-        let level = || LodLevel::new(Handle::default(), Handle::default());
-        let drawer = world.spawn_empty().id();
-        let group = world
-            .spawn((
-                LodLevels(vec![level(), level()]),
-                FrameSequentialLevels {
-                    entity: drawer,
-                    drawn: 0,
-                    selection: None,
-                    transition: Some((0, 1)),
-                    key: Some(key),
-                    state: LodState::NEW,
-                    previous_model: None,
-                    bounds: None,
-                },
-            ))
-            .id();
-        world.insert_resource(Scheduler(scheduler, vec![(group, key)]));
-        world.run_system_once(spawn_levels).unwrap();
-        let Scheduler(scheduler, keys) = world.resource::<Scheduler>();
-        assert!(
-            scheduler.live_ids().is_empty(),
-            "the t-instance id is still taken"
-        );
-        assert!(keys.is_empty());
-        assert!(
-            world.get_entity(drawer).is_err(),
-            "the old drawer is still there"
-        );
-        let levels = world.get::<FrameSequentialLevels>(group).unwrap();
-        assert_eq!((levels.key, levels.transition), (None, None));
-    }
-}
+#[path = "select_tests.rs"]
+mod tests;

@@ -1,6 +1,6 @@
 //! The per-instance word a level entity carries in Bevy's `MeshTag`, and the main-pass alpha
 //! that carries a fragment's LOD-buffer id word: the Rust side of
-//! `lodkit_bevy::frame_sequential` (frame_sequential.wgsl decodes what [`encode_tag`] packs).
+//! `lodkit_bevy::frame_sequential` (frame_sequential.wesl decodes what [`encode_tag`] packs).
 //!
 //! Tag layout (32 bits): bits 0..9 the t-instance id (0: an n-instance, drawn normally),
 //! 9..20 tau, 20..31 tau_next (both quantized over [-1, 1] in steps of 1/1023, so -1, 0 and 1

@@ -8,8 +8,8 @@ use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController};
 
 use super::timer::GpuFrameTimes;
 use super::{
-    FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodResolution,
-    FramerateTarget, MAX_FACTOR,
+    FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodFrameTimes,
+    FramebufferLodResolution, FramerateTarget, MAX_FACTOR,
 };
 
 /// What framebuffer LOD is doing on a camera (added with [`FramebufferLod`], updated every frame
@@ -25,8 +25,8 @@ pub struct FramebufferLodState {
     pub frame_time: Option<Duration>,
     /// The r that frame time was rendered at.
     pub measured_factor: f32,
-    /// Where that frame time came from: [`FrameTimeSource::GpuTimestamps`] or
-    /// [`FrameTimeSource::WallClock`].
+    /// Where that frame time came from: [`FrameTimeSource::GpuTimestamps`],
+    /// [`FrameTimeSource::WallClock`] or [`FrameTimeSource::Provided`].
     pub measured_with: Option<FrameTimeSource>,
     /// The controller's estimates (K, C) of eq. 3, t = K / r^2 + C, in seconds (adaptive only).
     pub estimates: Option<(f32, f32)>,
@@ -72,11 +72,16 @@ pub(super) fn update_resolution(
     time: Res<Time<Real>>,
     capabilities: Option<Res<FramebufferLodCapabilities>>,
     gpu_times: Res<GpuFrameTimes>,
-    mut cameras: Query<(Entity, &FramebufferLod, &mut FramebufferLodState)>,
+    mut cameras: Query<(
+        Entity,
+        &FramebufferLod,
+        &mut FramebufferLodState,
+        Option<&mut FramebufferLodFrameTimes>,
+    )>,
 ) {
     let timestamps = capabilities.is_some_and(|c| c.gpu_timestamps);
     let mut measured = gpu_times.take();
-    for (entity, settings, mut state) in &mut cameras {
+    for (entity, settings, mut state, provided) in &mut cameras {
         let state = &mut *state;
         let target = match settings.resolution {
             FramebufferLodResolution::Fixed(_) => None,
@@ -86,12 +91,22 @@ pub(super) fn update_resolution(
             FrameTimeSource::Auto | FrameTimeSource::GpuTimestamps if timestamps => {
                 FrameTimeSource::GpuTimestamps
             }
+            FrameTimeSource::Provided => FrameTimeSource::Provided,
             _ => FrameTimeSource::WallClock,
         };
         state.gpu_timed = source == FrameTimeSource::GpuTimestamps;
         // What the frames rendered so far measured, with the r each was rendered at.
         let samples = match source {
             FrameTimeSource::GpuTimestamps => measured.remove(&entity).unwrap_or_default(),
+            FrameTimeSource::Provided => provided
+                .map(|mut p| std::mem::take(&mut p.0))
+                .unwrap_or_default()
+                .into_iter()
+                // An r outside [1, MAX_FACTOR] was not rendered here, and a zero time measured
+                // nothing: neither is learned from.
+                .filter(|(r, t)| (1.0..=MAX_FACTOR).contains(r) && !t.is_zero())
+                .map(|(r, t)| (r, t.as_secs_f32()))
+                .collect(),
             _ => {
                 let dt = time.delta_secs();
                 if dt > 0.0 {

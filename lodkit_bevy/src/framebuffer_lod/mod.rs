@@ -15,7 +15,7 @@
 //!         Camera3d::default(),
 //!         Msaa::Off, // the prepass is read per pixel
 //!         FramebufferLod {
-//!             effect: assets.load("shaders/fog.wgsl"),
+//!             effect: assets.load("shaders/fog.wesl"),
 //!             resolution: FramebufferLodResolution::Adaptive(FramerateTarget::default()),
 //!             ..default()
 //!         },
@@ -28,14 +28,14 @@
 //!     .run();
 //! ```
 //!
-//! The effect is a WGSL fragment shader run with Bevy's fullscreen vertex shader; it imports
+//! The effect is a WESL fragment shader run with Bevy's fullscreen vertex shader; it imports
 //! `lodkit_bevy::framebuffer_lod` (the bindings, `effect_sample`, `effect_output`) and may import
 //! any `lodkit::` module:
 //!
 //! ```wgsl
-//! #import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput
-//! #import lodkit::gbuffer::GBufferOutput
-//! #import lodkit_bevy::framebuffer_lod::{effect_sample, effect_output, effect_param}
+//! import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput;
+//! import lodkit::gbuffer::GBufferOutput;
+//! import lodkit_bevy::framebuffer_lod::{effect_sample, effect_output, effect_param};
 //!
 //! @fragment
 //! fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
@@ -59,7 +59,6 @@ use bevy::core_pipeline::prepass::{DepthPrepass, NormalPrepass};
 use bevy::prelude::*;
 use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPlugin};
 use bevy::render::{RenderApp, renderer::RenderDevice};
-use bevy::shader::load_shader_library;
 
 pub use controller::FramebufferLodState;
 pub use render::{EFFECT_PASS, UPSAMPLE_PASS};
@@ -81,15 +80,22 @@ impl Plugin for FramebufferLodPlugin {
         if !app.is_plugin_added::<LodkitShadersPlugin>() {
             app.add_plugins(LodkitShadersPlugin);
         }
-        load_shader_library!(app, "framebuffer_lod.wgsl");
-        embedded_asset!(app, "upsample.wgsl");
+        crate::shaders::register_library(
+            app,
+            "framebuffer_lod",
+            include_str!("framebuffer_lod.wesl"),
+        );
+        embedded_asset!(app, "upsample.wesl");
         app.register_type::<FramebufferLod>()
             .add_plugins((
                 ExtractComponentPlugin::<FramebufferLod>::default(),
                 UniformComponentPlugin::<FramebufferLodUniform>::default(),
             ))
             .init_resource::<timer::GpuFrameTimes>()
-            .add_systems(Last, controller::update_resolution);
+            .add_systems(
+                Last,
+                controller::update_resolution.in_set(FramebufferLodSystems::Control),
+            );
         let times = app.world().resource::<timer::GpuFrameTimes>().clone();
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
             render_app.insert_resource(times);
@@ -130,7 +136,7 @@ pub struct FramebufferLodCapabilities {
 #[reflect(Component, Default, Clone)]
 #[require(DepthPrepass, NormalPrepass, Hdr, FramebufferLodState)]
 pub struct FramebufferLod {
-    /// The effect: a WGSL fragment shader (entry point `fragment`) that imports
+    /// The effect: a WESL fragment shader (entry point `fragment`) that imports
     /// `lodkit_bevy::framebuffer_lod` and returns `effect_output(color, effect_sample(..))`.
     /// Nothing is drawn while it is the default handle or still loading.
     pub effect: Handle<Shader>,
@@ -268,4 +274,24 @@ pub enum FrameTimeSource {
     GpuTimestamps,
     /// Real time between frames (`Time<Real>`): everything the frame costs, CPU included.
     WallClock,
+    /// The app's own measurements: each frame the controller takes what the app pushed into the
+    /// camera's [`FramebufferLodFrameTimes`] (an engine's profiler, a frame-time model in a
+    /// test). Push before [`FramebufferLodSystems::Control`] in `Last`.
+    Provided,
+}
+
+/// Frame times the app measured itself, for [`FrameTimeSource::Provided`]: each entry is the r
+/// a frame was rendered at (the [`FramebufferLodState::factor`] of the frame, read before the
+/// controller changes it) and the time that frame took. The controller drains it every frame;
+/// with another source it is left alone. Entries with an r outside [1, [`MAX_FACTOR`]] or a
+/// zero time are dropped.
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub struct FramebufferLodFrameTimes(pub Vec<(f32, Duration)>);
+
+/// The systems of [`FramebufferLodPlugin`] in the main world.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FramebufferLodSystems {
+    /// Updates every camera's [`FramebufferLodState`] from its settings and measurements (in
+    /// `Last`).
+    Control,
 }

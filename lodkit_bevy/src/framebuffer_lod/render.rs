@@ -16,7 +16,7 @@ use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::sync_component::SyncComponent;
 use bevy::render::view::{ExtractedView, ViewTarget, ViewUniform, ViewUniformOffset, ViewUniforms};
-use bevy::render::{GpuResourceAppExt, Render, RenderSystems};
+use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 
 use super::controller::FramebufferLodState;
 use super::timer::{self, GpuFrameTimer};
@@ -45,7 +45,7 @@ pub struct ExtractedFramebufferLod {
     low_size: UVec2,
 }
 
-/// The settings the shaders read (`FramebufferLodSettings` in framebuffer_lod.wgsl).
+/// The settings the shaders read (`FramebufferLodSettings` in framebuffer_lod.wesl).
 #[derive(Component, ShaderType, Clone, Copy, Debug)]
 pub struct FramebufferLodUniform {
     low_size: Vec2,
@@ -57,7 +57,7 @@ pub struct FramebufferLodUniform {
     params: [Vec4; 2],
 }
 
-impl SyncComponent for FramebufferLod {
+impl SyncComponent<RenderApp> for FramebufferLod {
     type Target = (
         ExtractedFramebufferLod,
         FramebufferLodUniform,
@@ -68,7 +68,7 @@ impl SyncComponent for FramebufferLod {
     );
 }
 
-impl ExtractComponent for FramebufferLod {
+impl ExtractComponent<RenderApp> for FramebufferLod {
     type QueryData = (
         &'static FramebufferLod,
         &'static FramebufferLodState,
@@ -181,7 +181,7 @@ impl FromWorld for FramebufferLodPipelines {
         Self {
             effect_layout,
             upsample_layout,
-            upsample_shader: load_embedded_asset!(world, "upsample.wgsl"),
+            upsample_shader: load_embedded_asset!(world, "upsample.wesl"),
             fullscreen: world.resource::<FullscreenShader>().clone(),
         }
     }
@@ -368,7 +368,7 @@ fn prepare_bind_groups(
         return;
     };
     for (entity, textures, prepass) in &views {
-        let (Some(depth), Some(normal)) = (prepass.depth_view(), prepass.normal_view()) else {
+        let (Some(depth), Some(normal)) = (prepass.depth_only_view(), prepass.normal_view()) else {
             continue;
         };
         let effect = device.create_bind_group(

@@ -155,11 +155,19 @@ fn prepare_timers(
                 continue;
             }
             let ticks = {
-                let range = slot.buffer.slice(..).get_mapped_range();
-                let words: [u64; 2] = std::array::from_fn(|i| {
-                    u64::from_le_bytes(range[i * 8..i * 8 + 8].try_into().unwrap_or([0; 8]))
-                });
-                words[1].saturating_sub(words[0])
+                // A range that cannot be read gives no measurement, not a panic.
+                match slot.buffer.slice(..).get_mapped_range() {
+                    Ok(range) => {
+                        let words: [u64; 2] = std::array::from_fn(|i| {
+                            range
+                                .get(i * 8..i * 8 + 8)
+                                .and_then(|b| b.try_into().ok())
+                                .map_or(0, u64::from_le_bytes)
+                        });
+                        words[1].saturating_sub(words[0])
+                    }
+                    Err(_) => 0,
+                }
             };
             slot.buffer.unmap();
             slot.state.store(FREE, Ordering::Release);

@@ -1,0 +1,140 @@
+//! Unit tests of the selection system on a bare `World`.
+
+use bevy::ecs::system::RunSystemOnce;
+
+use super::*;
+use crate::frame_sequential::LodLevel;
+use lodkit::select::LodGroup;
+use std::f32::consts::FRAC_PI_2;
+
+/// A world with a camera (with `msaa`) and one two-level group at distance 1, its levels
+/// spawned.
+fn world_with_group(msaa: Msaa) -> (World, Entity) {
+    let mut world = World::new();
+    world.init_resource::<Time>();
+    world.init_resource::<Assets<Mesh>>();
+    world.init_resource::<Scheduler>();
+    world.init_resource::<FrameSequentialStats>();
+    let mut camera = Camera::default();
+    // P[1][1] = 1: lodkit::select's distance is the distance itself.
+    camera.computed.clip_from_view = Mat4::from_cols_array(
+        &glam::camera::rh::proj::directx::perspective_infinite_reverse(FRAC_PI_2, 1.0, 0.1)
+            .to_cols_array(),
+    );
+    world.spawn((
+        camera,
+        GlobalTransform::IDENTITY,
+        FrameSequentialLod::default(),
+        msaa,
+    ));
+    let level = || LodLevel::new(Handle::default(), Handle::default());
+    let group = world
+        .spawn((
+            LodLevels(vec![level(), level()]),
+            FrameSequentialGroup::new(LodGroup::from_distances(&[0.0, 4.0]).unwrap()),
+            GlobalTransform::from_translation(Vec3::new(0.0, 0.0, -1.0)),
+        ))
+        .id();
+    world.run_system_once(spawn_levels).unwrap();
+    (world, group)
+}
+
+/// Runs the selection with the group at distance `z`: (frame kept, groups in transition, the
+/// group's transition).
+fn frame(world: &mut World, group: Entity, z: f32) -> (bool, usize, Option<(u8, u8)>) {
+    *world.get_mut::<GlobalTransform>(group).unwrap() =
+        GlobalTransform::from_translation(Vec3::new(0.0, 0.0, -z));
+    world.run_system_once(update).unwrap();
+    let stats = world.resource::<FrameSequentialStats>().clone();
+    let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+    (stats.frame_kept, stats.in_transition, levels.transition)
+}
+
+/// A transition begins only after a frame the render world kept: the frame the selection
+/// enters the band after idle frames is kept, with nothing in transition yet, and the
+/// transition begins the frame after. Idle frames are not kept (no copies).
+#[test]
+fn a_transition_begins_after_a_kept_frame() {
+    let (mut world, group) = world_with_group(Msaa::Off);
+    assert_eq!(frame(&mut world, group, 1.0), (false, 0, None), "idle");
+    assert_eq!(frame(&mut world, group, 1.0), (false, 0, None), "idle");
+    assert_eq!(
+        frame(&mut world, group, 4.1),
+        (true, 0, None),
+        "kept, not begun"
+    );
+    assert_eq!(
+        frame(&mut world, group, 4.1),
+        (true, 1, Some((0, 1))),
+        "begun"
+    );
+    assert_eq!(world.resource::<FrameSequentialStats>().frames_kept, 2);
+}
+
+/// A multisampled camera gets no combine: no frame is kept, no transition begins, the render
+/// world gets no view, and the group switches at once when its selection does.
+#[test]
+fn a_multisampled_camera_switches_levels_at_once() {
+    let (mut world, group) = world_with_group(Msaa::Sample4);
+    assert_eq!(frame(&mut world, group, 1.0), (false, 0, None), "idle");
+    for _ in 0..4 {
+        assert_eq!(
+            frame(&mut world, group, 4.1),
+            (false, 0, None),
+            "in the band"
+        );
+    }
+    assert_eq!(
+        frame(&mut world, group, 9.0),
+        (false, 0, None),
+        "past the band"
+    );
+    let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+    assert_eq!(levels.drawn, 1, "the coarse level is drawn");
+    let mut views = world.query::<&FrameSequentialView>();
+    assert_eq!(views.iter(&world).count(), 0, "the render world got a view");
+}
+
+/// A group whose levels change while it is in transition gives its t-instance id and slot
+/// back to the scheduler, and its old drawer goes.
+#[test]
+fn changed_levels_release_the_groups_transition() {
+    let mut world = World::new();
+    let mut scheduler = TransitionScheduler::new();
+    let key = scheduler.insert(0);
+    scheduler
+        .begin_transition(key, 1, Drive::Time { seconds: 1.0 })
+        .unwrap();
+    assert_eq!(scheduler.live_ids().len(), 1);
+    let level = || LodLevel::new(Handle::default(), Handle::default());
+    let drawer = world.spawn_empty().id();
+    let group = world
+        .spawn((
+            LodLevels(vec![level(), level()]),
+            FrameSequentialLevels {
+                entity: drawer,
+                drawn: 0,
+                selection: None,
+                transition: Some((0, 1)),
+                key: Some(key),
+                state: LodState::NEW,
+                previous_model: None,
+                bounds: None,
+            },
+        ))
+        .id();
+    world.insert_resource(Scheduler(scheduler, vec![(group, key)]));
+    world.run_system_once(spawn_levels).unwrap();
+    let Scheduler(scheduler, keys) = world.resource::<Scheduler>();
+    assert!(
+        scheduler.live_ids().is_empty(),
+        "the t-instance id is still taken"
+    );
+    assert!(keys.is_empty());
+    assert!(
+        world.get_entity(drawer).is_err(),
+        "the old drawer is still there"
+    );
+    let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+    assert_eq!((levels.key, levels.transition), (None, None));
+}
