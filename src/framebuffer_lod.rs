@@ -467,33 +467,9 @@ pub fn step_response(
     }
 }
 
-/// Peak signal-to-noise ratio in dB between two RGBA8 images (RGB channels only); +inf when equal,
-/// NaN when the two differ in length or are empty.
-///
-/// ```
-/// # use lodkit::framebuffer_lod::psnr_rgba8;
-/// let a = [10u8, 20, 30, 255];
-/// assert_eq!(psnr_rgba8(&a, &a), f32::INFINITY);
-/// let b = [11u8, 20, 30, 0];
-/// assert!((psnr_rgba8(&a, &b) - 10.0 * (255.0f32 * 255.0 * 3.0).log10()).abs() < 1e-3);
-/// ```
-pub fn psnr_rgba8(a: &[u8], b: &[u8]) -> f32 {
-    if a.len() != b.len() || a.len() < 4 {
-        return f32::NAN;
-    }
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for (pa, pb) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
-        for c in 0..3 {
-            let d = f64::from(pa[c]) - f64::from(pb[c]);
-            sum += d * d;
-            n += 1;
-        }
-    }
-    if sum == 0.0 {
-        return f32::INFINITY;
-    }
-    (10.0 * (255.0f64 * 255.0 / (sum / n as f64)).log10()) as f32
-}
+/// PSNR of two RGBA8 images: [`crate::metrics::psnr_rgba8`], re-exported where framebuffer LOD's
+/// quality is measured.
+pub use crate::metrics::psnr_rgba8;
 
 /// Multiplies two RGBA8 images channel by channel (RGB; alpha 255): how fine-grained resizing
 /// puts an upsampled term and a full-resolution term back together. Stops at the shorter image

@@ -17,6 +17,8 @@
 //!   frame-sequential LOD interpolation (Scherzer & Wimmer 2008): the transition scheduler, the
 //!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders.
 //! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
+//! - [`metrics`]: how a transition looks on read-back frames: pop, flicker (change over net
+//!   change, direction reversals), PSNR, medians.
 //! - [`gpu`] (feature `wgpu`): headless devices and ready-made passes.
 //!
 //! ## Features
@@ -45,6 +47,7 @@ pub mod framebuffer_lod;
 pub mod fullscreen;
 pub mod gbuffer;
 pub mod lod_buffer;
+pub mod metrics;
 pub mod noise;
 pub mod normal_distance;
 pub mod reproject;

@@ -4,9 +4,9 @@
 use std::process::Command;
 
 use lodkit::gpu::counters::{CounterKind, FragmentCounter};
+use lodkit::metrics::{pop, transition_change};
 use lodkit_cli::demo::render::Technique;
 use lodkit_cli::demo::scene::{DemoScene, SceneError};
-use lodkit_cli::demo::transitions::{pop, transition_change};
 use lodkit_cli::demo::upsampling::METHODS;
 use lodkit_cli::demo::{DemoOptions, run_on, utc_date};
 
@@ -22,7 +22,7 @@ fn change_and_pop_follow_their_definitions() {
     let color = [30u8, 60, 90, 255];
     // Only the image changed: mean of 30, 60, 90 over 255.
     let c = transition_change(&black, &color, &black, &black);
-    assert!((c - 60.0 / 255.0).abs() < 1e-6, "{c}");
+    assert!((c - 60.0 / 255.0).abs() < 1e-12, "{c}");
     // Image and reference changed alike (camera motion): nothing is left.
     assert_eq!(transition_change(&black, &color, &black, &color), 0.0);
     // Alpha is ignored.
@@ -204,11 +204,15 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     let report = run_on(gpu, &options, &scenes).unwrap();
     for t in &report.transitions {
         say(&format!(
-            "demo figure {} {}: pop {:.3}/{:.3} see-through {:.4} silhouette {:.4} outside {}",
+            "demo figure {} {}: pop {:.3}/{:.3} flicker {:.2}/{:.2} reversals {}/{} see-through {:.4} silhouette {:.4} outside {}",
             t.scene,
             t.technique,
             t.pop_static,
             t.pop_moving,
+            t.flicker_static,
+            t.flicker_moving,
+            t.reversals_static,
+            t.reversals_moving,
             t.see_through,
             t.silhouette_error,
             t.outside_rects
@@ -261,6 +265,13 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             assert!(hard.pop_static > 0.3, "a hard switch: {}", hard.pop_static);
         } else {
             assert_eq!(hard.pop_static, 1.0, "a hard switch changes in one frame");
+            // ... once, in one direction: no flicker, whatever the scene.
+            assert_eq!(
+                (hard.flicker_static, hard.reversals_static),
+                (1.0, 0),
+                "a hard switch in {}",
+                scene.name
+            );
         }
         assert_eq!(hard.triangles, expected_triangles(scene, frames, false));
         let fade = row("cross-fade");

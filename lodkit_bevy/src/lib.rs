@@ -14,10 +14,10 @@
 //! - [`FrameSequentialLodPlugin`] with the [`FrameSequentialLod`] camera component and
 //!   [`FrameSequentialGroup`](frame_sequential::FrameSequentialGroup) entities: smooth discrete
 //!   LOD transitions (Scherzer & Wimmer 2008). A group in transition draws one of its two
-//!   levels per frame and a combine pass merges consecutive frames, reprojected with Bevy's
-//!   depth and motion vectors: no see-through, no pop, one level drawn per frame. The depth and
-//!   motion-vector prepass it needs is its main cost in an app that has no prepass of its own:
-//!   see [`frame_sequential`] for the figures against Bevy's crossfade.
+//!   levels per frame and a combine pass merges consecutive frames, reprojected with the main
+//!   pass's depth and the camera's and groups' motion (no prepass needed): less pop than Bevy's
+//!   crossfade, one level drawn per frame. See [`frame_sequential`] for the figures against
+//!   Bevy's crossfade in an app with and without a prepass.
 //!
 //! lodkit is used with `default-features = false`: it brings no naga of its own; Bevy links its
 //! WESL modules (wesl-rs), as it links its own.

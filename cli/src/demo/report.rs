@@ -210,6 +210,8 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                 "technique",
                 "pop (static)",
                 "pop (moving)",
+                "flicker (static)",
+                "flicker (moving)",
                 "see-through",
                 "silhouette error (moving)",
             ],
@@ -219,6 +221,8 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                         t.technique.clone(),
                         format!("{:.3}", t.pop_static),
                         format!("{:.3}", t.pop_moving),
+                        format!("{:.2} ({} rev.)", t.flicker_static, t.reversals_static),
+                        format!("{:.2} ({} rev.)", t.flicker_moving, t.reversals_moving),
                         pct(t.see_through),
                         pct(t.silhouette_error),
                     ]
@@ -548,16 +552,26 @@ pub fn summary(report: &DemoReport) -> String {
     for scene in &report.scenes {
         let _ = writeln!(
             s,
-            "\n{scene:<24} {:>8} {:>8} {:>12} {:>8} {:>10} {:>10} {:>10}",
-            "pop", "pop mov", "see-through", "sil mov", "tris", "frags", "idle"
+            "\n{scene:<24} {:>8} {:>8} {:>8} {:>8} {:>12} {:>8} {:>10} {:>10} {:>10}",
+            "pop",
+            "pop mov",
+            "flicker",
+            "flk mov",
+            "see-through",
+            "sil mov",
+            "tris",
+            "frags",
+            "idle"
         );
         for t in report.transitions.iter().filter(|t| &t.scene == scene) {
             let _ = writeln!(
                 s,
-                "  {:<22} {:>8.3} {:>8.3} {:>12} {:>8} {:>9.3}x {:>10} {:>10}",
+                "  {:<22} {:>8.3} {:>8.3} {:>8.2} {:>8.2} {:>12} {:>8} {:>9.3}x {:>10} {:>10}",
                 t.technique,
                 t.pop_static,
                 t.pop_moving,
+                t.flicker_static,
+                t.flicker_moving,
                 pct(t.see_through),
                 pct(t.silhouette_error),
                 t.triangles_vs_hard,

@@ -45,16 +45,8 @@ pub struct PassRatio {
 }
 
 /// Median: the middle value, or the mean of the two middle values for an even count; NaN when
-/// empty.
-pub fn median(v: &[f64]) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => v[n / 2],
-        n => (v[n / 2 - 1] + v[n / 2]) / 2.0,
-    }
-}
+/// empty (lodkit's, shared with the Bevy examples).
+pub use lodkit::metrics::median;
 
 /// Wall time of `f` in milliseconds.
 pub fn wall_ms(f: &dyn Fn() -> Result<(), GpuError>) -> Result<f64, GpuError> {
@@ -310,16 +302,4 @@ pub fn upsample_vs_bilinear(
             &run_loads,
         )?,
     ])
-}
-
-#[cfg(test)]
-mod tests {
-    use super::median;
-
-    #[test]
-    fn median_of_an_even_count_is_the_mean_of_the_middle_two() {
-        assert_eq!(median(&[4.0, 1.0, 3.0]), 3.0);
-        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert!(median(&[]).is_nan());
-    }
 }

@@ -10,6 +10,7 @@ use super::DemoError;
 use super::render::{Background, Frame, LEAD_FRAMES, RunSpec, SceneRenderer, Technique};
 use lodkit::combine::PixelSource;
 use lodkit::gpu::{GpuContext, GpuError};
+use lodkit::metrics::{Flicker, FlickerMeter, pop, transition_change};
 
 /// Metrics of one technique on one scene.
 #[derive(Clone, Debug, Serialize)]
@@ -23,6 +24,18 @@ pub struct TransitionMetrics {
     pub pop_static: f32,
     /// Pop with the moving camera (camera motion subtracted through a run without transition).
     pub pop_moving: f32,
+    /// Flicker with the static camera: the frame-to-frame change of the image beyond the
+    /// reference run's, summed over the run, over its net change from the first frame to the
+    /// last (`lodkit::metrics::Flicker::ratio`; 1 = every pixel changes once, in one
+    /// direction).
+    pub flicker_static: f64,
+    /// Flicker with the moving camera.
+    pub flicker_moving: f64,
+    /// Per-pixel direction reversals over the static camera's run
+    /// (`lodkit::metrics::Flicker::reversals`).
+    pub reversals_static: u64,
+    /// The same with the moving camera.
+    pub reversals_moving: u64,
     /// Share of the transitioning objects' interior (pixels both LODs cover) where the
     /// background contributes to the middle frame.
     pub see_through: f32,
@@ -55,34 +68,6 @@ pub struct TransitionMetrics {
     pub change_static: Vec<f32>,
     /// The same with the moving camera.
     pub change_moving: Vec<f32>,
-}
-
-/// Mean absolute per-channel difference of `(a1 - r1) - (a0 - r0)` over RGB, in 0..1: how much
-/// the picture changed from one frame to the next beyond what the reference run changed.
-pub fn transition_change(a0: &[u8], a1: &[u8], r0: &[u8], r1: &[u8]) -> f32 {
-    let n = a0.len().min(a1.len()).min(r0.len()).min(r1.len());
-    let mut sum = 0.0f64;
-    for i in (0..n).filter(|i| i % 4 != 3) {
-        let d = (i32::from(a1[i]) - i32::from(r1[i])) - (i32::from(a0[i]) - i32::from(r0[i]));
-        sum += f64::from(d.unsigned_abs());
-    }
-    let channels = (n / 4 * 3).max(1);
-    (sum / channels as f64 / 255.0) as f32
-}
-
-/// The largest share of the total in one entry (0 when nothing changed).
-///
-/// ```
-/// # use lodkit_cli::demo::transitions::pop;
-/// assert_eq!(pop(&[0.0, 0.0, 3.0, 0.0]), 1.0);
-/// assert_eq!(pop(&[1.0, 1.0, 1.0, 1.0]), 0.25);
-/// ```
-pub fn pop(change: &[f32]) -> f32 {
-    let total: f32 = change.iter().sum();
-    if total <= 0.0 {
-        return 0.0;
-    }
-    change.iter().copied().fold(0.0, f32::max) / total
 }
 
 fn to_image(size: (u32, u32), pixels: Vec<u8>) -> Result<image::RgbaImage, DemoError> {
@@ -123,6 +108,7 @@ fn reference_run(
 /// What one transition run measured.
 struct TransitionRun {
     change: Vec<f32>,
+    flicker: Flicker,
     triangles: u64,
     fragments: u64,
     idle_fragments: u64,
@@ -152,6 +138,7 @@ fn transition_run(
     let strip_at = strip_frames(renderer);
     let mut run = TransitionRun {
         change: Vec::new(),
+        flicker: Flicker::default(),
         triangles: 0,
         fragments: 0,
         idle_fragments: 0,
@@ -159,6 +146,7 @@ fn transition_run(
         sources: None,
     };
     let mut previous: Option<Vec<u8>> = None;
+    let mut meter = FlickerMeter::default();
     let mut failed = None;
     let mut sources = None;
     let mut on_sources = |s| sources = Some(s);
@@ -174,7 +162,12 @@ fn transition_run(
                 reference_at(f),
             ) {
                 run.change
-                    .push(transition_change(prev, &frame.pixels, r0, r1));
+                    .push(transition_change(prev, &frame.pixels, r0, r1) as f32);
+            }
+            if let Some(r) = reference_at(f)
+                && let Err(e) = meter.push(&frame.pixels, r)
+            {
+                failed = Some(DemoError::Internal(e.to_string()));
             }
             if span.contains(&f) {
                 run.triangles += frame.triangles;
@@ -198,6 +191,7 @@ fn transition_run(
         (frame_sequential && moving).then_some(&mut on_sources as &mut dyn FnMut(Vec<PixelSource>)),
     )?;
     run.sources = sources;
+    run.flicker = meter.finish();
     match failed {
         Some(e) => Err(e),
         None => Ok(run),
@@ -383,6 +377,7 @@ pub fn measure_scene(
             return Err(DemoError::Internal("no reference run".to_owned()));
         };
         let mut changes = Vec::new();
+        let mut flickers = Vec::new();
         let mut cost = (0, 0, 0);
         renderer.take_outside_rects(); // the reference runs' count is not this technique's
         for (moving, reference) in [false, true].into_iter().zip(reference) {
@@ -401,6 +396,7 @@ pub fn measure_scene(
                 static_strips.push(run.strip.clone());
             }
             changes.push(run.change);
+            flickers.push(run.flicker);
         }
         let outside_rects = renderer.take_outside_rects();
         let (share, map) = see_through(gpu, renderer, technique, &masks, size)?;
@@ -408,11 +404,17 @@ pub fn measure_scene(
         super::save(&map, &out.join(format!("see-through/{scene}-{name}.png")))?;
         let moving_change = changes.pop().unwrap_or_default();
         let static_change = changes.pop().unwrap_or_default();
+        let [still, moved] = [0, 1].map(|k| flickers.get(k).copied().unwrap_or_default());
+        let as_f64 = |c: &[f32]| c.iter().map(|&v| f64::from(v)).collect::<Vec<f64>>();
         rows.push(TransitionMetrics {
             scene: scene.to_owned(),
             technique: name.to_owned(),
-            pop_static: pop(&static_change),
-            pop_moving: pop(&moving_change),
+            pop_static: pop(&as_f64(&static_change)) as f32,
+            pop_moving: pop(&as_f64(&moving_change)) as f32,
+            flicker_static: still.ratio(),
+            flicker_moving: moved.ratio(),
+            reversals_static: still.reversals,
+            reversals_moving: moved.reversals,
             see_through: share,
             outside_rects,
             silhouette_error: silhouette,

@@ -1,4 +1,4 @@
-//! The part of the example to copy into a Bevy 0.19 application: a material that draws one LOD
+//! The part of the example to copy into a Bevy 0.20 application: a material that draws one LOD
 //! level through lodkit's complementary screen-door pattern (its shader imports
 //! `lodkit::screen_door`, registered by `lodkit_bevy::LodkitShadersPlugin`), and applying a
 //! `lodkit::select::LodSelection` to a group's entities.

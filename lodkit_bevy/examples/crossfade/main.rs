@@ -1,4 +1,4 @@
-//! lodkit in Bevy 0.19.1: a complementary screen-door crossfade between two discrete LODs,
+//! lodkit in Bevy 0.20.1: a complementary screen-door crossfade between two discrete LODs,
 //! rendered headless and captured frame by frame.
 //!
 //! ```text

@@ -1,20 +1,27 @@
-//! Frame-sequential LOD in Bevy 0.19.1 side by side with Bevy's own `VisibilityRange`
-//! crossfade: the same scene, meshes and transition distances, rendered headless in one app,
-//! one run after the other, every frame read back.
+//! Frame-sequential LOD in Bevy 0.20 side by side with Bevy's own `VisibilityRange` crossfade:
+//! the same scene, meshes and transition distances, rendered headless in one app, one run after
+//! the other, every frame read back. Each run has a camera of its own with only what its
+//! technique needs, in two kinds of app: one without a prepass (neither technique needs one),
+//! and one that runs Bevy's depth and motion-vector prepass anyway (TAA, motion blur; names
+//! suffixed `_with_prepass`).
 //!
 //! ```text
-//! cargo run --example frame_sequential [-- [--out DIR] [--report FILE]
-//!     [--schedule complementary|paper] [--anchor screen|object] [--no-reprojection]]
+//! cargo run --example frame_sequential [-- [--out DIR] [--report FILE] [--frames DIR]
+//!     [--schedule complementary|paper] [--anchor screen|object] [--no-reprojection]
+//!     [--without-prepass-only]]
 //! ```
 //!
-//! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_frame_sequential.png` and
-//! `strip_bevy_crossfade.png` (7 frames over the moving camera's transitions), and with
-//! `--report` the figures as JSON. `--no-reprojection` breaks the combine on purpose (the
-//! older frame read at the same pixel): the moving camera then shows the background through
-//! the objects. Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
+//! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_<run>.png` (7 frames over the
+//! moving camera's transitions), with `--report` the figures as JSON (pop, flicker, reversals,
+//! see-through, coverage, fragments per pass), with `--frames DIR` every frame of every run as
+//! `DIR/<run>_<static|moving>/<frame>.png` (the references as `reference_fine` and
+//! `reference_coarse`), so anyone can recompute the figures. `--no-reprojection` breaks the
+//! combine on purpose (the older frame read at the same pixel): the moving camera then shows the
+//! background through the objects. `--without-prepass-only` skips the app with a prepass.
+//! Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
 //!
 //! The scene is `scene.rs` (what a Bevy app writes to use the plugin is there, in
-//! `spawn_groups`), the metrics `measure.rs`, the run loop `run.rs`.
+//! `spawn_groups`), the metrics `measure.rs`, one run `run.rs`, the comparison `report.rs`.
 
 #[path = "../common/frames.rs"]
 #[allow(
@@ -26,6 +33,7 @@ mod frames;
 #[allow(dead_code, reason = "shared by the examples; each uses a part")]
 mod headless;
 mod measure;
+mod report;
 mod run;
 mod scene;
 
@@ -39,18 +47,23 @@ use lodkit_bevy::frame_sequential::VisibilitySpace;
 pub struct Args {
     out: PathBuf,
     report: Option<PathBuf>,
+    frames: Option<PathBuf>,
+    with_prepass: bool,
     schedule: Schedule,
     anchor: VisibilitySpace,
     reprojection: bool,
 }
 
-const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] \
-[--schedule complementary|paper] [--anchor screen|object] [--no-reprojection]";
+const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] [--frames DIR] \
+[--schedule complementary|paper] [--anchor screen|object] [--no-reprojection] \
+[--without-prepass-only]";
 
 fn parse() -> Result<Option<Args>, String> {
     let mut args = Args {
         out: PathBuf::from("lodkit-bevy-frame-sequential"),
         report: None,
+        frames: None,
+        with_prepass: true,
         schedule: Schedule::Complementary,
         anchor: VisibilitySpace::Screen,
         reprojection: true,
@@ -62,6 +75,8 @@ fn parse() -> Result<Option<Args>, String> {
             "-h" | "--help" => return Ok(None),
             "--out" => args.out = PathBuf::from(value()?),
             "--report" => args.report = Some(PathBuf::from(value()?)),
+            "--frames" => args.frames = Some(PathBuf::from(value()?)),
+            "--without-prepass-only" => args.with_prepass = false,
             "--schedule" => {
                 args.schedule = match value()?.as_str() {
                     "complementary" => Schedule::Complementary,
@@ -95,7 +110,7 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match run::run(&args) {
+    match report::run(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(run::Failure(code, message)) => {
             eprintln!("error: {message}");

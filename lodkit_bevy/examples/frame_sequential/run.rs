@@ -1,10 +1,10 @@
-//! The runs: references (one level alone), lodkit's frame-sequential LOD and Bevy's crossfade,
-//! each with the still and the moving camera, every frame read back; then the report.
-
-use std::path::Path;
+//! One run: a camera of its own with only what its technique needs, the scene's groups, the
+//! still or moving camera path, every frame read back and the fragment-shader invocations of
+//! each pass counted.
 
 use bevy::camera::RenderTarget;
 use bevy::camera::visibility::VisibilityRange;
+use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass};
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
 use bevy::platform::time::Instant;
@@ -12,86 +12,104 @@ use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use lodkit::select::{LodSettings, TransitionMode};
-use lodkit_bevy::frame_sequential::{
-    COMBINE_PASS, FrameSequentialLod, FrameSequentialLodPlugin, FrameSequentialStats,
-};
+use lodkit_bevy::frame_sequential::{COMBINE_PASS, FrameSequentialLod, FrameSequentialLodPlugin};
 
 use crate::Args;
-use crate::frames::{Frame, strip};
-use crate::headless::{build_app, render_target, save_png, step};
-use crate::measure::{coverage, pop, see_through};
+use crate::frames::Frame;
+use crate::headless::{build_app, render_target, step};
 use crate::scene::{
     FRAMES, Technique, bevy_ranges, camera_at, group_position, groups, in_band, p11, spawn_groups,
 };
 
-const WIDTH: u32 = 320;
-const HEIGHT: u32 = 192;
-const BACKGROUND: Color = Color::srgb(0.08, 0.09, 0.12);
+pub const WIDTH: u32 = 320;
+pub const HEIGHT: u32 = 192;
+pub const BACKGROUND: Color = Color::srgb(0.08, 0.09, 0.12);
 /// Updates to wait for the last readbacks of a run.
 const DRAIN_UPDATES: usize = 12;
 /// Updates at the first pose before a run is recorded: a material added this frame is ready
-/// the next (Bevy prepares it after the images it binds), and the runs start alike.
+/// the next (Bevy prepares it after the images it binds), the camera's view resources are
+/// made, and the runs start alike.
 const WARMUP_UPDATES: usize = 3;
 /// The passes whose fragment-shader invocations are the groups' cost (the scene has nothing
-/// else): Bevy's prepass and opaque pass, and lodkit's combine.
-const PASSES: [&str; 4] = [
-    "early prepass",
-    "late prepass",
-    "main_opaque_pass_3d",
-    COMBINE_PASS,
+/// else), with the part of the report each adds to: Bevy's prepass, its opaque pass, and
+/// lodkit's combine.
+pub const PASSES: [(&str, Pass); 4] = [
+    ("early prepass", Pass::Prepass),
+    ("late prepass", Pass::Prepass),
+    ("main_opaque_pass_3d", Pass::Opaque),
+    (COMBINE_PASS, Pass::Combine),
 ];
+
+/// Where fragments go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// Bevy's depth (and motion-vector) prepass.
+    Prepass,
+    /// Bevy's opaque main pass.
+    Opaque,
+    /// lodkit's combine.
+    Combine,
+}
+
+impl Pass {
+    pub const ALL: [Pass; 3] = [Pass::Prepass, Pass::Opaque, Pass::Combine];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Pass::Prepass => "prepass",
+            Pass::Opaque => "opaque",
+            Pass::Combine => "combine",
+        }
+    }
+}
 
 /// A failure with its exit code.
 pub struct Failure(pub u8, pub String);
-
-fn io(message: String) -> Failure {
-    Failure(2, message)
-}
 
 /// Frames read back, in order.
 #[derive(Resource, Default)]
 struct Inbox(Vec<Vec<u8>>);
 
 /// What one run recorded.
-struct Run {
-    frames: Vec<Frame>,
-    /// Per update: fragment-shader invocations of PASSES reported that update (Bevy's render
-    /// diagnostics arrive `latency` updates after their frame).
-    fragments: Vec<f64>,
+pub struct Run {
+    pub frames: Vec<Frame>,
+    /// Per update: fragment-shader invocations of each [`Pass`] (in `Pass::ALL` order) reported
+    /// that update (Bevy's render diagnostics arrive `latency` updates after their frame).
+    pub fragments: Vec<[f64; 3]>,
     /// Per frame: whether a group was in its transition band.
-    in_transition: Vec<bool>,
+    pub in_transition: Vec<bool>,
 }
 
-struct Harness {
+impl Run {
+    /// Fragments of each pass over the frames in transition, with the diagnostics `latency`.
+    pub fn transition_fragments(&self, latency: usize) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for (f, _) in self.in_transition.iter().enumerate().filter(|(_, t)| **t) {
+            if let Some(counts) = self.fragments.get(f + latency) {
+                for (s, c) in sum.iter_mut().zip(counts) {
+                    *s += c;
+                }
+            }
+        }
+        sum
+    }
+}
+
+pub struct Harness {
     app: App,
-    camera: Entity,
     target: Handle<Image>,
     /// The last measurement time seen per pass (a pass that did not run adds nothing).
     seen: Vec<Option<Instant>>,
 }
 
 impl Harness {
-    fn new() -> Self {
+    pub fn new() -> Self {
         let mut app = build_app(|app| {
             app.add_plugins((FrameSequentialLodPlugin, RenderDiagnosticsPlugin))
                 .init_resource::<Inbox>();
         });
         let world = app.world_mut();
         let target = render_target(world, WIDTH, HEIGHT);
-        let camera = world
-            .spawn((
-                Camera3d::default(),
-                Camera {
-                    clear_color: ClearColorConfig::Custom(BACKGROUND),
-                    ..default()
-                },
-                RenderTarget::from(target.clone()),
-                Msaa::Off,
-                Tonemapping::None,
-                DebandDither::Disabled,
-                camera_at(false, 0).0,
-            ))
-            .id();
         world.spawn((
             DirectionalLight {
                 shadow_maps_enabled: false,
@@ -102,39 +120,57 @@ impl Harness {
         ));
         Self {
             app,
-            camera,
             target,
             seen: vec![None; PASSES.len()],
         }
     }
 
-    /// Fragment invocations the passes reported since the last call.
-    fn fragments(&mut self) -> f64 {
+    pub fn app(&self) -> &App {
+        &self.app
+    }
+
+    /// Fragment invocations per [`Pass`] reported since the last call.
+    fn fragments(&mut self) -> [f64; 3] {
         let store = self.app.world().resource::<DiagnosticsStore>();
-        let mut sum = 0.0;
-        for (pass, seen) in PASSES.iter().zip(&mut self.seen) {
+        let mut sum = [0.0; 3];
+        for ((pass, part), seen) in PASSES.iter().zip(&mut self.seen) {
             let path = DiagnosticPath::new(format!("render/{pass}/fragment_shader_invocations"));
             let Some(m) = store.get(&path).and_then(|d| d.measurement()) else {
                 continue;
             };
             if *seen != Some(m.time) {
                 *seen = Some(m.time);
-                sum += m.value;
+                sum[Pass::ALL.iter().position(|p| p == part).unwrap_or(0)] += m.value;
             }
         }
         sum
     }
 
-    fn step(&mut self) -> f64 {
+    fn step(&mut self) -> [f64; 3] {
         step(&mut self.app);
         self.fragments()
     }
 
-    /// Runs `technique` along the still or moving camera path.
-    fn run(&mut self, technique: Technique, moving: bool, args: &Args) -> Result<Run, Failure> {
+    /// The camera of a run: what every run has (target, clear color, no MSAA, no tonemapping
+    /// or dither, so frames compare exactly), Bevy's depth and motion-vector prepass in the app
+    /// that runs one anyway, and lodkit's component for frame-sequential LOD.
+    fn spawn_camera(&mut self, technique: Technique, prepass: bool, args: &Args) -> Entity {
         let world = self.app.world_mut();
-        let roots = spawn_groups(world, technique);
-        let mut camera = world.entity_mut(self.camera);
+        let mut camera = world.spawn((
+            Camera3d::default(),
+            Camera {
+                clear_color: ClearColorConfig::Custom(BACKGROUND),
+                ..default()
+            },
+            RenderTarget::from(self.target.clone()),
+            Msaa::Off,
+            Tonemapping::None,
+            DebandDither::Disabled,
+            camera_at(false, 0).0,
+        ));
+        if prepass {
+            camera.insert((DepthPrepass, MotionVectorPrepass));
+        }
         if technique == Technique::FrameSequential {
             camera.insert(FrameSequentialLod {
                 schedule: args.schedule,
@@ -146,14 +182,31 @@ impl Harness {
                 },
                 reprojection: args.reprojection,
             });
-        } else {
-            camera.remove::<FrameSequentialLod>();
         }
-        let (pose, bias) = camera_at(moving, 0);
-        *world.get_mut::<Transform>(self.camera).expect("camera") = pose;
-        if let Some(mut lod) = world.get_mut::<FrameSequentialLod>(self.camera) {
-            lod.settings.bias = bias;
-        }
+        camera.id()
+    }
+
+    /// Runs `technique` along the still or moving camera path, on a camera with Bevy's prepass
+    /// or without.
+    pub fn run(
+        &mut self,
+        technique: Technique,
+        prepass: bool,
+        moving: bool,
+        args: &Args,
+    ) -> Result<Run, Failure> {
+        let camera = self.spawn_camera(technique, prepass, args);
+        let world = self.app.world_mut();
+        let roots = spawn_groups(world, technique);
+        let place = |world: &mut World, frame: usize| {
+            let (pose, bias) = camera_at(moving, frame);
+            *world.get_mut::<Transform>(camera).expect("camera") = pose;
+            if let Some(mut lod) = world.get_mut::<FrameSequentialLod>(camera) {
+                lod.settings.bias = bias;
+            }
+            (pose, bias)
+        };
+        place(world, 0);
         for _ in 0..WARMUP_UPDATES {
             self.step();
         }
@@ -172,12 +225,8 @@ impl Harness {
             in_transition: Vec::new(),
         };
         for frame in 0..FRAMES {
-            let (pose, bias) = camera_at(moving, frame);
             let world = self.app.world_mut();
-            *world.get_mut::<Transform>(self.camera).expect("camera") = pose;
-            if let Some(mut lod) = world.get_mut::<FrameSequentialLod>(self.camera) {
-                lod.settings.bias = bias;
-            }
+            let (pose, bias) = place(world, frame);
             let mut banded = false;
             for (spec, (root, levels)) in specs.iter().zip(&roots) {
                 let position = group_position(spec, frame);
@@ -203,6 +252,7 @@ impl Harness {
         }
         let world = self.app.world_mut();
         world.despawn(readback);
+        world.despawn(camera);
         for (root, _) in roots {
             world.despawn(root);
         }
@@ -227,19 +277,22 @@ impl Harness {
 
     /// Updates between a frame and its render diagnostics: the first update reporting
     /// fragments after the scene appears.
-    fn diagnostics_latency(&mut self) -> Result<usize, Failure> {
+    pub fn diagnostics_latency(&mut self, args: &Args) -> Result<usize, Failure> {
+        let camera = self.spawn_camera(Technique::Reference(0), false, args);
         for _ in 0..6 {
             self.step();
         }
         let roots = spawn_groups(self.app.world_mut(), Technique::Reference(0));
         let mut latency = None;
         for k in 0..10 {
-            if self.step() > 0.0 && latency.is_none() {
+            if self.step().iter().sum::<f64>() > 0.0 && latency.is_none() {
                 latency = Some(k);
             }
         }
+        let world = self.app.world_mut();
+        world.despawn(camera);
         for (root, _) in roots {
-            self.app.world_mut().despawn(root);
+            world.despawn(root);
         }
         for _ in 0..6 {
             self.step();
@@ -251,117 +304,4 @@ impl Harness {
             )
         })
     }
-}
-
-/// Fragments of the frames in transition, with the diagnostics `latency`.
-fn transition_fragments(run: &Run, latency: usize) -> f64 {
-    run.in_transition
-        .iter()
-        .enumerate()
-        .filter(|(_, t)| **t)
-        .map(|(f, _)| run.fragments.get(f + latency).copied().unwrap_or(0.0))
-        .sum()
-}
-
-/// 7 frames evenly over the frames in transition.
-fn strip_of(run: &Run) -> Frame {
-    let frames: Vec<usize> = (0..FRAMES).filter(|&f| run.in_transition[f]).collect();
-    let (first, last) = (frames[0], frames[frames.len() - 1]);
-    let picks: Vec<Frame> = (0..7)
-        .map(|k| run.frames[first + (last - first) * k / 6].clone())
-        .collect();
-    strip(&picks)
-}
-
-pub fn run(args: &Args) -> Result<(), Failure> {
-    std::fs::create_dir_all(&args.out).map_err(|e| io(format!("{}: {e}", args.out.display())))?;
-    let mut h = Harness::new();
-    let latency = h.diagnostics_latency()?;
-    println!("render diagnostics arrive {latency} update(s) after their frame");
-    let background = Frame::filled(1, 1, srgb8(BACKGROUND)).rgb(0, 0);
-    let mut report = serde_json::Map::new();
-    let mut see = [0usize; 2];
-    let mut cover = [1.0f64; 2];
-    let mut fragments = [0.0f64; 2];
-    for moving in [false, true] {
-        let path = if moving { "moving" } else { "static" };
-        let fine = h.run(Technique::Reference(0), moving, args)?;
-        let coarse = h.run(Technique::Reference(1), moving, args)?;
-        if fine.frames[0].object_pixels(background) == 0 {
-            return Err(Failure(
-                1,
-                "nothing rendered: the reference frame is empty".into(),
-            ));
-        }
-        for (i, (technique, name)) in [
-            (Technique::FrameSequential, "frame_sequential"),
-            (Technique::BevyCrossfade, "bevy_crossfade"),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let run = h.run(technique, moving, args)?;
-            let p = pop(&run.frames, &fine.frames);
-            let holes = see_through(&run.frames, &fine.frames, &coarse.frames, background);
-            let shown = coverage(&run.frames, &fine.frames, &coarse.frames, background);
-            let window: Vec<usize> = (0..FRAMES).filter(|&f| run.in_transition[f]).collect();
-            see[i] += window.iter().map(|&f| holes[f]).sum::<usize>();
-            cover[i] = window.iter().map(|&f| shown[f]).fold(cover[i], f64::min);
-            fragments[i] += transition_fragments(&run, latency);
-            println!(
-                "{name:16} {path:6}: pop {p:.3}, see-through {} px, fragments {:.0}",
-                window.iter().map(|&f| holes[f]).sum::<usize>(),
-                transition_fragments(&run, latency)
-            );
-            report.insert(format!("pop_{name}_{path}"), p.into());
-            if moving {
-                let file = args.out.join(format!("strip_{name}.png"));
-                save_png(&strip_of(&run), &file).map_err(io)?;
-                report.insert(
-                    format!("png_strip_{name}"),
-                    file.display().to_string().into(),
-                );
-            }
-        }
-    }
-    for (i, name) in ["frame_sequential", "bevy_crossfade"].iter().enumerate() {
-        report.insert(format!("see_through_{name}"), see[i].into());
-        report.insert(format!("min_coverage_{name}"), cover[i].into());
-        report.insert(format!("fragments_{name}"), fragments[i].into());
-    }
-    report.insert(
-        "fragments_ratio".into(),
-        (fragments[0] / fragments[1].max(1.0)).into(),
-    );
-    report.insert("frames_per_run".into(), FRAMES.into());
-    report.insert("size".into(), vec![WIDTH, HEIGHT].into());
-    report.insert("diagnostics_latency".into(), latency.into());
-    report.insert(
-        "schedule".into(),
-        format!("{:?}", args.schedule).to_lowercase().into(),
-    );
-    report.insert(
-        "anchor".into(),
-        format!("{:?}", args.anchor).to_lowercase().into(),
-    );
-    report.insert("reprojection".into(), args.reprojection.into());
-    let stats = h.app.world().resource::<FrameSequentialStats>().clone();
-    report.insert("frames_scheduled".into(), stats.frames.into());
-    report.insert("frames_kept".into(), stats.frames_kept.into());
-    let json = serde_json::to_string_pretty(&report).expect("a JSON map serializes");
-    println!("{json}");
-    if let Some(path) = &args.report {
-        write(path, &json)?;
-    }
-    Ok(())
-}
-
-fn write(path: &Path, text: &str) -> Result<(), Failure> {
-    std::fs::write(path, text).map_err(|e| io(format!("{}: {e}", path.display())))
-}
-
-/// `color` as 8-bit sRGB, as the render target stores it.
-fn srgb8(color: Color) -> [u8; 3] {
-    let c = color.to_srgba();
-    [c.red, c.green, c.blue].map(|v| (v * 255.0).round() as u8)
 }

@@ -1,15 +1,17 @@
 //! Frame-sequential LOD on a Bevy camera (Scherzer & Wimmer 2008): a LOD group in transition
 //! draws ONE of its two levels per frame, alternating, and a combine pass merges this frame's
-//! picture with the last one's, reprojected with Bevy's depth and motion vectors. Each level is
+//! picture with the last one's, reprojected with the main pass's depth and the camera's and
+//! groups' motion (or Bevy's motion vectors, where the camera has that prepass). Each level is
 //! shown through lodkit's visibility pattern at the frame displayed, so the object never shows
 //! what is behind it (no see-through), the change is spread over the transition (no pop), and
 //! the group draws one level per frame, not two as a crossfade does.
 //!
-//! What that saves depends on the app. The camera needs Bevy's depth and motion-vector prepass,
-//! and Bevy's `VisibilityRange` crossfade needs none. In the `frame_sequential` example, over
-//! its transitions, frame-sequential LOD draws 0.78x the crossfade's fragments in an app that
-//! runs that prepass anyway (TAA, motion blur), and 2.4x in an app without a prepass, where the
-//! prepass is the larger cost (`cargo run --example frame_sequential -- --report report.json`,
+//! No prepass is needed, as for Bevy's `VisibilityRange` crossfade. In the `frame_sequential`
+//! example, each technique on a camera of its own, over its transitions, frame-sequential LOD
+//! draws 0.73x the crossfade's fragments in an app without a prepass and 0.78x in an app that
+//! runs Bevy's depth and motion-vector prepass anyway (TAA, motion blur), with less pop; on the
+//! flicker measure (change over net change) it scores 2.1 / 7.6 against the crossfade's 2.0 /
+//! 5.5 (still / moving camera) (`cargo run --example frame_sequential -- --report report.json`,
 //! and lodkit's docs/engines.md).
 //!
 //! ```no_run
@@ -54,7 +56,7 @@
 //! - [`FrameSequentialLodPlugin`] selects every [`FrameSequentialGroup`]'s level from the camera
 //!   with [`FrameSequentialLod`] (lodkit::select, with hysteresis; distance- or time-driven),
 //!   and runs lodkit's transition scheduler: a group shows the level the scheduler draws this
-//!   frame, through a child entity of the group, in Bevy's normal prepass and main pass. A
+//!   frame, through a child entity of the group, in Bevy's main pass (and prepass, if any). A
 //!   group not in transition is an ordinary Bevy mesh.
 //! - Levels use [`FrameSequentialMaterial`] (Bevy's `StandardMaterial`, lit by Bevy's PBR
 //!   functions), whose fragment shader ends with
@@ -78,7 +80,6 @@ mod tag;
 
 use bevy::asset::embedded_asset;
 use bevy::camera::Hdr;
-use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass};
 use bevy::pbr::MaterialPlugin;
 use bevy::prelude::*;
 use bevy::render::RenderApp;
@@ -149,12 +150,19 @@ impl Plugin for FrameSequentialLodPlugin {
 /// Frame-sequential LOD on a 3D camera: the camera that selects the levels of every
 /// [`FrameSequentialGroup`] and combines its frames.
 ///
-/// Requires (and adds) [`DepthPrepass`], [`MotionVectorPrepass`] and [`Hdr`]; the camera must
-/// also have `Msaa::Off`: with another `Msaa` the plugin logs one warning, runs no combine and
-/// lets no transition begin (groups switch levels at once).
+/// Requires (and adds) [`Hdr`]. No prepass is needed: the combine reprojects last frame's
+/// picture with this frame's depth (the main pass's), the camera's motion and, for a group that
+/// moved (its `GlobalTransform` changed), the group's motion. Add Bevy's
+/// [`MotionVectorPrepass`](bevy::core_pipeline::prepass::MotionVectorPrepass) (with
+/// [`DepthPrepass`](bevy::core_pipeline::prepass::DepthPrepass)) when levels move in ways a transform does not
+/// tell (skinned or morphed meshes, vertex animation): the combine then reads each pixel's
+/// motion from it; an app that runs that prepass anyway (TAA, motion blur) loses nothing by it.
+///
+/// The camera must also have `Msaa::Off`: with another `Msaa` the plugin logs one warning, runs
+/// no combine and lets no transition begin (groups switch levels at once).
 #[derive(Component, Clone, Debug, Reflect)]
 #[reflect(Component, Default, Clone)]
-#[require(DepthPrepass, MotionVectorPrepass, Hdr)]
+#[require(Hdr)]
 pub struct FrameSequentialLod {
     /// How the two levels share the visibility pattern over a transition (default: the paper's
     /// Fig. 2; `Schedule::Complementary` spreads the change at silhouettes over the whole
@@ -171,8 +179,9 @@ pub struct FrameSequentialLod {
     /// `Hard` switches at once).
     #[reflect(ignore)]
     pub settings: LodSettings,
-    /// Whether the combine reprojects the older frame with the camera's motion and Bevy's
-    /// motion vectors (default true). Off, the older frame is read at the same pixel: only for
+    /// Whether the combine reprojects the older frame with the camera's and the groups' motion,
+    /// or Bevy's motion vectors with a motion-vector prepass (default true). Off, the older
+    /// frame is read at the same pixel: only for
     /// seeing what reprojection does; a moving camera then shows the background through
     /// objects in transition.
     pub reprojection: bool,

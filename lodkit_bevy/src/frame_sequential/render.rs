@@ -12,10 +12,14 @@ use bevy::log::warn_once;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex, ExtractComponent};
-use bevy::render::render_resource::binding_types::{texture_2d, texture_depth_2d, uniform_buffer};
+use bevy::render::render_asset::RenderAssets;
+use bevy::render::render_resource::binding_types::{
+    storage_buffer_read_only_sized, texture_2d, texture_depth_2d, uniform_buffer,
+};
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::sync_component::SyncComponent;
+use bevy::render::texture::{FallbackImage, GpuImage};
 use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
 use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 
@@ -34,7 +38,15 @@ pub struct FrameSequentialView {
     pub clip_from_view: Mat4,
     /// This frame's clip space to last frame's (`lodkit::reproject::new_to_old_matrix`).
     pub new_to_old: Mat4,
-    /// Whether the combine reads Bevy's motion vectors.
+    /// Without motion vectors: per t-instance id whose group moved since last frame, the same
+    /// matrix with the group's motion (its pixels are reprojected with it).
+    pub object_new_to_old: Vec<(u32, Mat4)>,
+    /// Per t-instance drawn this frame with the pattern anchored to the screen: its id and the
+    /// tau at which it is displayed next frame (as its tag carries it).
+    pub drawn_tau_next: Vec<(u32, f32)>,
+    /// Last frame's `drawn_tau_next`: the levels the older buffer holds.
+    pub older_tau: Vec<(u32, f32)>,
+    /// Whether the combine reads Bevy's motion vectors (the camera has `MotionVectorPrepass`).
     pub motion_vectors: bool,
     /// The combine's rectangles (pixels, top left origin), not overlapping.
     pub rects: Vec<URect>,
@@ -122,6 +134,8 @@ impl FromWorld for CombinePipeline {
                     texture_depth_2d(),
                     color,
                     uniform_buffer::<CombineParams>(true),
+                    storage_buffer_read_only_sized(false, None),
+                    texture_2d(TextureSampleType::Float { filterable: false }),
                 ),
             ),
         );
@@ -232,12 +246,15 @@ fn prepare_textures(
 #[derive(Component)]
 pub struct CombineBindGroup(BindGroup);
 
+#[allow(clippy::too_many_arguments, reason = "one system's render-world inputs")]
 fn prepare_bind_groups(
     mut commands: Commands,
     device: Res<RenderDevice>,
     cache: Res<PipelineCache>,
     pipeline: Res<CombinePipeline>,
     params: Res<ComponentUniforms<CombineParams>>,
+    fallback: Res<FallbackImage>,
+    images: Res<RenderAssets<GpuImage>>,
     views: Query<(
         Entity,
         &FrameSequentialView,
@@ -248,13 +265,25 @@ fn prepare_bind_groups(
     let Some(params) = params.uniforms().binding() else {
         return;
     };
+    let Some(visibility) = images.get(&super::VISIBILITY_TEXTURE) else {
+        return;
+    };
     for (entity, view, textures, prepass) in &views {
-        let Some(motion) = prepass.and_then(ViewPrepassTextures::motion_vectors_view) else {
-            warn_once!(
-                "FrameSequentialLod needs MotionVectorPrepass on its camera: nothing is combined"
-            );
-            continue;
+        let motion = match prepass.and_then(ViewPrepassTextures::motion_vectors_view) {
+            Some(motion) => motion,
+            None if view.motion_vectors => {
+                warn_once!("FrameSequentialLod: the motion-vector prepass has no texture yet");
+                continue;
+            }
+            // Not read (flags.x = 0): any texture of the layout's type.
+            None => &fallback.d2.texture_view,
         };
+        let objects = object_data(view);
+        let object_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
+            label: Some("lodkit_frame_sequential_objects"),
+            contents: &objects,
+            usage: BufferUsages::STORAGE,
+        });
         let (newer, older) = (view.buffer, 1 - view.buffer);
         let bind_group = device.create_bind_group(
             "lodkit_frame_sequential_combine",
@@ -266,10 +295,34 @@ fn prepare_bind_groups(
                 &textures.depth[older].1,
                 motion,
                 params.clone(),
+                object_buffer.as_entire_binding(),
+                &visibility.texture_view,
             )),
         );
         commands.entity(entity).insert(CombineBindGroup(bind_group));
     }
+}
+
+/// combine.wesl's `objects`, as bytes: per t-instance id (up to the largest named), the
+/// reprojection of its pixels and the tau its older level is displayed at.
+fn object_data(view: &FrameSequentialView) -> Vec<u8> {
+    let ids = view.object_new_to_old.iter().map(|&(id, _)| id);
+    let slots = ids
+        .chain(view.older_tau.iter().map(|&(id, _)| id))
+        .max()
+        .map_or(1, |id| id as usize + 1);
+    let mut objects = vec![(view.new_to_old, Vec4::ZERO); slots];
+    for &(id, m) in &view.object_new_to_old {
+        objects[id as usize].0 = m;
+    }
+    for &(id, tau) in &view.older_tau {
+        objects[id as usize].1 = Vec4::new(tau, 1.0, 0.0, 0.0);
+    }
+    objects
+        .iter()
+        .flat_map(|(m, t)| m.to_cols_array().into_iter().chain(t.to_array()))
+        .flat_map(f32::to_le_bytes)
+        .collect()
 }
 
 type PassView = (

@@ -5,9 +5,11 @@
 use bevy::camera::CameraUpdateSystems;
 use bevy::camera::primitives::MeshAabb;
 use bevy::camera::visibility::VisibilitySystems;
+use bevy::core_pipeline::prepass::MotionVectorPrepass;
 use bevy::log::warn_once;
 use bevy::mesh::{MeshTag, VertexAttributeValues};
 use bevy::prelude::*;
+use bevy::render::render_resource::TextureUsages;
 use bevy::transform::TransformSystems;
 use lodkit::combine::{ScreenRect, merge_rects, screen_rect};
 use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
@@ -28,7 +30,7 @@ pub(super) fn build(app: &mut App) {
         .init_resource::<FrameSequentialStats>()
         .add_systems(
             PostUpdate,
-            (spawn_levels, update)
+            (configure_depth_copies, spawn_levels, update)
                 .chain()
                 .after(TransformSystems::Propagate)
                 .after(CameraUpdateSystems)
@@ -83,6 +85,17 @@ pub struct FrameSequentialStats {
     pub frame_kept: bool,
     /// Frames kept so far (of [`frames`](Self::frames)).
     pub frames_kept: u64,
+}
+
+/// The combine copies the main pass's depth (the older frame's, next frame): Bevy's depth
+/// texture allows copies only with a depth prepass, unless the camera asks for them.
+fn configure_depth_copies(mut cameras: Query<&mut Camera3d, With<FrameSequentialLod>>) {
+    for mut camera in &mut cameras {
+        let usages = TextureUsages::from(camera.depth_texture_usages);
+        if !usages.contains(TextureUsages::COPY_SRC) {
+            camera.depth_texture_usages = (usages | TextureUsages::COPY_SRC).into();
+        }
+    }
 }
 
 /// Spawns the drawing child of every new or changed [`LodLevels`]. A changed group starts over:
@@ -303,6 +316,7 @@ type CameraQuery<'w, 's> = Query<
         &'static FrameSequentialLod,
         Option<&'static FrameSequentialView>,
         Option<&'static Msaa>,
+        Has<MotionVectorPrepass>,
     ),
 >;
 
@@ -348,7 +362,7 @@ fn update(
         }
         live
     });
-    let Some((camera_entity, camera, camera_transform, settings, last, msaa)) =
+    let Some((camera_entity, camera, camera_transform, settings, last, msaa, has_motion)) =
         cameras.iter().find(|(_, c, ..)| c.is_active)
     else {
         return;
@@ -386,6 +400,9 @@ fn update(
     );
     let object = settings.anchor == VisibilitySpace::Object;
     let mut rects = Vec::new();
+    // Without Bevy's motion vectors, the world motion of each t-instance that moved.
+    let mut moved = Vec::new();
+    let mut drawn_tau_next = Vec::new();
     let mut in_transition = 0;
     // The combine needs last frame's picture: a transition begins only after a frame that the
     // render world kept, and frames are kept only while a group is in transition or about to be.
@@ -431,8 +448,12 @@ fn update(
             None => (selection.current, 0),
         };
         // An n-instance's tag is not 0 (it carries tau = 1): its id is.
-        if decode_tag(tag).0 != 0 {
+        let (tag_id, _, tau_next, _) = decode_tag(tag);
+        if tag_id != 0 {
             in_transition += 1;
+            if !object {
+                drawn_tau_next.push((tag_id, tau_next));
+            }
             if state.bounds.is_none() {
                 state.bounds = match group.bounds {
                     Some((lo, hi)) => Some(Bounds {
@@ -443,9 +464,12 @@ fn update(
                     None => level_bounds(levels, &meshes),
                 };
             }
+            let previous = state.previous_model.unwrap_or(model);
+            if previous != model {
+                moved.push((tag_id, previous * model.inverse()));
+            }
             match state.bounds {
                 Some(bounds) => {
-                    let previous = state.previous_model.unwrap_or(model);
                     rects.extend(group_rect(
                         bounds,
                         model,
@@ -495,16 +519,27 @@ fn update(
     stats.frame_kept = !multisampled && (keep_frame || in_transition > 0);
     stats.frames_kept += u64::from(stats.frame_kept);
     stats.combine_pixels = rects.iter().map(ScreenRect::area).sum();
-    let new_to_old = if settings.reprojection {
+    // This frame's clip space to last frame's for a point that moved by `motion` (world).
+    let reproject = |motion: Mat4| {
         let m = new_to_old_matrix(
             &to_lodkit(view_from_world),
             &to_lodkit(clip_from_view),
-            &to_lodkit(previous_view.0),
+            &to_lodkit(previous_view.0 * motion),
             &to_lodkit(previous_view.1),
         );
         Mat4::from_cols_array(&m.to_cols_array())
+    };
+    let motion_vectors = settings.reprojection && has_motion;
+    let (new_to_old, object_new_to_old) = if !settings.reprojection {
+        (Mat4::IDENTITY, Vec::new())
+    } else if motion_vectors {
+        (reproject(Mat4::IDENTITY), Vec::new())
     } else {
-        Mat4::IDENTITY
+        let objects = moved
+            .into_iter()
+            .map(|(id, motion)| (id, reproject(motion)))
+            .collect();
+        (reproject(Mat4::IDENTITY), objects)
     };
     if multisampled {
         return;
@@ -513,7 +548,10 @@ fn update(
         view_from_world,
         clip_from_view,
         new_to_old,
-        motion_vectors: settings.reprojection,
+        object_new_to_old,
+        older_tau: last.map_or_else(Vec::new, |l| l.drawn_tau_next.clone()),
+        drawn_tau_next,
+        motion_vectors,
         rects: rects
             .iter()
             .map(|r| URect::new(r.x, r.y, r.x + r.width, r.y + r.height))
