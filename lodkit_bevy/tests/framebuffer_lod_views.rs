@@ -1,6 +1,8 @@
-//! Framebuffer LOD in a headless Bevy app on the GPU, held to hand-derived pixels: an effect's
-//! own bindings (a uniform and a texture) reach its shader, and follow the asset when it
-//! changes.
+//! Framebuffer LOD in a headless Bevy app on the GPU: an effect's own bindings (a uniform and a
+//! texture) reach its shader and follow the asset when it changes (held to hand-derived
+//! pixels); cameras with viewports (split screen, each its own r) and a main-pass resolution
+//! override draw their effect inside their viewport only, and what they draw there is what the
+//! same camera draws alone into a target of its viewport's size.
 
 #[path = "../examples/common/frames.rs"]
 #[allow(dead_code, reason = "shared with the examples")]
@@ -11,9 +13,12 @@ mod headless;
 
 use bevy::asset::{RenderAssetUsages, uuid_handle};
 use bevy::camera::RenderTarget;
+use bevy::camera::{MainPassResolutionOverride, Viewport};
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
 use bevy::render::render_resource::{AsBindGroup, Extent3d, TextureDimension, TextureFormat};
+use bevy::render::sync_world::RenderEntity;
+use bevy::render::{Extract, ExtractSchedule, RenderApp};
 use bevy::shader::ShaderRef;
 use frames::Frame;
 use lodkit_bevy::prelude::*;
@@ -38,6 +43,39 @@ fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
 }
 ";
 
+const SHADE: Handle<Shader> = uuid_handle!("6a2e8b41-0d5c-4f7a-9b13-e8c4a7d2f095");
+
+/// Shades the scene's geometry: a sawtooth of view depth (period 4 m) times how much
+/// the surface faces the camera, in the uniform's color, with the uniform's alpha as coverage.
+const SHADE_SOURCE: &str = "
+import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput;
+import lodkit::gbuffer::GBufferOutput;
+import lodkit_bevy::framebuffer_lod::{effect_sample, effect_output};
+
+@group(constants::FRAMEBUFFER_LOD_EFFECT_BIND_GROUP) @binding(0) var<uniform> tint: vec4<f32>;
+
+@fragment
+fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
+    let s = effect_sample(in.position);
+    let stripes = fract(s.view_depth * 0.25);
+    let facing = 0.5 + 0.5 * s.view_normal.z;
+    return effect_output(vec4<f32>(tint.rgb * (stripes * facing * tint.a), tint.a), s);
+}
+";
+
+/// The geometry-aware test effect of the viewport tests.
+#[derive(Asset, TypePath, AsBindGroup, Clone)]
+struct Shade {
+    #[uniform(0)]
+    tint: Vec4,
+}
+
+impl FramebufferLodEffect for Shade {
+    fn fragment_shader() -> ShaderRef {
+        SHADE.into()
+    }
+}
+
 /// The test effect: a color uniform and a texture with its sampler.
 #[derive(Asset, TypePath, AsBindGroup, Clone)]
 struct Paint {
@@ -60,12 +98,22 @@ const TINT: [u8; 4] = [255, 51, 102, 255];
 /// A headless app with the paint effect's plugin and shader.
 fn app() -> App {
     let mut app = headless::build_app(|app| {
-        app.add_plugins(FramebufferLodEffectPlugin::<Paint>::default());
+        app.add_plugins((
+            FramebufferLodEffectPlugin::<Paint>::default(),
+            FramebufferLodEffectPlugin::<Shade>::default(),
+        ));
     });
-    app.world_mut()
-        .resource_mut::<Assets<Shader>>()
-        .insert(&PAINT, Shader::from_wesl(PAINT_SOURCE, "paint.wesl"))
-        .expect("a UUID handle");
+    let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
+    for (handle, source, path) in [
+        (&PAINT, PAINT_SOURCE, "paint.wesl"),
+        (&SHADE, SHADE_SOURCE, "shade.wesl"),
+    ] {
+        shaders
+            .insert(handle, Shader::from_wesl(source, path))
+            .expect("a UUID handle");
+    }
+    app.sub_app_mut(RenderApp)
+        .add_systems(ExtractSchedule, extract_resolution_override);
     app
 }
 
@@ -198,4 +246,214 @@ fn an_effects_own_uniform_and_texture_reach_its_shader() {
         "{bad} pixels differ from {:?}: {at:?}",
         painted(second)
     );
+}
+
+/// Clear color of the viewport tests (linear): not black, so an effect composited over a part
+/// of the target it should not touch changes it.
+const CLEAR: Vec3 = Vec3::new(0.2, 0.3, 0.4);
+
+/// A main-pass resolution override, put on the camera in the render world (where Bevy reads it).
+#[derive(Component, Clone, Copy)]
+struct ResolutionOverride(UVec2);
+
+fn extract_resolution_override(
+    mut commands: Commands,
+    cameras: Extract<Query<(RenderEntity, &ResolutionOverride)>>,
+) {
+    for (entity, o) in &cameras {
+        commands
+            .entity(entity)
+            .insert(MainPassResolutionOverride(o.0));
+    }
+}
+
+/// One camera of a viewport test.
+#[derive(Clone, Copy)]
+struct View {
+    eye: Vec3,
+    r: f32,
+    tint: Vec4,
+    /// Physical viewport: corner and size.
+    viewport: Option<(UVec2, UVec2)>,
+    order: isize,
+    /// Whether it clears the target (else it draws over what the cameras before it left in
+    /// the main texture they share, which is how it sees their spills).
+    clear: bool,
+    resolution_override: Option<UVec2>,
+}
+
+/// A ground plane, three boxes and a sun.
+fn spawn_scene(world: &mut World) {
+    world.spawn((
+        DirectionalLight {
+            shadow_maps_enabled: false,
+            illuminance: 5_000.0,
+            ..default()
+        },
+        Transform::from_xyz(2.0, 4.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    let ground = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Plane3d::default().mesh().size(40.0, 40.0));
+    let cube = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Cuboid::new(1.0, 2.0, 1.0));
+    let material = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(StandardMaterial {
+            base_color: Color::srgb(0.5, 0.45, 0.4),
+            ..default()
+        });
+    world.spawn((Mesh3d(ground), MeshMaterial3d(material.clone())));
+    for (x, z) in [(-1.5, 0.0), (1.0, -2.0), (0.5, 1.5)] {
+        world.spawn((
+            Mesh3d(cube.clone()),
+            MeshMaterial3d(material.clone()),
+            Transform::from_xyz(x, 1.0, z),
+        ));
+    }
+}
+
+/// Renders `views` into a `size` target in a fresh app and captures it.
+fn render(size: UVec2, views: &[View]) -> Frame {
+    let mut app = app();
+    let target = headless::render_target(app.world_mut(), size.x, size.y);
+    spawn_scene(app.world_mut());
+    for view in views {
+        let effect = app
+            .world_mut()
+            .resource_mut::<Assets<Shade>>()
+            .add(Shade { tint: view.tint });
+        let mut camera = app.world_mut().spawn((
+            Camera3d::default(),
+            Camera {
+                clear_color: if view.clear {
+                    ClearColorConfig::Custom(Color::linear_rgb(CLEAR.x, CLEAR.y, CLEAR.z))
+                } else {
+                    ClearColorConfig::None
+                },
+                order: view.order,
+                viewport: view.viewport.map(|(corner, size)| Viewport {
+                    physical_position: corner,
+                    physical_size: size,
+                    ..default()
+                }),
+                ..default()
+            },
+            RenderTarget::from(target.clone()),
+            Msaa::Off,
+            Tonemapping::None,
+            DebandDither::Disabled,
+            Transform::from_translation(view.eye).looking_at(Vec3::new(0.0, 0.8, 0.0), Vec3::Y),
+            FramebufferLodEffectHandle(effect),
+            FramebufferLod {
+                resolution: FramebufferLodResolution::Fixed(view.r),
+                ..default()
+            },
+        ));
+        if let Some(o) = view.resolution_override {
+            camera.insert(ResolutionOverride(o));
+        }
+    }
+    settle_and_capture(&mut app, &target)
+}
+
+/// The pixel of `frame` at (x, y).
+fn pixel(frame: &Frame, x: u32, y: u32) -> [u8; 3] {
+    let i = ((y * frame.width + x) * 4) as usize;
+    [frame.rgba[i], frame.rgba[i + 1], frame.rgba[i + 2]]
+}
+
+/// Tolerance of a pixel against the same camera rendered alone (8-bit steps per channel).
+const TOLERANCE: u8 = 2;
+
+const A: View = View {
+    eye: Vec3::new(-1.0, 2.5, 7.0),
+    r: 2.0,
+    tint: Vec4::new(1.0, 0.5, 0.1, 0.7),
+    viewport: None,
+    order: 0,
+    clear: true,
+    resolution_override: None,
+};
+const B: View = View {
+    eye: Vec3::new(5.0, 3.0, -4.0),
+    r: 3.0,
+    tint: Vec4::new(0.1, 0.6, 1.0, 0.6),
+    viewport: None,
+    order: 0,
+    clear: true,
+    resolution_override: None,
+};
+
+#[test]
+fn split_screen_cameras_each_draw_their_own_effect_inside_their_viewport() {
+    let half = UVec2::new(48, 40);
+    let size = UVec2::new(2 * half.x, half.y);
+    // Each camera alone, in a target of its viewport's size: the reference.
+    let alone = [render(half, &[A]), render(half, &[B])];
+    // Side by side, in both orders. The cameras share the main texture; the first clears it,
+    // the second draws over what the first left there: an effect the first spilled outside its
+    // viewport would show in the second's half. (What the second spills into the first's half
+    // never reaches the image: Bevy copies each camera's viewport out before the next camera
+    // draws. Hence both orders.)
+    for first in [0, 1] {
+        let mut views = [A, B];
+        views[0].viewport = Some((UVec2::ZERO, half));
+        views[1].viewport = Some((UVec2::new(half.x, 0), half));
+        views[first].order = 0;
+        views[1 - first].order = 1;
+        views[1 - first].clear = false;
+        let split = render(size, &views);
+        for (i, reference) in alone.iter().enumerate() {
+            let x0 = i as u32 * half.x;
+            let (bad, at) = mismatches(
+                &split,
+                [x0, 0, half.x, half.y],
+                |x, y| pixel(reference, x - x0, y),
+                TOLERANCE,
+            );
+            println!(
+                "camera {i} (drawn {}): {bad} pixels differ",
+                if i == first { "first" } else { "second" }
+            );
+            assert_eq!(
+                bad, 0,
+                "camera {i}'s half differs from the camera alone in {bad} pixels: {at:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_main_pass_resolution_override_keeps_the_effect_in_the_main_pass_viewport() {
+    let size = UVec2::new(96, 64);
+    let main_pass = UVec2::new(48, 32);
+    let alone = render(main_pass, &[A]);
+    let view = View {
+        resolution_override: Some(main_pass),
+        ..A
+    };
+    let frame = render(size, &[view]);
+    // Where the main pass drew: the camera alone at that size.
+    let (bad, at) = mismatches(
+        &frame,
+        [0, 0, main_pass.x, main_pass.y],
+        |x, y| pixel(&alone, x, y),
+        TOLERANCE,
+    );
+    println!("main-pass viewport: {bad} pixels differ");
+    assert_eq!(bad, 0, "{bad} pixels differ from the camera alone: {at:?}");
+    // Elsewhere nothing drew: the clear color.
+    let clear = [srgb8(CLEAR.x), srgb8(CLEAR.y), srgb8(CLEAR.z)];
+    for rect in [
+        [main_pass.x, 0, size.x - main_pass.x, size.y],
+        [0, main_pass.y, main_pass.x, size.y - main_pass.y],
+    ] {
+        let (bad, at) = mismatches(&frame, rect, |_, _| clear, 1);
+        assert_eq!(
+            bad, 0,
+            "{bad} pixels outside the main pass are not the clear color {clear:?}: {at:?}"
+        );
+    }
 }

@@ -167,7 +167,10 @@ pub struct FramebufferLodCapabilities {
 /// Requires (and adds) [`DepthPrepass`], [`NormalPrepass`] and [`Hdr`]; the camera must also
 /// have `Msaa::Off` (the effect pass is skipped with an error otherwise). Only meshes drawn in the
 /// prepass (opaque and alpha-masked, with prepass-enabled materials) give the upsample its edges.
-/// The effect covers the camera's whole render target (a camera `viewport` is not supported).
+/// The effect covers the camera's main-pass viewport and writes nothing outside it: its
+/// `Camera::viewport` (split screen: each camera its own r), or the whole target; with a
+/// `MainPassResolutionOverride` in the render world, the override's size at the viewport's
+/// corner, where Bevy's prepass and main pass drew.
 #[derive(Component, Clone, Debug, Default, Reflect)]
 #[reflect(Component, Default, Clone)]
 #[require(DepthPrepass, NormalPrepass, Hdr, FramebufferLodState)]

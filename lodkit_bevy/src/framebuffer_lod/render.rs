@@ -1,9 +1,12 @@
-//! The render-world side: extraction, the upsample pipeline, the low-resolution targets
-//! (allocated at full size once per camera size, drawn through a viewport that shrinks with r,
-//! so changing r never reallocates), bind groups and the two passes. The effect's own pipeline
+//! The render-world side: extraction, the camera's main-pass viewport (its `Camera::viewport`,
+//! sized by `MainPassResolutionOverride` where the render world has one), the upsample pipeline,
+//! the low-resolution targets (allocated at the viewport's size once per size, drawn through a
+//! viewport that shrinks with r, so changing r never reallocates), bind groups and the two
+//! passes, both held inside the camera's main-pass viewport. The effect's own pipeline
 //! and bind group come from its type's plugin (effect.rs).
 
 use bevy::asset::load_embedded_asset;
+use bevy::camera::MainPassResolutionOverride;
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::core_pipeline::{Core3d, Core3dSystems, FullscreenShader};
 use bevy::ecs::query::QueryItem;
@@ -43,7 +46,11 @@ pub struct ExtractedFramebufferLod {
     pub(super) factor: f32,
     /// Whether the camera's GPU time is measured (adaptive r on GPU timestamps).
     pub(super) gpu_timed: bool,
+    /// The low-resolution viewport this frame: ceil(main-pass viewport / r).
     low_size: UVec2,
+    /// The camera's main-pass viewport in its render target: top-left corner and size.
+    origin: UVec2,
+    full_size: UVec2,
 }
 
 /// The settings the shaders read (`FramebufferLodSettings` in framebuffer_lod.wesl).
@@ -51,6 +58,7 @@ pub struct ExtractedFramebufferLod {
 pub struct FramebufferLodUniform {
     low_size: Vec2,
     full_size: Vec2,
+    origin: Vec2,
     factor: f32,
     depth_sigma: f32,
     normal_sigma: f32,
@@ -91,28 +99,24 @@ impl ExtractComponent<RenderApp> for FramebufferLod {
             );
             return None;
         }
-        if camera.viewport.is_some() {
-            warn_once!(
-                "FramebufferLod covers the camera's whole render target: its viewport is ignored"
-            );
-        }
-        let full = camera.physical_target_size()?;
+        // The sizes are the render world's (prepare_viewports): a MainPassResolutionOverride
+        // lives there.
+        camera.physical_viewport_size()?;
         let factor = state.factor.clamp(1.0, super::MAX_FACTOR);
-        let low = (full.as_vec2() / factor)
-            .ceil()
-            .as_uvec2()
-            .clamp(UVec2::ONE, full.max(UVec2::ONE));
         let (depth_sigma, normal_sigma) = settings.upsample.sigmas();
         Some((
             ExtractedFramebufferLod {
                 composite: settings.composite,
                 factor,
                 gpu_timed: state.gpu_timed,
-                low_size: low,
+                low_size: UVec2::ONE,
+                origin: UVec2::ZERO,
+                full_size: UVec2::ONE,
             },
             FramebufferLodUniform {
-                low_size: low.as_vec2(),
-                full_size: full.as_vec2(),
+                low_size: Vec2::ONE,
+                full_size: Vec2::ONE,
+                origin: Vec2::ZERO,
                 factor,
                 depth_sigma,
                 normal_sigma,
@@ -127,6 +131,11 @@ pub(super) fn build(render_app: &mut SubApp) {
         Render,
         (
             prepare_pipelines.in_set(RenderSystems::Prepare),
+            // Before the uniform is written and the targets are sized (both in
+            // PrepareResources, a subset of Prepare that is not ordered after Prepare's own).
+            prepare_viewports
+                .in_set(RenderSystems::Prepare)
+                .before(RenderSystems::PrepareResources),
             prepare_textures.in_set(RenderSystems::PrepareResources),
             prepare_bind_groups.in_set(RenderSystems::PrepareBindGroups),
         ),
@@ -144,6 +153,36 @@ pub(super) fn finish(render_app: &mut SubApp) {
     render_app
         .init_gpu_resource::<FramebufferLodPipelines>()
         .init_gpu_resource::<SpecializedRenderPipelines<FramebufferLodPipelines>>();
+}
+
+/// The camera's main-pass viewport this frame, from its extracted view (`Camera::viewport`, or
+/// the whole target) and a `MainPassResolutionOverride` (which keeps the viewport's corner and
+/// sets its size, at most the viewport's): where the prepass and main pass drew, so where the
+/// effect reads and the upsample writes. The low-resolution size follows: ceil(size / r).
+fn prepare_viewports(
+    mut views: Query<(
+        &mut ExtractedFramebufferLod,
+        &mut FramebufferLodUniform,
+        &ExtractedView,
+        Option<&MainPassResolutionOverride>,
+    )>,
+) {
+    for (mut extracted, mut uniform, view, resolution_override) in &mut views {
+        let viewport = view.viewport;
+        let size = resolution_override
+            .map_or(viewport.zw(), |o| o.0.min(viewport.zw()))
+            .max(UVec2::ONE);
+        let low = (size.as_vec2() / uniform.factor)
+            .ceil()
+            .as_uvec2()
+            .clamp(UVec2::ONE, size);
+        extracted.origin = viewport.xy();
+        extracted.full_size = size;
+        extracted.low_size = low;
+        uniform.origin = viewport.xy().as_vec2();
+        uniform.full_size = size.as_vec2();
+        uniform.low_size = low.as_vec2();
+    }
 }
 
 /// The bindings `lodkit_bevy::framebuffer_lod` declares in group 0: view, globals, depth and
@@ -286,12 +325,12 @@ fn prepare_textures(
     device: Res<RenderDevice>,
     views: Query<(
         Entity,
-        &FramebufferLodUniform,
+        &ExtractedFramebufferLod,
         Option<&FramebufferLodTextures>,
     )>,
 ) {
-    for (entity, uniform, textures) in &views {
-        let size = uniform.full_size.as_uvec2();
+    for (entity, extracted, textures) in &views {
+        let size = extracted.full_size;
         if textures.is_some_and(|t| t.size == size) {
             continue;
         }
@@ -455,6 +494,9 @@ fn framebuffer_lod_pass(
             multiview_mask: None,
         });
         let span = diagnostics.pass_span(&mut pass, UPSAMPLE_PASS);
+        // Only the camera's main-pass viewport: the fullscreen triangle is clipped to it.
+        let (origin, full) = (extracted.origin.as_vec2(), extracted.full_size.as_vec2());
+        pass.set_viewport(origin.x, origin.y, full.x, full.y, 0.0, 1.0);
         pass.set_render_pipeline(upsample);
         pass.set_bind_group(0, &bind_groups.upsample, &offsets);
         pass.draw(0..3, 0..1);
