@@ -2,7 +2,8 @@
 //! texture) reach its shader and follow the asset when it changes (held to hand-derived
 //! pixels); cameras with viewports (split screen, each its own r) and a main-pass resolution
 //! override draw their effect inside their viewport only, and what they draw there is what the
-//! same camera draws alone into a target of its viewport's size.
+//! same camera draws alone into a target of its viewport's size; after the render target is
+//! resized, the first frame is the frame rendered at that size from the start.
 
 #[path = "../examples/common/frames.rs"]
 #[allow(dead_code, reason = "shared with the examples")]
@@ -314,6 +315,36 @@ fn spawn_scene(world: &mut World) {
     }
 }
 
+/// The camera of `view` with framebuffer LOD (no effect yet) rendering into `target`.
+fn lod_camera(view: &View, target: Handle<Image>) -> impl Bundle {
+    (
+        Camera3d::default(),
+        Camera {
+            clear_color: if view.clear {
+                ClearColorConfig::Custom(Color::linear_rgb(CLEAR.x, CLEAR.y, CLEAR.z))
+            } else {
+                ClearColorConfig::None
+            },
+            order: view.order,
+            viewport: view.viewport.map(|(corner, size)| Viewport {
+                physical_position: corner,
+                physical_size: size,
+                ..default()
+            }),
+            ..default()
+        },
+        RenderTarget::from(target),
+        Msaa::Off,
+        Tonemapping::None,
+        DebandDither::Disabled,
+        Transform::from_translation(view.eye).looking_at(Vec3::new(0.0, 0.8, 0.0), Vec3::Y),
+        FramebufferLod {
+            resolution: FramebufferLodResolution::Fixed(view.r),
+            ..default()
+        },
+    )
+}
+
 /// Renders `views` into a `size` target in a fresh app and captures it.
 fn render(size: UVec2, views: &[View]) -> Frame {
     let mut app = app();
@@ -325,31 +356,8 @@ fn render(size: UVec2, views: &[View]) -> Frame {
             .resource_mut::<Assets<Shade>>()
             .add(Shade { tint: view.tint });
         let mut camera = app.world_mut().spawn((
-            Camera3d::default(),
-            Camera {
-                clear_color: if view.clear {
-                    ClearColorConfig::Custom(Color::linear_rgb(CLEAR.x, CLEAR.y, CLEAR.z))
-                } else {
-                    ClearColorConfig::None
-                },
-                order: view.order,
-                viewport: view.viewport.map(|(corner, size)| Viewport {
-                    physical_position: corner,
-                    physical_size: size,
-                    ..default()
-                }),
-                ..default()
-            },
-            RenderTarget::from(target.clone()),
-            Msaa::Off,
-            Tonemapping::None,
-            DebandDither::Disabled,
-            Transform::from_translation(view.eye).looking_at(Vec3::new(0.0, 0.8, 0.0), Vec3::Y),
+            lod_camera(view, target.clone()),
             FramebufferLodEffectHandle(effect),
-            FramebufferLod {
-                resolution: FramebufferLodResolution::Fixed(view.r),
-                ..default()
-            },
         ));
         if let Some(o) = view.resolution_override {
             camera.insert(ResolutionOverride(o));
@@ -454,6 +462,75 @@ fn a_main_pass_resolution_override_keeps_the_effect_in_the_main_pass_viewport() 
         assert_eq!(
             bad, 0,
             "{bad} pixels outside the main pass are not the clear color {clear:?}: {at:?}"
+        );
+    }
+}
+
+/// A new size for the render target `target` (its GPU texture is recreated at that size).
+fn resize_target(app: &mut App, target: &Handle<Image>, size: UVec2) {
+    app.world_mut()
+        .resource_mut::<Assets<Image>>()
+        .get_mut(target)
+        .expect("the render target")
+        .resize(Extent3d {
+            width: size.x,
+            height: size.y,
+            depth_or_array_layers: 1,
+        });
+}
+
+#[test]
+fn after_a_resize_the_first_frame_is_the_frame_rendered_at_that_size() {
+    // r = 1.25: at the larger size the low-resolution viewport (77 x 58) no longer fits in
+    // targets allocated at the first size (64 x 48), so stale targets cannot go unnoticed.
+    let view = View { r: 1.25, ..A };
+    let sizes = [UVec2::new(96, 72), UVec2::new(48, 40)];
+    let references = sizes.map(|size| render(size, &[view]));
+    let mut app = app();
+    let target = headless::render_target(app.world_mut(), 64, 48);
+    spawn_scene(app.world_mut());
+    let effect = app
+        .world_mut()
+        .resource_mut::<Assets<Shade>>()
+        .add(Shade { tint: view.tint });
+    let camera = app
+        .world_mut()
+        .spawn((
+            lod_camera(&view, target.clone()),
+            FramebufferLodEffectHandle(effect),
+        ))
+        .id();
+    settle_and_capture(&mut app, &target);
+    let camera_size = |app: &App| {
+        app.world()
+            .get::<Camera>(camera)
+            .and_then(Camera::physical_target_size)
+    };
+    for (size, reference) in sizes.iter().zip(&references) {
+        resize_target(&mut app, &target, *size);
+        // Bevy's camera learns of an image target's new size a frame late (camera_system runs
+        // before the image's asset event is sent): this frame still renders the camera at the
+        // old size into the new texture, consistently (the plugin sizes everything from the
+        // extracted view).
+        headless::step(&mut app);
+        let lagged = camera_size(&app) != Some(*size);
+        // The next frame is the first at the new size (where Bevy lags; the second otherwise):
+        // the screenshot is of that very frame.
+        let frame = headless::capture(&mut app, &target).expect("a captured frame");
+        assert_eq!(camera_size(&app), Some(*size));
+        assert_eq!((frame.width, frame.height), (size.x, size.y));
+        println!("camera size lagged the resize by a frame: {lagged}");
+        let (bad, at) = mismatches(
+            &frame,
+            [0, 0, size.x, size.y],
+            |x, y| pixel(reference, x, y),
+            TOLERANCE,
+        );
+        println!("resized to {size}: {bad} pixels differ");
+        assert_eq!(
+            bad, 0,
+            "{bad} pixels of the first frame at {size} differ from a frame rendered at that \
+             size from the start: {at:?}"
         );
     }
 }

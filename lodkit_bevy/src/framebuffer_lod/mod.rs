@@ -170,7 +170,8 @@ pub struct FramebufferLodCapabilities {
 /// The effect covers the camera's main-pass viewport and writes nothing outside it: its
 /// `Camera::viewport` (split screen: each camera its own r), or the whole target; with a
 /// `MainPassResolutionOverride` in the render world, the override's size at the viewport's
-/// corner, where Bevy's prepass and main pass drew.
+/// corner, where Bevy's prepass and main pass drew. When the render target (or the viewport)
+/// is resized, the low-resolution targets are reallocated in the same frame.
 #[derive(Component, Clone, Debug, Default, Reflect)]
 #[reflect(Component, Default, Clone)]
 #[require(DepthPrepass, NormalPrepass, Hdr, FramebufferLodState)]
