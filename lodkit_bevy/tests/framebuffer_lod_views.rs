@@ -3,7 +3,8 @@
 //! pixels); cameras with viewports (split screen, each its own r) and a main-pass resolution
 //! override draw their effect inside their viewport only, and what they draw there is what the
 //! same camera draws alone into a target of its viewport's size; after the render target is
-//! resized, the first frame is the frame rendered at that size from the start.
+//! resized, the first frame is the frame rendered at that size from the start; an effect type
+//! that names no shader is reported and draws nothing.
 
 #[path = "../examples/common/frames.rs"]
 #[allow(dead_code, reason = "shared with the examples")]
@@ -533,4 +534,36 @@ fn after_a_resize_the_first_frame_is_the_frame_rendered_at_that_size() {
              size from the start: {at:?}"
         );
     }
+}
+
+/// An effect type that names no shader (`ShaderRef::Default`): a mistake the plugin reports.
+#[derive(Asset, TypePath, AsBindGroup, Clone, Default)]
+struct Shaderless {}
+
+impl FramebufferLodEffect for Shaderless {
+    fn fragment_shader() -> ShaderRef {
+        ShaderRef::Default
+    }
+}
+
+#[test]
+fn an_effect_without_a_shader_logs_an_error_and_draws_nothing() {
+    let mut app = headless::build_app(|app| {
+        app.add_plugins(FramebufferLodEffectPlugin::<Shaderless>::default());
+    });
+    let target = headless::render_target(app.world_mut(), 48, 32);
+    spawn_scene(app.world_mut());
+    let camera = app.world_mut().spawn(lod_camera(&A, target.clone())).id();
+    // The camera without an effect, then with the shaderless one: the same image, no panic.
+    let without = settle_and_capture(&mut app, &target);
+    let effect = app
+        .world_mut()
+        .resource_mut::<Assets<Shaderless>>()
+        .add(Shaderless::default());
+    app.world_mut()
+        .entity_mut(camera)
+        .insert(FramebufferLodEffectHandle(effect));
+    let with = settle_and_capture(&mut app, &target);
+    let (bad, at) = mismatches(&with, [0, 0, 48, 32], |x, y| pixel(&without, x, y), 0);
+    assert_eq!(bad, 0, "the shaderless effect changed {bad} pixels: {at:?}");
 }
