@@ -74,7 +74,8 @@ pub trait FramebufferLodEffect: AsBindGroup + Asset + Clone + Sized {
 /// The effect of a camera with [`FramebufferLod`](super::FramebufferLod) (which it adds): a
 /// handle to an `E` asset, as `MeshMaterial3d` is to a material. One effect per camera; the
 /// camera draws nothing while the asset (or an image it binds) is loading.
-#[derive(Component, Clone, Debug)]
+#[derive(Component, Clone, Debug, Reflect)]
+#[reflect(Component, Default, Clone)]
 #[require(super::FramebufferLod)]
 pub struct FramebufferLodEffectHandle<E: FramebufferLodEffect>(pub Handle<E>);
 
@@ -106,10 +107,12 @@ impl<E: FramebufferLodEffect> Plugin for FramebufferLodEffectPlugin<E> {
         if !app.is_plugin_added::<FramebufferLodPlugin>() {
             app.add_plugins(FramebufferLodPlugin);
         }
-        app.init_asset::<E>().add_plugins((
-            ExtractComponentPlugin::<FramebufferLodEffectHandle<E>>::default(),
-            RenderAssetPlugin::<PreparedEffect<E>, GpuImage>::default(),
-        ));
+        app.init_asset::<E>()
+            .register_type::<FramebufferLodEffectHandle<E>>()
+            .add_plugins((
+                ExtractComponentPlugin::<FramebufferLodEffectHandle<E>>::default(),
+                RenderAssetPlugin::<PreparedEffect<E>, GpuImage>::default(),
+            ));
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
             render_app.add_systems(
                 Render,
