@@ -7,7 +7,8 @@
 //!   materials and post-processing shaders can `import lodkit::screen_door::screen_door_keep;`,
 //!   `import lodkit::bilateral::bilateral_upsample_at;`, and so on.
 //! - [`FramebufferLodPlugin`] with the [`FramebufferLod`] camera component: geometry-aware
-//!   framebuffer LOD (Yang, Sander & Lawrence 2008). Your expensive effect runs at 1/r
+//!   framebuffer LOD (Yang, Sander & Lawrence 2008). Your expensive effect (an asset type with
+//!   its own bindings, like a material: [`framebuffer_lod::FramebufferLodEffect`]) runs at 1/r
 //!   resolution, lodkit's bilateral upsample rebuilds it from the depth and normal prepass
 //!   without bleeding across edges, and lodkit's controller can hold a frame-time target by
 //!   choosing r every frame. See [`framebuffer_lod`].
@@ -50,6 +51,7 @@ pub mod prelude {
     };
     pub use crate::framebuffer_lod::{
         FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodComposite,
+        FramebufferLodEffect, FramebufferLodEffectHandle, FramebufferLodEffectPlugin,
         FramebufferLodFrameTimes, FramebufferLodPlugin, FramebufferLodResolution,
         FramebufferLodState, FramebufferLodSystems, FramebufferLodUpsample, FramerateTarget,
     };

@@ -18,8 +18,23 @@ mod headless;
 
 use std::time::Duration;
 
+use bevy::asset::uuid_handle;
 use bevy::prelude::*;
+use bevy::render::render_resource::AsBindGroup;
+use bevy::shader::ShaderRef;
 use lodkit_bevy::prelude::*;
+
+/// The example's depth probe as the effect: cheap, no bindings of its own.
+const PROBE: Handle<Shader> = uuid_handle!("5f3a9c1e-7b2d-4e8f-a061-c4d2e9b7f813");
+
+#[derive(Asset, TypePath, AsBindGroup, Clone, Default)]
+struct Probe {}
+
+impl FramebufferLodEffect for Probe {
+    fn fragment_shader() -> ShaderRef {
+        PROBE.into()
+    }
+}
 
 /// The model's K (the part r scales) and C (the rest of the frame), in seconds.
 const K: f64 = 0.040;
@@ -90,25 +105,32 @@ fn measure(
 /// Runs the app for every step; returns each frame's (workload, r).
 fn run(seed: u64) -> Vec<(f64, f64)> {
     let mut app = headless::build_app(|app| {
-        app.add_plugins(FramebufferLodPlugin)
+        app.add_plugins(FramebufferLodEffectPlugin::<Probe>::default())
             .insert_resource(Noise(seed))
             .init_resource::<Trace>()
             .add_systems(Last, measure.before(FramebufferLodSystems::Control));
     });
     let image = headless::render_target(app.world_mut(), 64, 48);
+    app.world_mut()
+        .resource_mut::<Assets<Shader>>()
+        .insert(
+            &PROBE,
+            Shader::from_wesl(
+                include_str!("../examples/framebuffer_lod/depth_probe.wesl"),
+                "depth_probe.wesl",
+            ),
+        )
+        .expect("a UUID handle");
     let effect = app
         .world_mut()
-        .resource_mut::<Assets<Shader>>()
-        .add(Shader::from_wesl(
-            include_str!("../examples/framebuffer_lod/depth_probe.wesl"),
-            "depth_probe.wesl",
-        ));
+        .resource_mut::<Assets<Probe>>()
+        .add(Probe::default());
     app.world_mut().spawn((
         Camera3d::default(),
         bevy::camera::RenderTarget::from(image),
         Msaa::Off,
+        FramebufferLodEffectHandle(effect),
         FramebufferLod {
-            effect,
             resolution: FramebufferLodResolution::Adaptive(FramerateTarget {
                 frame_time: Duration::from_secs_f64(target()),
                 max_factor: 4.0,

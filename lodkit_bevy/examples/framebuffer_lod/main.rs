@@ -1,4 +1,4 @@
-//! Framebuffer LOD in Bevy 0.19.1, headless: ray-marched height fog over a field of thin pillars,
+//! Framebuffer LOD in Bevy 0.20.1, headless: ray-marched height fog over a field of thin pillars,
 //! rendered at 1/r resolution and upsampled bilinearly or with lodkit's bilateral filter, then
 //! lodkit's controller holding a frame-time target while the fog's cost doubles and halves.
 //!
@@ -12,7 +12,8 @@
 //! and `figure.png` (reference, bilinear and bilateral at r = 2 above their error maps). With
 //! `--report` also the figures as JSON. Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O.
 //!
-//! The part an application copies is the camera in `spawn_scene` and `fog.wesl`.
+//! The part an application copies is the `Fog` effect type (its bindings: a settings uniform and a
+//! noise texture), the camera in `spawn_scene` and `fog.wesl`.
 
 #[path = "../common/frames.rs"]
 #[allow(
@@ -28,23 +29,88 @@ mod run;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use bevy::asset::uuid_handle;
+use bevy::asset::{RenderAssetUsages, uuid_handle};
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
+use bevy::image::{ImageAddressMode, ImageSampler, ImageSamplerDescriptor};
 use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
+use bevy::render::render_resource::{
+    AsBindGroup, Extent3d, ShaderType, TextureDimension, TextureFormat,
+};
+use bevy::shader::ShaderRef;
 use lodkit_bevy::prelude::*;
 
 /// The fog effect (fog.wesl) and the depth probe (depth_probe.wesl), under fixed handles.
 const FOG: Handle<Shader> = uuid_handle!("3b0e7c1e-5f0a-4d55-9a62-7f1f6c2d8e41");
 const PROBE: Handle<Shader> = uuid_handle!("9d4c2a77-1e3b-4c8f-b0a5-2e6f8d1c3b92");
 
-/// Fog parameters: (march steps, density, height scale in m, noise amount), (sun direction, -).
+/// March steps of the fog in the pictures.
 const FOG_STEPS: f32 = 48.0;
-const FOG_PARAMS: [Vec4; 2] = [
-    Vec4::new(FOG_STEPS, 0.07, 3.0, 0.6),
-    Vec4::new(0.3, 0.25, -1.0, 0.0),
-];
+/// The fog's settings in the pictures.
+const FOG_SETTINGS: FogSettings = FogSettings {
+    sun: Vec3::new(0.3, 0.25, -1.0),
+    steps: FOG_STEPS,
+    density: 0.07,
+    height: 3.0,
+    noise_amount: 0.6,
+    as_factor: 0.0,
+};
+/// Texels of the noise texture a side, and lattice cells of its value noise a side.
+const NOISE_TEXELS: u32 = 64;
+const NOISE_CELLS: u32 = 8;
+
+/// The fog's uniform (`FogSettings` in fog.wesl).
+#[derive(ShaderType, Clone, Copy, Debug)]
+pub struct FogSettings {
+    /// Direction toward the sun (normalized in the shader).
+    sun: Vec3,
+    /// March steps from the camera to the surface.
+    steps: f32,
+    /// Extinction per metre at the ground, before the noise.
+    density: f32,
+    /// Height over which the density falls by e (m).
+    height: f32,
+    /// How much the noise texture modulates the density (0: none, 1: fully).
+    noise_amount: f32,
+    /// 1: return the transmittance as a factor (composited `Modulate`); 0: premultiplied fog.
+    as_factor: f32,
+}
+
+/// The example's expensive effect: ray-marched height fog whose density a tileable noise
+/// texture modulates. Its fields are its bindings (group
+/// `constants::FRAMEBUFFER_LOD_EFFECT_BIND_GROUP` in fog.wesl).
+#[derive(Asset, TypePath, AsBindGroup, Clone, Debug)]
+pub struct Fog {
+    #[uniform(0)]
+    settings: FogSettings,
+    #[texture(1)]
+    #[sampler(2)]
+    noise: Handle<Image>,
+}
+
+impl FramebufferLodEffect for Fog {
+    fn fragment_shader() -> ShaderRef {
+        FOG.into()
+    }
+}
+
+/// The depth probe: no bindings of its own.
+#[derive(Asset, TypePath, AsBindGroup, Clone, Debug, Default)]
+pub struct DepthProbe {}
+
+impl FramebufferLodEffect for DepthProbe {
+    fn fragment_shader() -> ShaderRef {
+        PROBE.into()
+    }
+}
+
+/// The example's effect assets.
+#[derive(Resource, Clone)]
+pub struct Effects {
+    fog: Handle<Fog>,
+    probe: Handle<DepthProbe>,
+}
 const SKY: Color = Color::srgb(0.45, 0.55, 0.72);
 
 /// Command-line options.
@@ -72,10 +138,64 @@ impl Plugin for EffectShadersPlugin {
     }
 }
 
+/// Tileable value noise in [0, 1]: a `NOISE_CELLS`-square lattice of values from a small LCG,
+/// smoothstep-interpolated, wrapping at the edges; sampled with a repeating linear sampler.
+fn noise_image() -> Image {
+    let mut seed = 0x9e37_79b9_u32;
+    let lattice: Vec<f32> = (0..NOISE_CELLS * NOISE_CELLS)
+        .map(|_| {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32
+        })
+        .collect();
+    let at = |x: u32, y: u32| lattice[((y % NOISE_CELLS) * NOISE_CELLS + x % NOISE_CELLS) as usize];
+    let per_cell = NOISE_TEXELS / NOISE_CELLS;
+    let smooth = |t: f32| t * t * (3.0 - 2.0 * t);
+    let texels = (0..NOISE_TEXELS * NOISE_TEXELS)
+        .map(|i| {
+            let (x, y) = (i % NOISE_TEXELS, i / NOISE_TEXELS);
+            let (cx, cy) = (x / per_cell, y / per_cell);
+            let fx = smooth((x % per_cell) as f32 / per_cell as f32);
+            let fy = smooth((y % per_cell) as f32 / per_cell as f32);
+            let top = at(cx, cy) * (1.0 - fx) + at(cx + 1, cy) * fx;
+            let bottom = at(cx, cy + 1) * (1.0 - fx) + at(cx + 1, cy + 1) * fx;
+            ((top * (1.0 - fy) + bottom * fy) * 255.0).round() as u8
+        })
+        .collect();
+    let mut image = Image::new(
+        Extent3d {
+            width: NOISE_TEXELS,
+            height: NOISE_TEXELS,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        texels,
+        TextureFormat::R8Unorm,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    image.sampler = ImageSampler::Descriptor(ImageSamplerDescriptor {
+        address_mode_u: ImageAddressMode::Repeat,
+        address_mode_v: ImageAddressMode::Repeat,
+        ..ImageSamplerDescriptor::linear()
+    });
+    image
+}
+
 /// The scene: a camera with framebuffer LOD rendering into an image, a sun, a ground plane and
 /// thin pillars from 3 m to 50 m away in front of the sky.
 fn spawn_scene(world: &mut World, width: u32, height: u32) -> (Handle<Image>, Entity) {
     let target = headless::render_target(world, width, height);
+    let noise = world.resource_mut::<Assets<Image>>().add(noise_image());
+    let effects = Effects {
+        fog: world.resource_mut::<Assets<Fog>>().add(Fog {
+            settings: FOG_SETTINGS,
+            noise,
+        }),
+        probe: world
+            .resource_mut::<Assets<DepthProbe>>()
+            .add(DepthProbe::default()),
+    };
+    world.insert_resource(effects.clone());
     let camera = world.spawn((
         Camera3d::default(),
         Camera {
@@ -87,11 +207,7 @@ fn spawn_scene(world: &mut World, width: u32, height: u32) -> (Handle<Image>, En
         Tonemapping::AcesFitted,
         DebandDither::Disabled,
         Transform::from_xyz(0.0, 1.6, 6.0).looking_at(Vec3::new(0.0, 1.4, -30.0), Vec3::Y),
-        FramebufferLod {
-            effect: FOG,
-            params: FOG_PARAMS,
-            ..default()
-        },
+        FramebufferLodEffectHandle(effects.fog),
     ));
     let camera = camera.id();
     world.spawn((
@@ -190,7 +306,8 @@ fn main() -> ExitCode {
     };
     let mut app = headless::build_app(|app| {
         app.add_plugins((
-            FramebufferLodPlugin,
+            FramebufferLodEffectPlugin::<Fog>::default(),
+            FramebufferLodEffectPlugin::<DepthProbe>::default(),
             EffectShadersPlugin,
             RenderDiagnosticsPlugin,
         ));

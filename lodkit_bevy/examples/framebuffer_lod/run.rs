@@ -14,7 +14,7 @@ use crate::headless::{capture, save_png, step};
 use crate::measure::{
     edge_mask, error_map, excursion, mean_abs_error, probe_depths, relative_spread, settle_frames,
 };
-use crate::{Args, FOG, FOG_STEPS, PROBE};
+use crate::{Args, DepthProbe, Effects, FOG_STEPS, Fog};
 
 /// A failure with its exit code.
 pub struct Failure(pub u8, pub String);
@@ -52,18 +52,37 @@ fn io(message: String) -> Failure {
     Failure(2, message)
 }
 
-/// Sets the camera's framebuffer LOD and tonemapping.
+/// Which of the example's effects the camera runs.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Effect {
+    Fog,
+    Probe,
+}
+
+/// Sets the camera's effect, framebuffer LOD and tonemapping.
 fn configure(
     app: &mut App,
     camera: Entity,
-    effect: &Handle<Shader>,
+    effect: Effect,
     upsample: FramebufferLodUpsample,
     resolution: FramebufferLodResolution,
     tonemapping: Tonemapping,
 ) {
+    let effects = app.world().resource::<Effects>().clone();
     let mut entity = app.world_mut().entity_mut(camera);
+    match effect {
+        Effect::Fog => {
+            entity
+                .remove::<FramebufferLodEffectHandle<DepthProbe>>()
+                .insert(FramebufferLodEffectHandle(effects.fog));
+        }
+        Effect::Probe => {
+            entity
+                .remove::<FramebufferLodEffectHandle<Fog>>()
+                .insert(FramebufferLodEffectHandle(effects.probe));
+        }
+    }
     if let Some(mut lod) = entity.get_mut::<FramebufferLod>() {
-        lod.effect = effect.clone();
         lod.upsample = upsample;
         lod.resolution = resolution;
     }
@@ -114,7 +133,7 @@ fn fixed_times(app: &mut App, camera: Entity, r: f32, frames: usize) -> Vec<f32>
     configure(
         app,
         camera,
-        &FOG,
+        Effect::Fog,
         FramebufferLodUpsample::default(),
         FramebufferLodResolution::Fixed(r),
         Tonemapping::AcesFitted,
@@ -131,18 +150,25 @@ fn fixed_times(app: &mut App, camera: Entity, r: f32, frames: usize) -> Vec<f32>
         .collect()
 }
 
-/// Sets the composite, and the fog shader's factor switch with it (params[1].w).
-fn set_composite(app: &mut App, camera: Entity, composite: FramebufferLodComposite, factor: f32) {
-    if let Some(mut lod) = app.world_mut().get_mut::<FramebufferLod>(camera) {
-        lod.composite = composite;
-        lod.params[1].w = factor;
+/// Changes the fog asset's settings (its bind group is rebuilt).
+fn set_fog(app: &mut App, change: impl FnOnce(&mut crate::FogSettings)) {
+    let fog = app.world().resource::<Effects>().fog.clone();
+    if let Some(mut fog) = app.world_mut().resource_mut::<Assets<Fog>>().get_mut(&fog) {
+        change(&mut fog.settings);
     }
 }
 
-fn set_workload(app: &mut App, camera: Entity, scale: f32) {
+/// Sets the composite, and the fog's factor switch with it.
+fn set_composite(app: &mut App, camera: Entity, composite: FramebufferLodComposite, factor: f32) {
     if let Some(mut lod) = app.world_mut().get_mut::<FramebufferLod>(camera) {
-        lod.params[0].x = CONTROLLER_STEPS * scale;
+        lod.composite = composite;
     }
+    set_fog(app, |fog| fog.as_factor = factor);
+}
+
+/// Sets the fog's march steps: its cost.
+fn set_workload(app: &mut App, scale: f32) {
+    set_fog(app, |fog| fog.steps = CONTROLLER_STEPS * scale);
 }
 
 pub fn run(
@@ -157,7 +183,14 @@ pub fn run(
     // Depth probe: where the depth discontinuities are.
     let fixed = FramebufferLodResolution::Fixed(1.0);
     let bilateral = FramebufferLodUpsample::default();
-    configure(app, camera, &PROBE, bilateral, fixed, Tonemapping::None);
+    configure(
+        app,
+        camera,
+        Effect::Probe,
+        bilateral,
+        fixed,
+        Tonemapping::None,
+    );
     let probe = settled_capture(app, target)?;
     let depths = probe_depths(&probe);
     let mask = edge_mask(&depths, probe.width, probe.height);
@@ -184,7 +217,14 @@ pub fn run(
         ("bilateral_r3", bilateral, 3.0),
     ] {
         let r = FramebufferLodResolution::Fixed(r);
-        configure(app, camera, &FOG, upsample, r, Tonemapping::AcesFitted);
+        configure(
+            app,
+            camera,
+            Effect::Fog,
+            upsample,
+            r,
+            Tonemapping::AcesFitted,
+        );
         let frame = settled_capture(app, target)?;
         fragments.push(effect_fragments(app));
         save_png(&frame, &path(&format!("{name}.png"))).map_err(io)?;
@@ -203,7 +243,14 @@ pub fn run(
         ("modulate_bilateral_r2", bilateral, 2.0),
     ] {
         let r = FramebufferLodResolution::Fixed(r);
-        configure(app, camera, &FOG, upsample, r, Tonemapping::AcesFitted);
+        configure(
+            app,
+            camera,
+            Effect::Fog,
+            upsample,
+            r,
+            Tonemapping::AcesFitted,
+        );
         let frame = settled_capture(app, target)?;
         save_png(&frame, &path(&format!("{name}.png"))).map_err(io)?;
         factor_frames.push(frame);
@@ -269,7 +316,7 @@ pub fn run(
 
     // The controller: a target for r = START_FACTOR from two calibration runs, then the fog's
     // cost doubled and halved every FRAMES_PER_STEP frames.
-    set_workload(app, camera, 1.0);
+    set_workload(app, 1.0);
     let (times1, times3) = (
         fixed_times(app, camera, 1.0, 9),
         fixed_times(app, camera, MAX_FACTOR, 9),
@@ -305,7 +352,7 @@ pub fn run(
     configure(
         app,
         camera,
-        &FOG,
+        Effect::Fog,
         bilateral,
         adaptive,
         Tonemapping::AcesFitted,
@@ -322,7 +369,7 @@ pub fn run(
             break;
         }
         let scale = if i % 2 == 1 { 2.0 } else { 1.0 };
-        set_workload(app, camera, scale);
+        set_workload(app, scale);
         let mut times = Vec::new();
         let mut stalled = 0;
         for frame in 0..FRAMES_PER_STEP {
@@ -374,7 +421,7 @@ pub fn run(
             disturbed.push(result);
         }
     }
-    set_workload(app, camera, 1.0);
+    set_workload(app, 1.0);
 
     let (r_min, r_max) = factors
         .iter()

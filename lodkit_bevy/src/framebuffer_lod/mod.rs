@@ -6,16 +6,39 @@
 //! does, and the result is composited into the camera's HDR main texture before tonemapping.
 //! lodkit's framerate controller can choose r every frame from the measured frame time.
 //!
+//! The effect is an asset type of yours, as a Bevy material is: its fields are the effect's
+//! bindings (derive `AsBindGroup`: uniforms, textures, samplers), [`FramebufferLodEffect`] names
+//! its fragment shader, [`FramebufferLodEffectPlugin`] prepares it, and the camera holds a
+//! [`FramebufferLodEffectHandle`] to one (which adds [`FramebufferLod`]):
+//!
 //! ```no_run
 //! use bevy::prelude::*;
+//! use bevy::render::render_resource::AsBindGroup;
+//! use bevy::shader::ShaderRef;
 //! use lodkit_bevy::prelude::*;
 //!
-//! fn setup(mut commands: Commands, assets: Res<AssetServer>) {
+//! #[derive(Asset, TypePath, AsBindGroup, Clone)]
+//! struct Fog {
+//!     #[uniform(0)]
+//!     density: f32,
+//!     #[texture(1)]
+//!     #[sampler(2)]
+//!     noise: Handle<Image>,
+//! }
+//!
+//! impl FramebufferLodEffect for Fog {
+//!     fn fragment_shader() -> ShaderRef {
+//!         "shaders/fog.wesl".into()
+//!     }
+//! }
+//!
+//! fn setup(mut commands: Commands, assets: Res<AssetServer>, mut fogs: ResMut<Assets<Fog>>) {
+//!     let fog = fogs.add(Fog { density: 0.05, noise: assets.load("textures/noise.png") });
 //!     commands.spawn((
 //!         Camera3d::default(),
 //!         Msaa::Off, // the prepass is read per pixel
+//!         FramebufferLodEffectHandle(fog),
 //!         FramebufferLod {
-//!             effect: assets.load("shaders/fog.wesl"),
 //!             resolution: FramebufferLodResolution::Adaptive(FramerateTarget::default()),
 //!             ..default()
 //!         },
@@ -23,31 +46,38 @@
 //! }
 //!
 //! App::new()
-//!     .add_plugins((DefaultPlugins, FramebufferLodPlugin))
+//!     .add_plugins((DefaultPlugins, FramebufferLodEffectPlugin::<Fog>::default()))
 //!     .add_systems(Startup, setup)
 //!     .run();
 //! ```
 //!
-//! The effect is a WESL fragment shader run with Bevy's fullscreen vertex shader; it imports
-//! `lodkit_bevy::framebuffer_lod` (the bindings, `effect_sample`, `effect_output`) and may import
-//! any `lodkit::` module:
+//! The shader is a WESL fragment shader run with Bevy's fullscreen vertex shader. It imports
+//! `lodkit_bevy::framebuffer_lod` (group 0: the view, the prepass, `effect_sample`,
+//! `effect_output`), may import any `lodkit::` module, and declares the effect's own bindings in
+//! group [`FRAMEBUFFER_LOD_EFFECT_BIND_GROUP_INDEX`], which WESL spells
+//! `constants::FRAMEBUFFER_LOD_EFFECT_BIND_GROUP` (as materials use `MATERIAL_BIND_GROUP`):
 //!
 //! ```wgsl
 //! import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput;
 //! import lodkit::gbuffer::GBufferOutput;
-//! import lodkit_bevy::framebuffer_lod::{effect_sample, effect_output, effect_param};
+//! import lodkit_bevy::framebuffer_lod::{effect_sample, effect_output};
+//!
+//! @group(constants::FRAMEBUFFER_LOD_EFFECT_BIND_GROUP) @binding(0) var<uniform> density: f32;
+//! @group(constants::FRAMEBUFFER_LOD_EFFECT_BIND_GROUP) @binding(1) var noise: texture_2d<f32>;
+//! @group(constants::FRAMEBUFFER_LOD_EFFECT_BIND_GROUP) @binding(2) var noise_sampler: sampler;
 //!
 //! @fragment
 //! fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
 //!     let s = effect_sample(in.position);
-//!     let density = effect_param(0u).x;
-//!     let transmittance = exp(-density * s.view_depth);
+//!     let n = textureSampleLevel(noise, noise_sampler, s.world_position.xz * 0.1, 0.0).r;
+//!     let transmittance = exp(-density * n * s.view_depth);
 //!     // premultiplied: the fog's light, and how much of the scene it hides
 //!     return effect_output(vec4(vec3(0.6, 0.7, 0.8) * (1.0 - transmittance), 1.0 - transmittance), s);
 //! }
 //! ```
 
 mod controller;
+mod effect;
 mod render;
 mod timer;
 
@@ -61,13 +91,18 @@ use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPl
 use bevy::render::{RenderApp, renderer::RenderDevice};
 
 pub use controller::FramebufferLodState;
+pub use effect::{
+    FRAMEBUFFER_LOD_EFFECT_BIND_GROUP_INDEX, FramebufferLodEffect, FramebufferLodEffectHandle,
+    FramebufferLodEffectPlugin,
+};
 pub use render::{EFFECT_PASS, UPSAMPLE_PASS};
 
 use render::FramebufferLodUniform;
 
 use crate::LodkitShadersPlugin;
 
-/// Adds framebuffer LOD to every camera with a [`FramebufferLod`] component.
+/// Adds framebuffer LOD to every camera with a [`FramebufferLod`] component and an effect
+/// ([`FramebufferLodEffectHandle`]); [`FramebufferLodEffectPlugin`] adds it for you.
 ///
 /// Registers lodkit's shader modules ([`LodkitShadersPlugin`], if not added yet) and the
 /// `lodkit_bevy::framebuffer_lod` module effects import, the render passes (scheduled in
@@ -125,41 +160,28 @@ pub struct FramebufferLodCapabilities {
     pub gpu_timestamps: bool,
 }
 
-/// Framebuffer LOD on a 3D camera: `effect` runs at 1/r resolution and is upsampled with lodkit's
-/// bilateral filter from the camera's depth and normal prepass.
+/// Framebuffer LOD on a 3D camera: its effect (a [`FramebufferLodEffectHandle`] on the same
+/// camera) runs at 1/r resolution and is upsampled with lodkit's bilateral filter from the
+/// camera's depth and normal prepass. Without an effect nothing is drawn.
 ///
 /// Requires (and adds) [`DepthPrepass`], [`NormalPrepass`] and [`Hdr`]; the camera must also
 /// have `Msaa::Off` (the effect pass is skipped with an error otherwise). Only meshes drawn in the
 /// prepass (opaque and alpha-masked, with prepass-enabled materials) give the upsample its edges.
-/// The effect covers the camera's whole render target (a camera `viewport` is not supported).
-#[derive(Component, Clone, Debug, Reflect)]
+/// The effect covers the camera's main-pass viewport and writes nothing outside it: its
+/// `Camera::viewport` (split screen: each camera its own r), or the whole target; with a
+/// `MainPassResolutionOverride` in the render world, the override's size at the viewport's
+/// corner, where Bevy's prepass and main pass drew. When the render target (or the viewport)
+/// is resized, the low-resolution targets are reallocated in the same frame.
+#[derive(Component, Clone, Debug, Default, Reflect)]
 #[reflect(Component, Default, Clone)]
 #[require(DepthPrepass, NormalPrepass, Hdr, FramebufferLodState)]
 pub struct FramebufferLod {
-    /// The effect: a WESL fragment shader (entry point `fragment`) that imports
-    /// `lodkit_bevy::framebuffer_lod` and returns `effect_output(color, effect_sample(..))`.
-    /// Nothing is drawn while it is the default handle or still loading.
-    pub effect: Handle<Shader>,
     /// How the upsampled effect is combined with the scene.
     pub composite: FramebufferLodComposite,
     /// How the low-resolution effect is brought to full resolution.
     pub upsample: FramebufferLodUpsample,
     /// How r is chosen.
     pub resolution: FramebufferLodResolution,
-    /// Eight values the effect reads with `effect_param(0u)` and `effect_param(1u)`.
-    pub params: [Vec4; 2],
-}
-
-impl Default for FramebufferLod {
-    fn default() -> Self {
-        Self {
-            effect: Handle::default(),
-            composite: FramebufferLodComposite::default(),
-            upsample: FramebufferLodUpsample::default(),
-            resolution: FramebufferLodResolution::default(),
-            params: [Vec4::ZERO; 2],
-        }
-    }
 }
 
 /// How the upsampled effect is combined with the camera's image (before tonemapping).

@@ -1,8 +1,12 @@
-//! The render-world side: extraction, the effect and upsample pipelines, the low-resolution
-//! targets (allocated at full size once per camera size, drawn through a viewport that shrinks
-//! with r, so changing r never reallocates), bind groups and the two passes.
+//! The render-world side: extraction, the camera's main-pass viewport (its `Camera::viewport`,
+//! sized by `MainPassResolutionOverride` where the render world has one), the upsample pipeline,
+//! the low-resolution targets (allocated at the viewport's size once per size, drawn through a
+//! viewport that shrinks with r, so changing r never reallocates), bind groups and the two
+//! passes, both held inside the camera's main-pass viewport. The effect's own pipeline
+//! and bind group come from its type's plugin (effect.rs).
 
 use bevy::asset::load_embedded_asset;
+use bevy::camera::MainPassResolutionOverride;
 use bevy::core_pipeline::prepass::ViewPrepassTextures;
 use bevy::core_pipeline::{Core3d, Core3dSystems, FullscreenShader};
 use bevy::ecs::query::QueryItem;
@@ -19,11 +23,12 @@ use bevy::render::view::{ExtractedView, ViewTarget, ViewUniform, ViewUniformOffs
 use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 
 use super::controller::FramebufferLodState;
+use super::effect::{EffectBinding, FRAMEBUFFER_LOD_EFFECT_BIND_GROUP_INDEX};
 use super::timer::{self, GpuFrameTimer};
 use super::{FramebufferLod, FramebufferLodComposite};
 
 /// Format of the low-resolution color and geometry targets (lodkit::gbuffer's geometry layout).
-const LOW_FORMAT: TextureFormat = TextureFormat::Rgba16Float;
+pub(super) const LOW_FORMAT: TextureFormat = TextureFormat::Rgba16Float;
 /// View depth given to the sky: far beyond any scene, inside half-float range.
 const SKY_DEPTH: f32 = 60_000.0;
 /// Name of the effect pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
@@ -36,13 +41,16 @@ pub const UPSAMPLE_PASS: &str = "lodkit_framebuffer_lod_upsample";
 /// What the render world keeps of a camera's [`FramebufferLod`].
 #[derive(Component, Clone, Debug)]
 pub struct ExtractedFramebufferLod {
-    effect: Handle<Shader>,
     composite: FramebufferLodComposite,
     /// r this frame.
     pub(super) factor: f32,
     /// Whether the camera's GPU time is measured (adaptive r on GPU timestamps).
     pub(super) gpu_timed: bool,
+    /// The low-resolution viewport this frame: ceil(main-pass viewport / r).
     low_size: UVec2,
+    /// The camera's main-pass viewport in its render target: top-left corner and size.
+    origin: UVec2,
+    full_size: UVec2,
 }
 
 /// The settings the shaders read (`FramebufferLodSettings` in framebuffer_lod.wesl).
@@ -50,11 +58,11 @@ pub struct ExtractedFramebufferLod {
 pub struct FramebufferLodUniform {
     low_size: Vec2,
     full_size: Vec2,
+    origin: Vec2,
     factor: f32,
     depth_sigma: f32,
     normal_sigma: f32,
     sky_depth: f32,
-    params: [Vec4; 2],
 }
 
 impl SyncComponent<RenderApp> for FramebufferLod {
@@ -91,34 +99,28 @@ impl ExtractComponent<RenderApp> for FramebufferLod {
             );
             return None;
         }
-        if camera.viewport.is_some() {
-            warn_once!(
-                "FramebufferLod covers the camera's whole render target: its viewport is ignored"
-            );
-        }
-        let full = camera.physical_target_size()?;
+        // The sizes are the render world's (prepare_viewports): a MainPassResolutionOverride
+        // lives there.
+        camera.physical_viewport_size()?;
         let factor = state.factor.clamp(1.0, super::MAX_FACTOR);
-        let low = (full.as_vec2() / factor)
-            .ceil()
-            .as_uvec2()
-            .clamp(UVec2::ONE, full.max(UVec2::ONE));
         let (depth_sigma, normal_sigma) = settings.upsample.sigmas();
         Some((
             ExtractedFramebufferLod {
-                effect: settings.effect.clone(),
                 composite: settings.composite,
                 factor,
                 gpu_timed: state.gpu_timed,
-                low_size: low,
+                low_size: UVec2::ONE,
+                origin: UVec2::ZERO,
+                full_size: UVec2::ONE,
             },
             FramebufferLodUniform {
-                low_size: low.as_vec2(),
-                full_size: full.as_vec2(),
+                low_size: Vec2::ONE,
+                full_size: Vec2::ONE,
+                origin: Vec2::ZERO,
                 factor,
                 depth_sigma,
                 normal_sigma,
                 sky_depth: SKY_DEPTH,
-                params: settings.params,
             },
         ))
     }
@@ -129,6 +131,11 @@ pub(super) fn build(render_app: &mut SubApp) {
         Render,
         (
             prepare_pipelines.in_set(RenderSystems::Prepare),
+            // Before the uniform is written and the targets are sized (both in
+            // PrepareResources, a subset of Prepare that is not ordered after Prepare's own).
+            prepare_viewports
+                .in_set(RenderSystems::Prepare)
+                .before(RenderSystems::PrepareResources),
             prepare_textures.in_set(RenderSystems::PrepareResources),
             prepare_bind_groups.in_set(RenderSystems::PrepareBindGroups),
         ),
@@ -148,7 +155,58 @@ pub(super) fn finish(render_app: &mut SubApp) {
         .init_gpu_resource::<SpecializedRenderPipelines<FramebufferLodPipelines>>();
 }
 
-/// Bind group layouts and shaders of the two passes.
+/// The camera's main-pass viewport this frame, from its extracted view (`Camera::viewport`, or
+/// the whole target) and a `MainPassResolutionOverride` (which keeps the viewport's corner and
+/// sets its size, at most the viewport's): where the prepass and main pass drew, so where the
+/// effect reads and the upsample writes. The low-resolution size follows: ceil(size / r).
+fn prepare_viewports(
+    mut views: Query<(
+        &mut ExtractedFramebufferLod,
+        &mut FramebufferLodUniform,
+        &ExtractedView,
+        Option<&MainPassResolutionOverride>,
+    )>,
+) {
+    for (mut extracted, mut uniform, view, resolution_override) in &mut views {
+        let viewport = view.viewport;
+        let size = resolution_override
+            .map_or(viewport.zw(), |o| o.0.min(viewport.zw()))
+            .max(UVec2::ONE);
+        let low = (size.as_vec2() / uniform.factor)
+            .ceil()
+            .as_uvec2()
+            .clamp(UVec2::ONE, size);
+        extracted.origin = viewport.xy();
+        extracted.full_size = size;
+        extracted.low_size = low;
+        uniform.origin = viewport.xy().as_vec2();
+        uniform.full_size = size.as_vec2();
+        uniform.low_size = low.as_vec2();
+    }
+}
+
+/// The bindings `lodkit_bevy::framebuffer_lod` declares in group 0: view, globals, depth and
+/// normal prepass, settings.
+fn common_entries() -> [BindGroupLayoutEntryBuilder; 5] {
+    [
+        uniform_buffer::<ViewUniform>(true),
+        uniform_buffer::<GlobalsUniform>(false),
+        texture_depth_2d(),
+        texture_2d(TextureSampleType::Float { filterable: true }),
+        uniform_buffer::<FramebufferLodUniform>(true),
+    ]
+}
+
+/// Group 0 of the effect pass (the effect's own bindings are group 1).
+pub(super) fn effect_view_layout() -> BindGroupLayoutDescriptor {
+    let [a, b, c, d, e] = common_entries();
+    BindGroupLayoutDescriptor::new(
+        "lodkit_framebuffer_lod_effect",
+        &BindGroupLayoutEntries::sequential(ShaderStages::FRAGMENT, (a, b, c, d, e)),
+    )
+}
+
+/// Bind group layouts and shader of the upsample pass, and the effect pass's group 0.
 #[derive(Resource)]
 pub struct FramebufferLodPipelines {
     effect_layout: BindGroupLayoutDescriptor,
@@ -159,23 +217,16 @@ pub struct FramebufferLodPipelines {
 
 impl FromWorld for FramebufferLodPipelines {
     fn from_world(world: &mut World) -> Self {
-        let common = (
-            uniform_buffer::<ViewUniform>(true),
-            uniform_buffer::<GlobalsUniform>(false),
-            texture_depth_2d(),
-            texture_2d(TextureSampleType::Float { filterable: true }),
-            uniform_buffer::<FramebufferLodUniform>(true),
-        );
-        let effect_layout = BindGroupLayoutDescriptor::new(
-            "lodkit_framebuffer_lod_effect",
-            &BindGroupLayoutEntries::sequential(ShaderStages::FRAGMENT, common),
-        );
+        let common = common_entries();
+        let effect_layout = effect_view_layout();
         let low = texture_2d(TextureSampleType::Float { filterable: false });
         let upsample_layout = BindGroupLayoutDescriptor::new(
             "lodkit_framebuffer_lod_upsample",
             &BindGroupLayoutEntries::sequential(
                 ShaderStages::FRAGMENT,
-                (common.0, common.1, common.2, common.3, common.4, low, low),
+                (
+                    common[0], common[1], common[2], common[3], common[4], low, low,
+                ),
             ),
         );
         Self {
@@ -187,75 +238,48 @@ impl FromWorld for FramebufferLodPipelines {
     }
 }
 
-/// Which of the two pipelines, and what it depends on.
+/// The upsample pipeline: blended with this composite into a main texture of this format.
 #[derive(Clone, PartialEq, Eq, Hash)]
-pub enum PipelineKey {
-    /// The user's effect into the low-resolution targets.
-    Effect(Handle<Shader>),
-    /// The upsample, blended into a main texture of this format.
-    Upsample(FramebufferLodComposite, TextureFormat),
-}
+pub struct PipelineKey(FramebufferLodComposite, TextureFormat);
 
 impl SpecializedRenderPipeline for FramebufferLodPipelines {
     type Key = PipelineKey;
 
     fn specialize(&self, key: Self::Key) -> RenderPipelineDescriptor {
-        let (label, layout, shader, targets) = match key {
-            PipelineKey::Effect(shader) => {
-                let target = ColorTargetState {
-                    format: LOW_FORMAT,
-                    blend: None,
-                    write_mask: ColorWrites::ALL,
-                };
-                (
-                    "lodkit_framebuffer_lod_effect",
-                    self.effect_layout.clone(),
-                    shader,
-                    vec![Some(target.clone()), Some(target)],
-                )
-            }
-            PipelineKey::Upsample(composite, format) => {
-                let keep_alpha = BlendComponent {
-                    src_factor: BlendFactor::Zero,
-                    dst_factor: BlendFactor::One,
-                    operation: BlendOperation::Add,
-                };
-                let color = match composite {
-                    FramebufferLodComposite::Over => BlendComponent {
-                        src_factor: BlendFactor::One,
-                        dst_factor: BlendFactor::OneMinusSrcAlpha,
-                        operation: BlendOperation::Add,
-                    },
-                    FramebufferLodComposite::Modulate => BlendComponent {
-                        src_factor: BlendFactor::Zero,
-                        dst_factor: BlendFactor::Src,
-                        operation: BlendOperation::Add,
-                    },
-                };
-                let target = ColorTargetState {
-                    format,
-                    blend: Some(BlendState {
-                        color,
-                        alpha: keep_alpha,
-                    }),
-                    write_mask: ColorWrites::ALL,
-                };
-                (
-                    "lodkit_framebuffer_lod_upsample",
-                    self.upsample_layout.clone(),
-                    self.upsample_shader.clone(),
-                    vec![Some(target)],
-                )
-            }
+        let PipelineKey(composite, format) = key;
+        let keep_alpha = BlendComponent {
+            src_factor: BlendFactor::Zero,
+            dst_factor: BlendFactor::One,
+            operation: BlendOperation::Add,
+        };
+        let color = match composite {
+            FramebufferLodComposite::Over => BlendComponent {
+                src_factor: BlendFactor::One,
+                dst_factor: BlendFactor::OneMinusSrcAlpha,
+                operation: BlendOperation::Add,
+            },
+            FramebufferLodComposite::Modulate => BlendComponent {
+                src_factor: BlendFactor::Zero,
+                dst_factor: BlendFactor::Src,
+                operation: BlendOperation::Add,
+            },
+        };
+        let target = ColorTargetState {
+            format,
+            blend: Some(BlendState {
+                color,
+                alpha: keep_alpha,
+            }),
+            write_mask: ColorWrites::ALL,
         };
         RenderPipelineDescriptor {
-            label: Some(label.into()),
-            layout: vec![layout],
+            label: Some("lodkit_framebuffer_lod_upsample".into()),
+            layout: vec![self.upsample_layout.clone()],
             vertex: self.fullscreen.to_vertex_state(),
             fragment: Some(FragmentState {
-                shader,
+                shader: self.upsample_shader.clone(),
                 entry_point: Some("fragment".into()),
-                targets,
+                targets: vec![Some(target)],
                 ..default()
             }),
             ..default()
@@ -263,10 +287,9 @@ impl SpecializedRenderPipeline for FramebufferLodPipelines {
     }
 }
 
-/// The camera's two pipelines.
+/// The camera's upsample pipeline (the effect's comes with its [`EffectBinding`]).
 #[derive(Component)]
 pub struct FramebufferLodPipelineIds {
-    effect: CachedRenderPipelineId,
     upsample: CachedRenderPipelineId,
 }
 
@@ -278,19 +301,14 @@ fn prepare_pipelines(
     views: Query<(Entity, &ExtractedFramebufferLod, &ExtractedView)>,
 ) {
     for (entity, extracted, view) in &views {
-        let effect = specialized.specialize(
-            &cache,
-            &pipelines,
-            PipelineKey::Effect(extracted.effect.clone()),
-        );
         let upsample = specialized.specialize(
             &cache,
             &pipelines,
-            PipelineKey::Upsample(extracted.composite, view.target_format),
+            PipelineKey(extracted.composite, view.target_format),
         );
         commands
             .entity(entity)
-            .insert(FramebufferLodPipelineIds { effect, upsample });
+            .insert(FramebufferLodPipelineIds { upsample });
     }
 }
 
@@ -307,12 +325,12 @@ fn prepare_textures(
     device: Res<RenderDevice>,
     views: Query<(
         Entity,
-        &FramebufferLodUniform,
+        &ExtractedFramebufferLod,
         Option<&FramebufferLodTextures>,
     )>,
 ) {
-    for (entity, uniform, textures) in &views {
-        let size = uniform.full_size.as_uvec2();
+    for (entity, extracted, textures) in &views {
+        let size = extracted.full_size;
         if textures.is_some_and(|t| t.size == size) {
             continue;
         }
@@ -410,6 +428,7 @@ type PassView = (
     &'static FramebufferLodTextures,
     &'static FramebufferLodBindGroups,
     &'static FramebufferLodPipelineIds,
+    &'static EffectBinding,
 );
 
 /// The effect at 1/r into the low-resolution targets, then the upsample into the main texture.
@@ -418,10 +437,11 @@ fn framebuffer_lod_pass(
     cache: Res<PipelineCache>,
     mut ctx: RenderContext,
 ) {
-    let (target, view_offset, settings_index, extracted, textures, bind_groups, ids) =
+    let (target, view_offset, settings_index, extracted, textures, bind_groups, ids, effect) =
         view.into_inner();
+    let effect_bind_group = &effect.bind_group;
     let (Some(effect), Some(upsample)) = (
-        cache.get_render_pipeline(ids.effect),
+        cache.get_render_pipeline(effect.pipeline),
         cache.get_render_pipeline(ids.upsample),
     ) else {
         return;
@@ -456,6 +476,11 @@ fn framebuffer_lod_pass(
         pass.set_viewport(0.0, 0.0, low.x, low.y, 0.0, 1.0);
         pass.set_render_pipeline(effect);
         pass.set_bind_group(0, &bind_groups.effect, &offsets);
+        pass.set_bind_group(
+            FRAMEBUFFER_LOD_EFFECT_BIND_GROUP_INDEX,
+            effect_bind_group,
+            &[],
+        );
         pass.draw(0..3, 0..1);
         span.end(&mut pass);
     }
@@ -469,6 +494,9 @@ fn framebuffer_lod_pass(
             multiview_mask: None,
         });
         let span = diagnostics.pass_span(&mut pass, UPSAMPLE_PASS);
+        // Only the camera's main-pass viewport: the fullscreen triangle is clipped to it.
+        let (origin, full) = (extracted.origin.as_vec2(), extracted.full_size.as_vec2());
+        pass.set_viewport(origin.x, origin.y, full.x, full.y, 0.0, 1.0);
         pass.set_render_pipeline(upsample);
         pass.set_bind_group(0, &bind_groups.upsample, &offsets);
         pass.draw(0..3, 0..1);
