@@ -173,7 +173,7 @@ fn steps(trace: &[(f64, f64)]) -> Vec<Step> {
             Step {
                 settle,
                 worst: after.last().copied().unwrap_or(f64::NAN),
-                median: (after[(after.len() - 1) / 2] + after[after.len() / 2]) / 2.0,
+                median: lodkit::metrics::median(&after),
             }
         })
         .collect()

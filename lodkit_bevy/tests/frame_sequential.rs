@@ -206,7 +206,11 @@ fn paper_schedule_on_the_object_shows_no_background() {
     let Some(r) = report(&["--schedule", "paper", "--anchor", "object"]) else {
         return;
     };
-    assert_eq!(num(&r, "see_through_frame_sequential_with_prepass"), 0.0, "{r}");
+    assert_eq!(
+        num(&r, "see_through_frame_sequential_with_prepass"),
+        0.0,
+        "{r}"
+    );
     let holes = num(&r, "see_through_frame_sequential");
     assert!(holes <= 45.0, "see-through without a prepass: {holes} px");
 }

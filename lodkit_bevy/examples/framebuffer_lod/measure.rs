@@ -97,14 +97,18 @@ pub fn error_map(a: &Frame, b: &Frame, gain: u8) -> Frame {
     Frame::new(a.width, a.height, rgba)
 }
 
+/// The median of `values` (`lodkit::metrics::median`, which lodkit's demo uses too).
+pub fn median(values: &[f32]) -> f32 {
+    let v: Vec<f64> = values.iter().map(|&x| f64::from(x)).collect();
+    lodkit::metrics::median(&v) as f32
+}
+
 /// The `window`-frame median of `times` from frame `k` on, over `target` (NaN past the end).
 pub fn median_ratio(times: &[f32], target: f32, window: usize, k: usize) -> f32 {
     let Some(w) = times.get(k..k + window.max(1)) else {
         return f32::NAN;
     };
-    let mut w = w.to_vec();
-    w.sort_by(f32::total_cmp);
-    w[w.len() / 2] / target
+    median(w) / target
 }
 
 /// Frames from a workload step until the frame time is back within `tolerance` (a fraction) of
@@ -134,12 +138,8 @@ pub fn excursion(times: &[f32], target: f32, window: usize) -> f32 {
 /// Relative spread of frame times measured at one r: 1.4826 x the median absolute deviation over
 /// the median (a standard deviation that one stalled frame does not inflate); 0 when empty.
 pub fn relative_spread(times: &[f32]) -> f32 {
-    let median = |v: &mut Vec<f32>| {
-        v.sort_by(f32::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(f32::NAN)
-    };
-    let m = median(&mut times.to_vec());
-    let mut deviations: Vec<f32> = times.iter().map(|t| (t - m).abs()).collect();
-    let spread = 1.4826 * median(&mut deviations) / m;
+    let m = median(times);
+    let deviations: Vec<f32> = times.iter().map(|t| (t - m).abs()).collect();
+    let spread = 1.4826 * median(&deviations) / m;
     if spread.is_finite() { spread } else { 0.0 }
 }

@@ -12,7 +12,8 @@ use serde_json::json;
 use crate::frames::{Frame, strip};
 use crate::headless::{capture, save_png, step};
 use crate::measure::{
-    edge_mask, error_map, excursion, mean_abs_error, probe_depths, relative_spread, settle_frames,
+    edge_mask, error_map, excursion, mean_abs_error, median, probe_depths, relative_spread,
+    settle_frames,
 };
 use crate::{Args, DepthProbe, Effects, FOG_STEPS, Fog};
 
@@ -119,13 +120,6 @@ struct StepResult {
     settle: Option<usize>,
     excursion: f32,
     stalled: usize,
-}
-
-/// Median of `values` (NaN when empty).
-fn median(values: &[f32]) -> f32 {
-    let mut v = values.to_vec();
-    v.sort_by(f32::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f32::NAN)
 }
 
 /// The frame times of `frames` frames at a fixed r (seconds, as measured).

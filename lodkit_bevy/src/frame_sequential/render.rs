@@ -246,7 +246,10 @@ fn prepare_textures(
 #[derive(Component)]
 pub struct CombineBindGroup(BindGroup);
 
-#[allow(clippy::too_many_arguments, reason = "one system's render-world inputs")]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "one system's render-world inputs"
+)]
 fn prepare_bind_groups(
     mut commands: Commands,
     device: Res<RenderDevice>,
