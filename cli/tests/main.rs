@@ -5,6 +5,7 @@
 #[path = "../../integration_tests/support.rs"]
 mod support;
 mod budget;
+mod ci_formats;
 mod cli;
 mod combine_regions;
 mod demo;
