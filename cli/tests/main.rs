@@ -4,6 +4,7 @@
 #[macro_use]
 #[path = "../../integration_tests/support.rs"]
 mod support;
+mod action;
 mod budget;
 mod ci_formats;
 mod cli;
