@@ -7,6 +7,9 @@
 #   LODKIT_DEFS          shader defs, NAME or NAME=VALUE (-D)
 #   LODKIT_BUDGET        a shader-cost budget, .ron or .toml (--budget)
 #   LODKIT_CAPABILITIES  validator capabilities beyond WebGPU's (--capabilities)
+#   LODKIT_PERMUTE       true: check the combinations of the defs each shader tests (--permute)
+#   LODKIT_PERMUTATIONS  a permutation file, .toml or .ron (--permutations)
+#   LODKIT_MAX_SETS      the most sets checked as every combination (--max-sets)
 #   LODKIT_FORMAT        github (default), sarif, json or human (--format)
 #   LODKIT_OUTPUT        a file to write the report into instead of the log
 #   LODKIT_ARGS          further arguments for `lodkit check`
@@ -37,6 +40,9 @@ for dir in "${include[@]}"; do args+=(-I "$dir"); done
 for def in "${defs[@]}"; do args+=(-D "$def"); done
 [ -n "${LODKIT_BUDGET:-}" ] && args+=(--budget "$LODKIT_BUDGET")
 [ -n "${LODKIT_CAPABILITIES:-}" ] && args+=(--capabilities "$LODKIT_CAPABILITIES")
+[ "${LODKIT_PERMUTE:-false}" = true ] && args+=(--permute)
+[ -n "${LODKIT_PERMUTATIONS:-}" ] && args+=(--permutations "$LODKIT_PERMUTATIONS")
+[ -n "${LODKIT_MAX_SETS:-}" ] && args+=(--max-sets "$LODKIT_MAX_SETS")
 args+=("${extra[@]}")
 
 files=()

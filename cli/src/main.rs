@@ -106,6 +106,21 @@ enum Command {
         /// entry or the file's top sets `allow_unbounded_loops: true`.
         #[arg(long, value_name = "FILE")]
         budget: Option<PathBuf>,
+        /// Check each shader under the combinations of the shader defs it and the modules it
+        /// imports test (`#ifdef`, `#if`, `#{NAME}`, `@if`, `constants::NAME`): all of them when
+        /// there are at most --max-sets, else the default, each def alone and every pair.
+        /// `-D` defs are set in every set. Each failure names its set and the shortest set that
+        /// still fails.
+        #[arg(long)]
+        permute: bool,
+        /// A TOML or RON file that declares the def sets of the shaders its globs match
+        /// (`one_of`, `optional`, `values`, `requires`, `excludes`); others are checked as with
+        /// --permute.
+        #[arg(long, value_name = "FILE")]
+        permutations: Option<PathBuf>,
+        /// The most sets that are checked as every combination; past it, pairwise.
+        #[arg(long, value_name = "N", default_value_t = 256)]
+        max_sets: usize,
         /// Shaders to check (.wgsl: naga_oil; .wesl: WESL linked by wesl-rs; .glsl/.vert/.frag/.comp).
         #[arg(required = true)]
         files: Vec<PathBuf>,
@@ -288,12 +303,18 @@ fn main() -> ExitCode {
             format,
             stats,
             budget,
+            permute,
+            permutations,
+            max_sets,
             files,
         } => check::run(&check::CheckRun {
             compose: &compose,
             format,
             stats,
             budget: budget.as_deref(),
+            permute,
+            permutations: permutations.as_deref(),
+            max_sets,
             files: &files,
         }),
         Command::Export {

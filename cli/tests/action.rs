@@ -63,6 +63,9 @@ fn action(dir: &Path, env: &[(&str, &str)]) -> (i32, String, String) {
         "LODKIT_DEFS",
         "LODKIT_BUDGET",
         "LODKIT_CAPABILITIES",
+        "LODKIT_PERMUTE",
+        "LODKIT_PERMUTATIONS",
+        "LODKIT_MAX_SETS",
         "LODKIT_FORMAT",
         "LODKIT_OUTPUT",
         "LODKIT_ARGS",
@@ -98,6 +101,39 @@ fn action_annotates_the_broken_shader_of_a_tree() {
         "{stderr}"
     );
     assert!(stderr.contains("(2 files)"), "{stderr}");
+}
+
+#[test]
+fn action_checks_the_permutation_tree_under_its_declared_sets() {
+    let dir = workspace_root().join("cli/tests/permute_tree");
+    let (code, stdout, stderr) = action(
+        &dir,
+        &[
+            ("LODKIT_PATHS", "shaders/**/*.wgsl"),
+            ("LODKIT_INCLUDE", "modules"),
+            ("LODKIT_PERMUTATIONS", "lodkit-permutations.toml"),
+        ],
+    );
+    assert_eq!(code, 1, "{stderr}");
+    // The three broken shaders, each with the shortest set that breaks it (cli/tests/
+    // permutations.rs derives them); the material and the prepass pass all 27 of theirs.
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 3, "{stdout}");
+    for (line, (file, shortest)) in lines.iter().zip([
+        ("type_mismatch", "{PACKED, TONEMAP}"),
+        ("unsubstituted", "{SHADOWS}"),
+        ("uv_outside_ifdef", "{ALPHA_MASK}"),
+    ]) {
+        assert!(
+            line.starts_with(&format!("::error file=shaders/broken/{file}.wgsl,")),
+            "{line}"
+        );
+        assert!(
+            line.ends_with(&format!("shortest failing set {shortest})")),
+            "{line}"
+        );
+    }
+    assert!(stderr.contains("under 150 shader-def sets"), "{stderr}");
 }
 
 #[test]

@@ -14,5 +14,6 @@ mod docs_figures;
 mod engine_tree;
 mod impostor;
 mod npm_package;
+mod permutations;
 mod pipes;
 mod wesl_check;

@@ -84,6 +84,7 @@ pub struct ShaderLibrary {
     unavailable: Unavailable,
     #[cfg(feature = "wesl")]
     wesl_modules: Vec<super::wesl_link::WeslUserModule>,
+    memo: Option<super::memo::ValidationMemo>,
 }
 
 impl std::fmt::Debug for ShaderLibrary {
@@ -131,7 +132,21 @@ impl ShaderLibrary {
             unavailable: Unavailable::new(),
             #[cfg(feature = "wesl")]
             wesl_modules: Vec::new(),
+            memo: None,
         })
+    }
+
+    /// From now on, validates each distinct composed module once: a composition whose module
+    /// is identical to one validated before (the same IR, hashed) takes that verdict. For a
+    /// check of one shader under many shader-def sets.
+    pub fn remember_validations(&mut self) {
+        self.memo.get_or_insert_with(Default::default);
+    }
+
+    /// Modules validated and validations reused since [`remember_validations`](Self::remember_validations)
+    /// (`None` before it).
+    pub fn validation_counts(&self) -> Option<super::memo::ValidationCounts> {
+        self.memo.as_ref().map(|m| m.counts)
     }
 
     /// The underlying naga_oil composer.
@@ -258,11 +273,13 @@ impl ShaderLibrary {
             ..desc.clone()
         };
         let module = match desc.language {
+            SourceLanguage::Wgsl if self.memo.is_some() => return self.compose_wgsl_once(desc),
             SourceLanguage::Wgsl => self.compose_wgsl(desc)?,
             SourceLanguage::Glsl(stage) => return self.compose_glsl(desc, stage),
             SourceLanguage::Wesl => self.compose_wesl(desc)?,
         };
-        let info = validate_with(&module, self.capabilities, desc.file_path)?;
+        let info = super::memo::validate(self.memo.as_mut(), &module, self.capabilities)
+            .map_err(|e| validation_error(&e, desc.file_path))?;
         Ok(Composed { module, info })
     }
 
@@ -309,6 +326,40 @@ impl ShaderLibrary {
                 let d = from_composer_error(&e, &self.composer, Some(desc.source));
                 ShaderError::Source(Box::new(self.with_import_hint(d)))
             })
+    }
+
+    /// Composes WGSL with naga_oil's own validation off and validates each distinct module
+    /// once ([`remember_validations`](Self::remember_validations)). An invalid module is
+    /// composed again with naga_oil validating, which places the error in the user's source;
+    /// that diagnostic is remembered too.
+    fn compose_wgsl_once(&mut self, desc: &ComposeDescriptor) -> Result<Composed, ShaderError> {
+        self.composer.validate = false;
+        let module = self.compose_wgsl(desc);
+        self.composer.validate = true;
+        let module = module?;
+        let key = super::memo::key(&module);
+        let Some(memo) = self.memo.as_mut() else {
+            return Err(deep_stack_failed(desc.file_path));
+        };
+        let e = match super::memo::validate_keyed(memo, key, &module, self.capabilities) {
+            Ok(info) => return Ok(Composed { module, info }),
+            Err(e) => e,
+        };
+        let located = (key, desc.file_path.to_owned());
+        if let Some(d) = memo.located.get(&located) {
+            return Err(ShaderError::Source(Box::new(d.clone())));
+        }
+        let d = match self.compose_wgsl(desc) {
+            Err(ShaderError::Source(d)) => *d,
+            _ => match validation_error(&e, desc.file_path) {
+                ShaderError::Source(d) => *d,
+                other => return Err(other),
+            },
+        };
+        if let Some(memo) = self.memo.as_mut() {
+            memo.located.insert(located, d.clone());
+        }
+        Err(ShaderError::Source(Box::new(d)))
     }
 
     /// Every `#import` must name a module the composer has, used or not (naga_oil itself only
@@ -429,12 +480,10 @@ impl ShaderLibrary {
         // Within the limits above naga's parser still recurses thousands of levels deep, and the
         // validator recurses once per nested block (a `?:` chain nests as deep): `compose` runs
         // this on a thread with a deep stack. A panic in naga is this file's error.
-        let capabilities = self.capabilities;
+        let (capabilities, memo) = (self.capabilities, &mut self.memo);
         let parse_and_validate = || {
             let module = naga::front::glsl::Frontend::default().parse(&options, text)?;
-            let info =
-                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
-                    .validate(&module);
+            let info = super::memo::validate(memo.as_mut(), &module, capabilities);
             Ok((module, info))
         };
         let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse_and_validate));
@@ -527,14 +576,14 @@ fn validate_with(
     capabilities: naga::valid::Capabilities,
     file: &str,
 ) -> Result<naga::valid::ModuleInfo, ShaderError> {
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
-        .validate(module)
-        .map_err(|e| {
-            ShaderError::Source(Box::new(validation_diagnostic(
-                &e,
-                file.to_owned(),
-                Arc::from(""),
-                |_| 0..0,
-            )))
-        })
+    super::memo::validate(None, module, capabilities).map_err(|e| validation_error(&e, file))
+}
+
+fn validation_error(e: &naga::WithSpan<naga::valid::ValidationError>, file: &str) -> ShaderError {
+    ShaderError::Source(Box::new(validation_diagnostic(
+        e,
+        file.to_owned(),
+        Arc::from(""),
+        |_| 0..0,
+    )))
 }

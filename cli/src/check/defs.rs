@@ -17,8 +17,18 @@ impl DefSet {
         Self(defs)
     }
 
+    /// The defs of `pairs`, sorted by name.
+    pub fn from_pairs(mut pairs: Vec<(String, ShaderDefValue)>) -> Self {
+        pairs.sort_by(|a, b| a.0.cmp(&b.0));
+        Self(pairs)
+    }
+
+    /// The defs, sorted by name.
+    pub fn pairs(&self) -> &[(String, ShaderDefValue)] {
+        &self.0
+    }
+
     /// The defs as the composer takes them.
-    #[allow(dead_code)]
     pub fn to_map(&self) -> HashMap<String, ShaderDefValue> {
         self.0.iter().cloned().collect()
     }

@@ -1,18 +1,25 @@
 //! `lodkit check`: compose each shader against the lodkit modules (and the user's), validate it,
 //! count its cost (`--stats`, `--budget`), and report what failed for people, as JSON, as SARIF
-//! 2.1.0 or as GitHub workflow commands.
+//! 2.1.0 or as GitHub workflow commands. With `--permute` or `--permutations FILE` each shader
+//! is checked under many shader-def sets ([`plan`]), each distinct composed module validated
+//! once, and each failure reduced to the shortest def set that still fails.
 
 mod defs;
+mod discover;
+mod file;
+mod permfile;
+mod plan;
 mod report;
+mod sets;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
 use clap::ValueEnum;
-use lodkit::shaders::{self, Location, ShaderDefValue, ShaderError};
+use lodkit::shaders::{Location, ShaderDefValue, ShaderError};
 
-use crate::compose::{self, Outcome};
+use crate::compose;
 use crate::output::{self, Output};
 use crate::{ComposeArgs, stats};
 
@@ -45,34 +52,51 @@ pub struct Finding {
     pub file: String,
     /// Line and column, when the problem has one.
     pub location: Option<Location>,
-    /// The shader defs the file was composed with.
+    /// The shader defs the file was composed with (the first set that failed).
     pub defs: DefSet,
+    /// In a check of many sets: the sets that fail this way, of the sets checked.
+    pub failing: Option<(usize, usize)>,
+    /// In a check of many sets: the shortest def set that still fails this way.
+    pub shortest: Option<DefSet>,
 }
 
 impl Finding {
     fn from_error(file: &Path, e: &ShaderError, defs: &DefSet) -> Self {
-        match e.diagnostic() {
-            Some(d) => Self {
-                rule: report::rule_of(d.kind),
-                message: match &d.hint {
+        let (rule, message, file, location) = match e.diagnostic() {
+            Some(d) => (
+                report::rule_of(d.kind),
+                match &d.hint {
                     Some(hint) => format!("{} ({hint})", d.message),
                     None => d.message.clone(),
                 },
-                file: d.file.clone(),
-                location: d.location,
-                defs: defs.clone(),
-            },
-            None => Self {
-                rule: match e {
+                d.file.clone(),
+                d.location,
+            ),
+            None => (
+                match e {
                     ShaderError::Io { .. } => "io",
                     _ => "export",
                 },
-                message: e.to_string(),
-                file: file.display().to_string(),
-                location: None,
-                defs: defs.clone(),
-            },
+                e.to_string(),
+                file.display().to_string(),
+                None,
+            ),
+        };
+        Self {
+            rule,
+            message,
+            file,
+            location,
+            defs: defs.clone(),
+            failing: None,
+            shortest: None,
         }
+    }
+
+    /// The same failure: same rule, place and message (under whichever defs).
+    fn same_as(&self, other: &Finding) -> bool {
+        (self.rule, &self.message, &self.file, self.location)
+            == (other.rule, &other.message, &other.file, other.location)
     }
 }
 
@@ -86,19 +110,38 @@ pub struct CheckRun<'a> {
     pub stats: bool,
     /// `--budget FILE`.
     pub budget: Option<&'a Path>,
+    /// `--permute`: check the combinations of the defs each shader tests.
+    pub permute: bool,
+    /// `--permutations FILE`: the sets a permutation file declares.
+    pub permutations: Option<&'a Path>,
+    /// `--max-sets N`.
+    pub max_sets: usize,
     /// The shaders.
     pub files: &'a [PathBuf],
+}
+
+/// What the files of a check came to.
+#[derive(Default)]
+struct Totals {
+    invalid: usize,
+    unreadable: usize,
+    sets: usize,
+    over: Vec<String>,
+    findings: Vec<Finding>,
+    reports: Vec<serde_json::Value>,
 }
 
 /// Runs `lodkit check`: exit 0 all valid and within budget, 1 a shader invalid or over budget,
 /// 2 a file unreadable or a usage error.
 pub fn run(run: &CheckRun) -> ExitCode {
+    let started = Instant::now();
     let (args, format) = (run.compose, run.format);
-    let defs: HashMap<String, ShaderDefValue> = args.define.iter().cloned().collect();
-    let def_set = DefSet::from_map(&defs);
+    let fixed: std::collections::HashMap<String, ShaderDefValue> =
+        args.define.iter().cloned().collect();
+    let def_set = DefSet::from_map(&fixed);
     let mut budget = match run
         .budget
-        .map(|b| stats::Budget::load(b, &defs))
+        .map(|b| stats::Budget::load(b, &fixed))
         .transpose()
     {
         Ok(b) => b,
@@ -107,6 +150,22 @@ pub fn run(run: &CheckRun) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    let file = match run
+        .permutations
+        .map(permfile::PermutationFile::load)
+        .transpose()
+    {
+        Ok(f) => f,
+        Err(e) => {
+            output::eprintln(&format!("error[permutations]: {e}"));
+            return ExitCode::from(2);
+        }
+    };
+    let permute = run.permute || file.is_some();
+    if run.max_sets == 0 {
+        output::eprintln("error: --max-sets must be 1 or more");
+        return ExitCode::from(2);
+    }
     let mut out = Output::default();
     let mut library = match compose::library(args) {
         Ok(l) => l,
@@ -121,65 +180,32 @@ pub fn run(run: &CheckRun) -> ExitCode {
             return out.finish(ExitCode::from(code));
         }
     };
-    let (mut invalid, mut unreadable) = (0, 0);
-    let mut over = Vec::new();
-    let mut findings = Vec::new();
-    let mut reports = Vec::new();
+    if permute {
+        library.remember_validations();
+    }
+    let planner = plan::Planner {
+        fixed,
+        permute,
+        max_sets: run.max_sets,
+        file,
+        sources: if permute {
+            discover::Sources::scan(&args.include, &args.exclude)
+        } else {
+            discover::Sources::scan(&[], &[])
+        },
+    };
+    let mut totals = Totals::default();
+    let mut ctx = file::FileCheck {
+        library: &mut library,
+        planner: &planner,
+        stage: args.stage,
+        format,
+        stats: run.stats,
+        budget: budget.as_mut(),
+        out: &mut out,
+    };
     for path in run.files {
-        let outcome = compose::compose_file(&mut library, args, path);
-        let file = path.display().to_string();
-        match &outcome {
-            Outcome::Valid(c) => {
-                let entry_points: Vec<String> = c
-                    .module
-                    .entry_points
-                    .iter()
-                    .map(|e| e.name.clone())
-                    .collect();
-                if let CheckFormat::Human = format {
-                    out.println(&format!(
-                        "ok: {file} ({} entry point{})",
-                        entry_points.len(),
-                        if entry_points.len() == 1 { "" } else { "s" }
-                    ));
-                }
-                let mut report = serde_json::json!({"file": file, "valid": true, "entry_points": entry_points, "diagnostics": []});
-                if run.stats || budget.is_some() {
-                    let costs = shaders::cost::entry_point_costs(&c.module);
-                    for cost in &costs {
-                        if let Some(b) = budget.as_mut() {
-                            for line in b.check(path, cost) {
-                                findings.push(Finding {
-                                    rule: "budget",
-                                    message: line.clone(),
-                                    file: file.clone(),
-                                    location: None,
-                                    defs: def_set.clone(),
-                                });
-                                over.push(line);
-                            }
-                        }
-                        if run.stats && matches!(format, CheckFormat::Human) {
-                            out.print(&stats::human(cost));
-                        }
-                    }
-                    report["stats"] = costs.iter().map(stats::json).collect();
-                }
-                reports.push(report);
-            }
-            Outcome::Invalid(e) | Outcome::Unreadable(e) => {
-                if matches!(outcome, Outcome::Invalid(_)) {
-                    invalid += 1
-                } else {
-                    unreadable += 1
-                }
-                if let CheckFormat::Human = format {
-                    compose::print_error(e);
-                }
-                findings.push(Finding::from_error(path, e, &def_set));
-                reports.push(serde_json::json!({"file": file, "valid": false, "entry_points": [], "diagnostics": [compose::error_json(path, e)]}));
-            }
-        }
+        ctx.check(path, &mut totals);
     }
     if let Some(b) = &budget {
         for key in b.unused() {
@@ -189,12 +215,40 @@ pub fn run(run: &CheckRun) -> ExitCode {
         }
     }
     let files = run.files.len();
+    let Totals {
+        invalid,
+        unreadable,
+        over,
+        findings,
+        reports,
+        sets,
+    } = totals;
+    let counts = library.validation_counts().unwrap_or_default();
+    let closing = format!(
+        "checked {files} file{} under {sets} shader-def set{}: {} valid, {invalid} invalid, \
+         {unreadable} unreadable{}; {} distinct modules validated, {} reused; {:.2} s",
+        if files == 1 { "" } else { "s" },
+        if sets == 1 { "" } else { "s" },
+        files - invalid - unreadable,
+        if budget.is_some() {
+            format!(", {} over budget", over.len())
+        } else {
+            String::new()
+        },
+        counts.validated,
+        counts.reused,
+        started.elapsed().as_secs_f64()
+    );
     match format {
         CheckFormat::Json => {
             let mut doc = serde_json::json!({"valid": invalid + unreadable == 0, "files": reports});
             if budget.is_some() {
                 doc["within_budget"] = over.is_empty().into();
                 doc["over_budget"] = over.clone().into();
+            }
+            if permute {
+                doc["sets_checked"] = sets.into();
+                doc["modules_validated"] = counts.validated.into();
             }
             out.println(&doc.to_string())
         }
@@ -204,7 +258,9 @@ pub fn run(run: &CheckRun) -> ExitCode {
             for line in &over {
                 output::eprintln(&format!("error[budget]: {line}"));
             }
-            if files > 1 {
+            if permute {
+                output::eprintln(&closing);
+            } else if files > 1 {
                 output::eprintln(&format!(
                     "checked {files} files: {} valid, {invalid} invalid, {unreadable} unreadable{}",
                     files - invalid - unreadable,
@@ -216,6 +272,9 @@ pub fn run(run: &CheckRun) -> ExitCode {
                 ));
             }
         }
+    }
+    if permute && !matches!(format, CheckFormat::Human) {
+        output::eprintln(&closing);
     }
     out.finish(ExitCode::from(if unreadable > 0 {
         2

@@ -84,9 +84,18 @@ pub fn artifact_uri(file: &str) -> String {
     }
 }
 
-/// The text of a finding: the message, then the shader defs it was composed with.
+/// The text of a finding: the message, then the shader defs it was composed with (and, from a
+/// check of many sets, in how many it fails and the shortest set that still fails).
 pub fn message_text(f: &Finding) -> String {
-    format!("{} (shader defs {})", f.message, f.defs)
+    let mut text = format!("{} (shader defs {}", f.message, f.defs);
+    if let Some((failing, of)) = f.failing {
+        text.push_str(&format!("; fails in {failing} of {of} sets"));
+    }
+    if let Some(shortest) = &f.shortest {
+        text.push_str(&format!("; shortest failing set {shortest}"));
+    }
+    text.push(')');
+    text
 }
 
 /// The SARIF 2.1.0 log of `findings`, one result per finding at level `error`.
@@ -151,9 +160,18 @@ fn result(f: &Finding) -> sarif::Result {
     }
     let properties = sarif::PropertyBag::builder()
         .additional_properties(
-            [("shaderDefs".to_owned(), serde_json::json!(f.defs.args()))]
-                .into_iter()
-                .collect::<std::collections::BTreeMap<_, _>>(),
+            [
+                Some(("shaderDefs".to_owned(), serde_json::json!(f.defs.args()))),
+                f.shortest.as_ref().map(|s| {
+                    (
+                        "shortestFailingShaderDefs".to_owned(),
+                        serde_json::json!(s.args()),
+                    )
+                }),
+            ]
+            .into_iter()
+            .flatten()
+            .collect::<std::collections::BTreeMap<_, _>>(),
         )
         .build();
     let mut result = sarif::Result::builder()
