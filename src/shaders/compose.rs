@@ -12,6 +12,8 @@ use super::loading::{Unavailable, add_modules, collect_files, split_duplicates};
 use super::registry::{self, Language, ModuleKind};
 use super::{ShaderError, closest, glsl, read_source};
 
+mod on_demand;
+
 /// Shader defs by name, as naga_oil takes them (`-D NAME=VALUE` on the command line).
 pub type ShaderDefs = HashMap<String, ShaderDefValue>;
 
@@ -59,8 +61,10 @@ pub struct Composed {
     pub info: naga::valid::ModuleInfo,
 }
 
-/// The entry object: a naga_oil [`Composer`] holding every lodkit WGSL module, plus the user's
-/// modules and include folders.
+/// The entry object: a naga_oil [`Composer`] that knows every lodkit WGSL module, plus the
+/// user's modules and include folders. A lodkit module enters the composer when a shader or a
+/// user module first imports it (with the modules it imports), so composing one shader parses
+/// only the modules it uses.
 ///
 /// ```
 /// use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
@@ -109,21 +113,21 @@ pub fn add_to_composer(composer: &mut Composer) -> Result<(), ShaderError> {
 }
 
 impl ShaderLibrary {
-    /// A library with every lodkit module and naga's default capabilities.
+    /// A library of every lodkit module (loaded when first imported) and naga's default
+    /// capabilities.
     pub fn new() -> Result<Self, ShaderError> {
         Self::with_descriptor(&LibraryDescriptor::default())
     }
 
-    /// A library with every lodkit module and the given options.
+    /// A library of every lodkit module (loaded when first imported) and the given options.
     pub fn with_descriptor(desc: &LibraryDescriptor) -> Result<Self, ShaderError> {
         // `with_capabilities` builds a second Composer (naga_oil compiles its regexes again, ~5 ms):
         // only pay for it when the capabilities differ from the default.
-        let mut composer = if desc.capabilities == naga::valid::Capabilities::default() {
+        let composer = if desc.capabilities == naga::valid::Capabilities::default() {
             Composer::default()
         } else {
             Composer::default().with_capabilities(desc.capabilities)
         };
-        add_to_composer(&mut composer)?;
         Ok(Self {
             composer,
             capabilities: desc.capabilities,
@@ -136,20 +140,8 @@ impl ShaderLibrary {
         })
     }
 
-    /// From now on, validates each distinct composed module once: a composition whose module
-    /// is identical to one validated before (the same IR, hashed) takes that verdict. For a
-    /// check of one shader under many shader-def sets.
-    pub fn remember_validations(&mut self) {
-        self.memo.get_or_insert_with(Default::default);
-    }
-
-    /// Modules validated and validations reused since [`remember_validations`](Self::remember_validations)
-    /// (`None` before it).
-    pub fn validation_counts(&self) -> Option<super::memo::ValidationCounts> {
-        self.memo.as_ref().map(|m| m.counts)
-    }
-
-    /// The underlying naga_oil composer.
+    /// The underlying naga_oil composer (lodkit's modules enter it as shaders import them;
+    /// [`add_to_composer`] adds them all).
     pub fn composer(&self) -> &Composer {
         &self.composer
     }
@@ -209,6 +201,7 @@ impl ShaderLibrary {
                 sources.push((file.display().to_string(), Arc::from(text)));
             }
         }
+        self.load_lodkit_for(sources.iter().map(|(_, text)| &**text))?;
         split_duplicates(&mut sources, &mut self.unavailable);
         // naga_oil parses each module: on a deep stack, as `compose` does.
         let (composer, unavailable) = (&mut self.composer, &mut self.unavailable);
@@ -241,6 +234,7 @@ impl ShaderLibrary {
         if let Some(e) = super::limits::wgsl_too_deep(source) {
             return Err(super::limits::limit_error(file_path, source, e));
         }
+        self.load_lodkit_for([source])?;
         let composer = &mut self.composer;
         let sources = vec![(file_path.to_owned(), Arc::from(source))];
         super::limits::on_deep_stack_once(|| add_modules(composer, sources, false, None))
@@ -313,6 +307,7 @@ impl ShaderLibrary {
     }
 
     fn compose_wgsl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
+        self.load_lodkit_for([desc.source])?;
         self.check_imports(desc)?;
         self.composer
             .make_naga_module(NagaModuleDescriptor {
@@ -326,40 +321,6 @@ impl ShaderLibrary {
                 let d = from_composer_error(&e, &self.composer, Some(desc.source));
                 ShaderError::Source(Box::new(self.with_import_hint(d)))
             })
-    }
-
-    /// Composes WGSL with naga_oil's own validation off and validates each distinct module
-    /// once ([`remember_validations`](Self::remember_validations)). An invalid module is
-    /// composed again with naga_oil validating, which places the error in the user's source;
-    /// that diagnostic is remembered too.
-    fn compose_wgsl_once(&mut self, desc: &ComposeDescriptor) -> Result<Composed, ShaderError> {
-        self.composer.validate = false;
-        let module = self.compose_wgsl(desc);
-        self.composer.validate = true;
-        let module = module?;
-        let key = super::memo::key(&module);
-        let Some(memo) = self.memo.as_mut() else {
-            return Err(deep_stack_failed(desc.file_path));
-        };
-        let e = match super::memo::validate_keyed(memo, key, &module, self.capabilities) {
-            Ok(info) => return Ok(Composed { module, info }),
-            Err(e) => e,
-        };
-        let located = (key, desc.file_path.to_owned());
-        if let Some(d) = memo.located.get(&located) {
-            return Err(ShaderError::Source(Box::new(d.clone())));
-        }
-        let d = match self.compose_wgsl(desc) {
-            Err(ShaderError::Source(d)) => *d,
-            _ => match validation_error(&e, desc.file_path) {
-                ShaderError::Source(d) => *d,
-                other => return Err(other),
-            },
-        };
-        if let Some(memo) = self.memo.as_mut() {
-            memo.located.insert(located, d.clone());
-        }
-        Err(ShaderError::Source(Box::new(d)))
     }
 
     /// Every `#import` must name a module the composer has, used or not (naga_oil itself only

@@ -66,11 +66,7 @@ type Pair = (usize, usize, usize, usize);
 
 /// The sets to check, and how they were chosen. `allowed` says whether a set of defs may be
 /// checked (the `requires` and `excludes` of a permutation file).
-pub fn choose(
-    factors: &[Factor],
-    max_sets: usize,
-    allowed: &Allowed,
-) -> (Vec<Row>, Coverage) {
+pub fn choose(factors: &[Factor], max_sets: usize, allowed: &Allowed) -> (Vec<Row>, Coverage) {
     let total = factors
         .iter()
         .fold(1u128, |n, f| n.saturating_mul(f.levels.len() as u128));
