@@ -102,7 +102,7 @@ fn permute_names_the_one_combination_each_bug_needs() {
                 BROKEN[1].into(),
                 7,
                 20,
-                "parse".into(),
+                "preprocessor".into(),
                 v(&["SHADOWS"]),
                 1,
                 2,
@@ -119,6 +119,12 @@ fn permute_names_the_one_combination_each_bug_needs() {
                 v(&["ALPHA_MASK"])
             ),
         ]
+    );
+    // naga sees a stray `#` where the def has no value: the diagnostic says which def.
+    assert_eq!(
+        doc["files"][1]["diagnostics"][0]["message"],
+        "shader def `MAX_CASCADES_PER_LIGHT` has no value here, so `#{MAX_CASCADES_PER_LIGHT}` \
+         is left in the source"
     );
     assert_eq!(doc["sets_checked"], 14);
     assert!(

@@ -44,7 +44,10 @@ impl FileCheck<'_> {
         language: SourceLanguage,
         set: &DefSet,
     ) -> Outcome {
-        compose::compose_source(self.library, path, source, language, set.to_map())
+        match compose::compose_source(self.library, path, source, language, set.to_map()) {
+            Outcome::Invalid(e) => Outcome::Invalid(unsubstituted(e, path, source)),
+            other => other,
+        }
     }
 
     /// Checks `path` under its sets and adds what it found to `totals`.
@@ -249,4 +252,37 @@ impl FileCheck<'_> {
             return DefSet::from_pairs(current);
         }
     }
+}
+
+/// A parse error at a `#{NAME}` the preprocessor left in place (the def has no value in this
+/// set) becomes a `preprocessor` diagnostic that says so; naga only sees a stray `#`.
+fn unsubstituted(e: ShaderError, path: &Path, source: &str) -> ShaderError {
+    let ShaderError::Source(d) = &e else {
+        return e;
+    };
+    let (Some(at), shaders::DiagnosticKind::Parse) = (d.location, d.kind) else {
+        return e;
+    };
+    let text = if d.file == path.display().to_string() {
+        Some(source.to_owned())
+    } else {
+        std::fs::read_to_string(&d.file).ok()
+    };
+    let name = text.as_deref().and_then(|t| {
+        let line = t.lines().nth(at.line.checked_sub(1)?)?;
+        let rest: String = line.chars().skip(at.column.checked_sub(1)?).collect();
+        let inner = rest.strip_prefix("#{")?;
+        Some(inner[..inner.find('}')?].to_owned())
+    });
+    let Some(name) = name else {
+        return e;
+    };
+    let mut d = (**d).clone();
+    d.notes.insert(0, d.message.clone());
+    d.kind = shaders::DiagnosticKind::Preprocessor;
+    d.message =
+        format!("shader def `{name}` has no value here, so `#{{{name}}}` is left in the source");
+    ShaderError::Source(Box::new(d.with_hint(format!(
+        "give it one: -D {name}=VALUE, or `values` in a permutation file"
+    ))))
 }
