@@ -1,6 +1,7 @@
-//! Cost of the shader library on the host: composing every module into a cold naga_oil Composer,
-//! composing one user shader against a warm library, exporting it, and `lodkit check` of one small
-//! shader end to end (process start included).
+//! Cost of the shader library on the host: a library with nothing loaded yet (naga_oil's
+//! Composer), a cold library composing one shader (loading the lodkit modules it imports),
+//! composing one user shader against a warm library, exporting it, and `lodkit check` of one
+//! small shader end to end (process start included).
 //!
 //! `cargo bench -p lodkit-cli --bench compose`
 
@@ -15,12 +16,18 @@ fn compose(library: &mut ShaderLibrary) -> shaders::Composed {
 }
 
 fn benches(c: &mut Criterion) {
-    c.bench_function("library: cold composer + every module + one shader", |b| {
-        b.iter(|| {
-            let mut library = ShaderLibrary::new().expect("library");
-            black_box(compose(&mut library))
-        })
+    c.bench_function("library: new, nothing loaded", |b| {
+        b.iter(|| black_box(ShaderLibrary::new().expect("library")))
     });
+    c.bench_function(
+        "library: cold composer + the modules one shader imports + it",
+        |b| {
+            b.iter(|| {
+                let mut library = ShaderLibrary::new().expect("library");
+                black_box(compose(&mut library))
+            })
+        },
+    );
     let mut library = ShaderLibrary::new().expect("library");
     c.bench_function("compose one shader (warm library)", |b| {
         b.iter(|| black_box(compose(&mut library)))

@@ -58,7 +58,7 @@ pub fn write_wesl(out: &Path, npm: bool) -> ExitCode {
     let files = match files {
         Ok(files) => files,
         Err(e) => {
-            eprintln!("error: a lodkit module has no WESL form: {e}");
+            crate::output::eprintln(&format!("error: a lodkit module has no WESL form: {e}"));
             return ExitCode::from(1);
         }
     };
@@ -69,7 +69,7 @@ pub fn write_wesl(out: &Path, npm: bool) -> ExitCode {
             .map_or(Ok(()), std::fs::create_dir_all)
             .and_then(|()| std::fs::write(&path, text));
         if let Err(e) = written {
-            eprintln!("error: cannot write `{}`: {e}", path.display());
+            crate::output::eprintln(&format!("error: cannot write `{}`: {e}", path.display()));
             return ExitCode::from(2);
         }
     }

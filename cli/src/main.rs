@@ -5,21 +5,20 @@
 //! 2 usage, scene-file or I/O error. A reader that stops early (`lodkit ... | head -1`) changes
 //! none of them: everything printed on stdout goes through `output::Output`.
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod check;
+mod compose;
 mod library;
 mod output;
 mod stats;
 
+use compose::{Outcome, compose_file, print_error};
 use output::Output;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use lodkit::shaders::{
-    self, ComposeDescriptor, ExportOptions, ExportTarget, Exported, ShaderDefValue, ShaderError,
-    ShaderLibrary, SourceLanguage,
-};
+use lodkit::shaders::{self, ExportOptions, ExportTarget, Exported, ShaderDefValue, ShaderError};
 
 #[derive(Parser)]
 #[command(
@@ -96,7 +95,7 @@ enum Command {
         #[command(flatten)]
         compose: ComposeArgs,
         #[arg(long, value_enum, default_value_t)]
-        format: Format,
+        format: check::CheckFormat,
         /// Print what each entry point fetches (texture loads, samples, gathers, storage reads,
         /// per resource) and its ALU ops, counted from the IR for one invocation.
         #[arg(long)]
@@ -107,6 +106,21 @@ enum Command {
         /// entry or the file's top sets `allow_unbounded_loops: true`.
         #[arg(long, value_name = "FILE")]
         budget: Option<PathBuf>,
+        /// Check each shader under the combinations of the shader defs it and the modules it
+        /// imports test (`#ifdef`, `#if`, `#{NAME}`, `@if`, `constants::NAME`): all of them when
+        /// there are at most --max-sets, else the default, each def alone and every pair.
+        /// `-D` defs are set in every set. Each failure names its set and the shortest set that
+        /// still fails.
+        #[arg(long)]
+        permute: bool,
+        /// A TOML or RON file that declares the def sets of the shaders its globs match
+        /// (`one_of`, `optional`, `values`, `requires`, `excludes`); others are checked as with
+        /// --permute.
+        #[arg(long, value_name = "FILE")]
+        permutations: Option<PathBuf>,
+        /// The most sets that are checked as every combination; past it, pairwise.
+        #[arg(long, value_name = "N", default_value_t = 256)]
+        max_sets: usize,
         /// Shaders to check (.wgsl: naga_oil; .wesl: WESL linked by wesl-rs; .glsl/.vert/.frag/.comp).
         #[arg(required = true)]
         files: Vec<PathBuf>,
@@ -229,7 +243,7 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            output::eprintln(&format!("error: {e}"));
             match e {
                 DemoError::Options(_)
                 | DemoError::Scene(_)
@@ -250,7 +264,7 @@ fn adapter() -> ExitCode {
             out.finish(ExitCode::SUCCESS)
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            output::eprintln(&format!("error: {e}"));
             ExitCode::from(1)
         }
     }
@@ -289,8 +303,20 @@ fn main() -> ExitCode {
             format,
             stats,
             budget,
+            permute,
+            permutations,
+            max_sets,
             files,
-        } => check(&compose, format, stats, budget.as_deref(), &files),
+        } => check::run(&check::CheckRun {
+            compose: &compose,
+            format,
+            stats,
+            budget: budget.as_deref(),
+            permute,
+            permutations: permutations.as_deref(),
+            max_sets,
+            files: &files,
+        }),
         Command::Export {
             compose,
             to,
@@ -301,237 +327,6 @@ fn main() -> ExitCode {
     }
 }
 
-/// What happened to one file.
-enum Outcome {
-    Valid(Box<shaders::Composed>),
-    Invalid(ShaderError),
-    Unreadable(ShaderError),
-}
-
-fn library(args: &ComposeArgs) -> Result<ShaderLibrary, ShaderError> {
-    let mut library = ShaderLibrary::with_descriptor(&shaders::LibraryDescriptor {
-        capabilities: args
-            .capabilities
-            .map_or_else(Default::default, |c| c | Default::default()),
-    })?;
-    library.add_import_dirs_excluding(&args.include, &args.exclude)?;
-    Ok(library)
-}
-
-fn language_of(path: &Path, stage: Option<Stage>) -> Result<SourceLanguage, String> {
-    let name = path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or_default();
-    if name.ends_with(".wgsl") {
-        return Ok(SourceLanguage::Wgsl);
-    }
-    if name.ends_with(".wesl") {
-        return Ok(SourceLanguage::Wesl);
-    }
-    let from_name = [
-        (".vert", naga::ShaderStage::Vertex),
-        (".frag", naga::ShaderStage::Fragment),
-        (".comp", naga::ShaderStage::Compute),
-    ]
-    .into_iter()
-    .find(|(ext, _)| name.ends_with(ext) || name.contains(&format!("{ext}.")))
-    .map(|(_, s)| s);
-    let stage = stage.map(|s| match s {
-        Stage::Vertex => naga::ShaderStage::Vertex,
-        Stage::Fragment => naga::ShaderStage::Fragment,
-        Stage::Compute => naga::ShaderStage::Compute,
-    });
-    match stage.or(from_name) {
-        Some(stage) => Ok(SourceLanguage::Glsl(stage)),
-        None if name.ends_with(".glsl") => Err(format!(
-            "{}: a GLSL file needs a stage: pass --stage or name it .vert/.frag/.comp",
-            path.display()
-        )),
-        None => Err(format!(
-            "{}: unknown shader language (expected .wgsl, .wesl, .glsl, .vert, .frag or .comp)",
-            path.display()
-        )),
-    }
-}
-
-fn compose_file(library: &mut ShaderLibrary, args: &ComposeArgs, path: &Path) -> Outcome {
-    let language = match language_of(path, args.stage) {
-        Ok(l) => l,
-        Err(message) => {
-            return Outcome::Unreadable(ShaderError::Io {
-                path: path.to_path_buf(),
-                source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
-            });
-        }
-    };
-    let source = match shaders::read_source(path) {
-        Ok(s) => s,
-        Err(e @ ShaderError::Io { .. }) => return Outcome::Unreadable(e),
-        Err(e) => return Outcome::Invalid(e),
-    };
-    let defs: HashMap<String, ShaderDefValue> = args.define.iter().cloned().collect();
-    let file_path = path.display().to_string();
-    match library.compose(&ComposeDescriptor {
-        source: &source,
-        file_path: &file_path,
-        language,
-        shader_defs: defs,
-    }) {
-        Ok(c) => Outcome::Valid(Box::new(c)),
-        Err(e) => Outcome::Invalid(e),
-    }
-}
-
-fn error_json(file: &Path, e: &ShaderError) -> serde_json::Value {
-    match e.diagnostic() {
-        Some(d) => serde_json::to_value(d).unwrap_or_default(),
-        None => serde_json::json!({
-            "kind": match e { ShaderError::Io { .. } => "io", _ => "export" },
-            "message": e.to_string(),
-            "file": file.display().to_string(),
-            "hint": null,
-            "notes": [],
-        }),
-    }
-}
-
-fn print_error(e: &ShaderError) {
-    match e.diagnostic() {
-        Some(d) => eprint!("{}", d.render()),
-        None => eprintln!("error: {e}"),
-    }
-}
-
-fn check(
-    args: &ComposeArgs,
-    format: Format,
-    stats: bool,
-    budget: Option<&Path>,
-    files: &[PathBuf],
-) -> ExitCode {
-    let defs: HashMap<String, ShaderDefValue> = args.define.iter().cloned().collect();
-    let mut budget = match budget.map(|b| stats::Budget::load(b, &defs)).transpose() {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("error[budget]: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let mut over = Vec::new();
-    let mut out = Output::default();
-    let mut library = match library(args) {
-        Ok(l) => l,
-        Err(e) => {
-            let code = if matches!(e, ShaderError::Io { .. }) {
-                2
-            } else {
-                1
-            };
-            report_setup_error(&mut out, format, &e);
-            return out.finish(ExitCode::from(code));
-        }
-    };
-    let (mut invalid, mut unreadable) = (0, 0);
-    let mut reports = Vec::new();
-    for path in files {
-        let outcome = compose_file(&mut library, args, path);
-        let file = path.display().to_string();
-        match &outcome {
-            Outcome::Valid(c) => {
-                let entry_points: Vec<String> = c
-                    .module
-                    .entry_points
-                    .iter()
-                    .map(|e| e.name.clone())
-                    .collect();
-                if let Format::Human = format {
-                    out.println(&format!(
-                        "ok: {file} ({} entry point{})",
-                        entry_points.len(),
-                        if entry_points.len() == 1 { "" } else { "s" }
-                    ));
-                }
-                let mut report = serde_json::json!({"file": file, "valid": true, "entry_points": entry_points, "diagnostics": []});
-                if stats || budget.is_some() {
-                    let costs = shaders::cost::entry_point_costs(&c.module);
-                    for cost in &costs {
-                        if let Some(b) = budget.as_mut() {
-                            over.extend(b.check(path, cost));
-                        }
-                        if stats && matches!(format, Format::Human) {
-                            out.print(&stats::human(cost));
-                        }
-                    }
-                    report["stats"] = costs.iter().map(stats::json).collect();
-                }
-                reports.push(report);
-            }
-            Outcome::Invalid(e) | Outcome::Unreadable(e) => {
-                if matches!(outcome, Outcome::Invalid(_)) {
-                    invalid += 1
-                } else {
-                    unreadable += 1
-                }
-                if let Format::Human = format {
-                    print_error(e);
-                }
-                reports.push(serde_json::json!({"file": file, "valid": false, "entry_points": [], "diagnostics": [error_json(path, e)]}));
-            }
-        }
-    }
-    if let Some(b) = &budget {
-        for key in b.unused() {
-            eprintln!("warning[budget]: no entry point of the files checked matches \"{key}\"");
-        }
-    }
-    if let Format::Human = format {
-        for line in &over {
-            eprintln!("error[budget]: {line}");
-        }
-    }
-    match format {
-        Format::Json => {
-            let mut doc = serde_json::json!({"valid": invalid + unreadable == 0, "files": reports});
-            if budget.is_some() {
-                doc["within_budget"] = over.is_empty().into();
-                doc["over_budget"] = over.clone().into();
-            }
-            out.println(&doc.to_string())
-        }
-        Format::Human if files.len() > 1 => eprintln!(
-            "checked {} files: {} valid, {} invalid, {} unreadable{}",
-            files.len(),
-            files.len() - invalid - unreadable,
-            invalid,
-            unreadable,
-            if budget.is_some() {
-                format!(", {} over budget", over.len())
-            } else {
-                String::new()
-            }
-        ),
-        Format::Human => {}
-    }
-    out.finish(ExitCode::from(if unreadable > 0 {
-        2
-    } else if invalid > 0 || !over.is_empty() {
-        1
-    } else {
-        0
-    }))
-}
-
-fn report_setup_error(out: &mut Output, format: Format, e: &ShaderError) {
-    match format {
-        Format::Human => print_error(e),
-        Format::Json => out.println(
-            &serde_json::json!({"valid": false, "files": [], "diagnostics": [error_json(Path::new(""), e)]})
-                .to_string(),
-        ),
-    }
-}
-
 fn export(
     args: &ComposeArgs,
     to: Target,
@@ -539,7 +334,7 @@ fn export(
     output: &Path,
     file: &Path,
 ) -> ExitCode {
-    let mut library = match library(args) {
+    let mut library = match compose::library(args) {
         Ok(l) => l,
         Err(e) => {
             print_error(&e);
@@ -590,11 +385,11 @@ fn export(
                 Exported::SpirV(w) => format!("{} SPIR-V words", w.len()),
                 Exported::Text(t) => format!("{} bytes of {target}", t.len()),
             };
-            eprintln!("wrote {} ({what})", output.display());
+            output::eprintln(&format!("wrote {} ({what})", output.display()));
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("error: cannot write `{}`: {e}", output.display());
+            output::eprintln(&format!("error: cannot write `{}`: {e}", output.display()));
             ExitCode::from(2)
         }
     }

@@ -1,7 +1,8 @@
 //! Everything `lodkit` prints on stdout goes through [`Output`]. A reader that stops early
 //! (`lodkit check --stats shaders/*.wgsl | head -1`) is no error: what is left to print is
 //! dropped and the command exits as it would have. Any other failure to write is an I/O error
-//! (exit 2).
+//! (exit 2). Diagnostics on stderr go through [`eprint`], which drops what a closed stderr
+//! cannot take instead of panicking as `eprintln!` does.
 
 use std::io::{ErrorKind, Write as _};
 use std::process::ExitCode;
@@ -44,7 +45,7 @@ impl Output {
     pub fn finish(self, code: ExitCode) -> ExitCode {
         match self.failed {
             Some(e) => {
-                eprintln!("error: cannot write to stdout: {e}");
+                eprint(&format!("error: cannot write to stdout: {e}\n"));
                 ExitCode::from(2)
             }
             None => code,
@@ -57,4 +58,18 @@ pub fn emit(text: &str) -> ExitCode {
     let mut out = Output::default();
     out.print(text);
     out.finish(ExitCode::SUCCESS)
+}
+
+/// Writes `text` to stderr; a stderr that is closed or fails takes nothing, and the command
+/// goes on (its exit code says what happened).
+pub fn eprint(text: &str) {
+    let mut stderr = std::io::stderr().lock();
+    let _ = stderr
+        .write_all(text.as_bytes())
+        .and_then(|()| stderr.flush());
+}
+
+/// Writes `line` and a newline to stderr, as [`eprint`].
+pub fn eprintln(line: &str) {
+    eprint(&format!("{line}\n"));
 }

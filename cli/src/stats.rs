@@ -229,6 +229,11 @@ impl Budget {
         Ok(budget)
     }
 
+    /// The shader defs of the set checked next (a check of many sets changes them per set).
+    pub fn set_defs(&mut self, defs: &HashMap<String, ShaderDefValue>) {
+        self.defs = defs.clone();
+    }
+
     /// Whether every def `entry` names is set so in this run.
     fn holds_defs(&self, entry: &Entry) -> bool {
         entry

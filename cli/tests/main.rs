@@ -4,7 +4,9 @@
 #[macro_use]
 #[path = "../../integration_tests/support.rs"]
 mod support;
+mod action;
 mod budget;
+mod ci_formats;
 mod cli;
 mod combine_regions;
 mod demo;
@@ -12,5 +14,6 @@ mod docs_figures;
 mod engine_tree;
 mod impostor;
 mod npm_package;
+mod permutations;
 mod pipes;
 mod wesl_check;

@@ -12,6 +12,8 @@ use super::loading::{Unavailable, add_modules, collect_files, split_duplicates};
 use super::registry::{self, Language, ModuleKind};
 use super::{ShaderError, closest, glsl, read_source};
 
+mod on_demand;
+
 /// Shader defs by name, as naga_oil takes them (`-D NAME=VALUE` on the command line).
 pub type ShaderDefs = HashMap<String, ShaderDefValue>;
 
@@ -59,8 +61,10 @@ pub struct Composed {
     pub info: naga::valid::ModuleInfo,
 }
 
-/// The entry object: a naga_oil [`Composer`] holding every lodkit WGSL module, plus the user's
-/// modules and include folders.
+/// The entry object: a naga_oil [`Composer`] that knows every lodkit WGSL module, plus the
+/// user's modules and include folders. A lodkit module enters the composer when a shader or a
+/// user module first imports it (with the modules it imports), so composing one shader parses
+/// only the modules it uses.
 ///
 /// ```
 /// use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
@@ -84,6 +88,7 @@ pub struct ShaderLibrary {
     unavailable: Unavailable,
     #[cfg(feature = "wesl")]
     wesl_modules: Vec<super::wesl_link::WeslUserModule>,
+    memo: Option<super::memo::ValidationMemo>,
 }
 
 impl std::fmt::Debug for ShaderLibrary {
@@ -108,21 +113,21 @@ pub fn add_to_composer(composer: &mut Composer) -> Result<(), ShaderError> {
 }
 
 impl ShaderLibrary {
-    /// A library with every lodkit module and naga's default capabilities.
+    /// A library of every lodkit module (loaded when first imported) and naga's default
+    /// capabilities.
     pub fn new() -> Result<Self, ShaderError> {
         Self::with_descriptor(&LibraryDescriptor::default())
     }
 
-    /// A library with every lodkit module and the given options.
+    /// A library of every lodkit module (loaded when first imported) and the given options.
     pub fn with_descriptor(desc: &LibraryDescriptor) -> Result<Self, ShaderError> {
         // `with_capabilities` builds a second Composer (naga_oil compiles its regexes again, ~5 ms):
         // only pay for it when the capabilities differ from the default.
-        let mut composer = if desc.capabilities == naga::valid::Capabilities::default() {
+        let composer = if desc.capabilities == naga::valid::Capabilities::default() {
             Composer::default()
         } else {
             Composer::default().with_capabilities(desc.capabilities)
         };
-        add_to_composer(&mut composer)?;
         Ok(Self {
             composer,
             capabilities: desc.capabilities,
@@ -131,10 +136,12 @@ impl ShaderLibrary {
             unavailable: Unavailable::new(),
             #[cfg(feature = "wesl")]
             wesl_modules: Vec::new(),
+            memo: None,
         })
     }
 
-    /// The underlying naga_oil composer.
+    /// The underlying naga_oil composer (lodkit's modules enter it as shaders import them;
+    /// [`add_to_composer`] adds them all).
     pub fn composer(&self) -> &Composer {
         &self.composer
     }
@@ -194,6 +201,7 @@ impl ShaderLibrary {
                 sources.push((file.display().to_string(), Arc::from(text)));
             }
         }
+        self.load_lodkit_for(sources.iter().map(|(_, text)| &**text))?;
         split_duplicates(&mut sources, &mut self.unavailable);
         // naga_oil parses each module: on a deep stack, as `compose` does.
         let (composer, unavailable) = (&mut self.composer, &mut self.unavailable);
@@ -226,6 +234,7 @@ impl ShaderLibrary {
         if let Some(e) = super::limits::wgsl_too_deep(source) {
             return Err(super::limits::limit_error(file_path, source, e));
         }
+        self.load_lodkit_for([source])?;
         let composer = &mut self.composer;
         let sources = vec![(file_path.to_owned(), Arc::from(source))];
         super::limits::on_deep_stack_once(|| add_modules(composer, sources, false, None))
@@ -258,11 +267,13 @@ impl ShaderLibrary {
             ..desc.clone()
         };
         let module = match desc.language {
+            SourceLanguage::Wgsl if self.memo.is_some() => return self.compose_wgsl_once(desc),
             SourceLanguage::Wgsl => self.compose_wgsl(desc)?,
             SourceLanguage::Glsl(stage) => return self.compose_glsl(desc, stage),
             SourceLanguage::Wesl => self.compose_wesl(desc)?,
         };
-        let info = validate_with(&module, self.capabilities, desc.file_path)?;
+        let info = super::memo::validate(self.memo.as_mut(), &module, self.capabilities)
+            .map_err(|e| validation_error(&e, desc.file_path))?;
         Ok(Composed { module, info })
     }
 
@@ -296,6 +307,7 @@ impl ShaderLibrary {
     }
 
     fn compose_wgsl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
+        self.load_lodkit_for([desc.source])?;
         self.check_imports(desc)?;
         self.composer
             .make_naga_module(NagaModuleDescriptor {
@@ -429,12 +441,10 @@ impl ShaderLibrary {
         // Within the limits above naga's parser still recurses thousands of levels deep, and the
         // validator recurses once per nested block (a `?:` chain nests as deep): `compose` runs
         // this on a thread with a deep stack. A panic in naga is this file's error.
-        let capabilities = self.capabilities;
+        let (capabilities, memo) = (self.capabilities, &mut self.memo);
         let parse_and_validate = || {
             let module = naga::front::glsl::Frontend::default().parse(&options, text)?;
-            let info =
-                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
-                    .validate(&module);
+            let info = super::memo::validate(memo.as_mut(), &module, capabilities);
             Ok((module, info))
         };
         let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse_and_validate));
@@ -527,14 +537,14 @@ fn validate_with(
     capabilities: naga::valid::Capabilities,
     file: &str,
 ) -> Result<naga::valid::ModuleInfo, ShaderError> {
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
-        .validate(module)
-        .map_err(|e| {
-            ShaderError::Source(Box::new(validation_diagnostic(
-                &e,
-                file.to_owned(),
-                Arc::from(""),
-                |_| 0..0,
-            )))
-        })
+    super::memo::validate(None, module, capabilities).map_err(|e| validation_error(&e, file))
+}
+
+fn validation_error(e: &naga::WithSpan<naga::valid::ValidationError>, file: &str) -> ShaderError {
+    ShaderError::Source(Box::new(validation_diagnostic(
+        e,
+        file.to_owned(),
+        Arc::from(""),
+        |_| 0..0,
+    )))
 }

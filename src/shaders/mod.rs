@@ -34,6 +34,8 @@ mod limits;
 mod loading;
 #[cfg(feature = "compose")]
 mod macros;
+#[cfg(feature = "compose")]
+mod memo;
 mod registry;
 mod wesl;
 #[cfg(feature = "wesl")]
@@ -57,6 +59,8 @@ pub use diagnostic::{Diagnostic, DiagnosticKind, Location};
 pub use export::{ExportOptions, ExportTarget, Exported, export};
 #[cfg(feature = "compose")]
 pub use limits::{MAX_EXPANDED_TOKENS, MAX_EXPRESSION_DEPTH, MAX_MACRO_CALL_NESTING, MAX_NESTING};
+#[cfg(feature = "compose")]
+pub use memo::ValidationCounts;
 #[cfg(feature = "compose")]
 pub use naga;
 #[cfg(feature = "compose")]
