@@ -268,3 +268,151 @@ fn select_sphere_visible_matches_rust_twin() {
         "GLSL lodkit_select_sphere_visible"
     );
 }
+
+/// The Rust mirrors of the selection pass's structs have the WGSL sizes and member offsets
+/// (naga's layouter on the composed pass).
+#[test]
+fn rust_mirrors_match_the_select_pass_layout() {
+    use lodkit::gpu::select::{GpuLodGroup, GpuLodInstance, GpuSelectCamera, GpuSelectEntry};
+    use std::mem::{offset_of, size_of};
+    let composed = lodkit::shaders::compose_pass("select", &[]).unwrap();
+    let module = &composed.module;
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    /// (WGSL struct, Rust size, (member, Rust offset)).
+    type Mirror = (&'static str, usize, Vec<(&'static str, usize)>);
+    let mirrors: [Mirror; 4] = [
+        (
+            "SelectInstance",
+            size_of::<GpuLodInstance>(),
+            vec![
+                ("radius", offset_of!(GpuLodInstance, radius)),
+                ("max_scale", offset_of!(GpuLodInstance, max_scale)),
+                ("group", offset_of!(GpuLodInstance, group)),
+            ],
+        ),
+        (
+            "SelectCamera",
+            size_of::<GpuSelectCamera>(),
+            vec![
+                ("position", offset_of!(GpuSelectCamera, position)),
+                ("factor", offset_of!(GpuSelectCamera, factor)),
+                ("step", offset_of!(GpuSelectCamera, step)),
+                ("cull", offset_of!(GpuSelectCamera, cull)),
+            ],
+        ),
+        (
+            "SelectEntry",
+            size_of::<GpuSelectEntry>(),
+            vec![("alpha", offset_of!(GpuSelectEntry, alpha))],
+        ),
+        (
+            // naga_oil decorates names imported from a module.
+            "SelectGroup",
+            size_of::<GpuLodGroup>(),
+            vec![
+                ("level_count", offset_of!(GpuLodGroup, level_count)),
+                ("hysteresis", offset_of!(GpuLodGroup, hysteresis)),
+                ("first_slot", offset_of!(GpuLodGroup, first_slot)),
+            ],
+        ),
+    ];
+    for (name, size, members) in mirrors {
+        let (handle, ty) = module
+            .types
+            .iter()
+            .find(|(_, t)| {
+                t.name
+                    .as_deref()
+                    .is_some_and(|n| n == name || n.starts_with(&format!("{name}X_naga_oil")))
+            })
+            .unwrap_or_else(|| panic!("no struct {name} in passes/select.wgsl"));
+        assert_eq!(layouter[handle].size as usize, size, "size of {name}");
+        let naga::TypeInner::Struct { members: wgsl, .. } = &ty.inner else {
+            panic!("{name} is not a struct");
+        };
+        for (member, offset) in members {
+            let m = wgsl
+                .iter()
+                .find(|m| m.name.as_deref() == Some(member))
+                .unwrap_or_else(|| panic!("{name} has no member {member}"));
+            assert_eq!(m.offset as usize, offset, "{name}.{member}");
+        }
+    }
+}
+
+/// Bad input to the selector is a typed error naming the parameter, never a panic.
+#[test]
+fn selector_rejects_bad_groups_meshes_and_views() {
+    use lodkit::gpu::GpuError;
+    use lodkit::gpu::select::{
+        GpuLodSelector, GpuLodSelectorDescriptor, GpuSelectFrame, LevelMesh,
+    };
+    let gpu = lodkit_test_gpu!();
+    let nine = LodGroup::from_distances(&[0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]).unwrap();
+    let two = LodGroup::from_distances(&[0.0, 10.0]).unwrap();
+    let desc = |groups, meshes| GpuLodSelectorDescriptor {
+        groups,
+        settings: LodSettings::default(),
+        meshes,
+    };
+    let err = GpuLodSelector::new(gpu, &desc(std::slice::from_ref(&nine), &[])).err();
+    assert!(
+        matches!(err, Some(GpuError::Invalid { parameter: "groups", ref value, .. }) if value.contains("9 levels")),
+        "{err:?}"
+    );
+    let three = [LevelMesh::default(); 3];
+    let meshes: [&[LevelMesh]; 1] = [&three];
+    let err = GpuLodSelector::new(gpu, &desc(std::slice::from_ref(&two), &meshes)).err();
+    assert!(
+        matches!(
+            err,
+            Some(GpuError::Mismatch {
+                parameter: "meshes",
+                ..
+            })
+        ),
+        "{err:?}"
+    );
+    let bad = LodSettings {
+        hysteresis: -1.0,
+        ..Default::default()
+    };
+    let err = GpuLodSelector::new(
+        gpu,
+        &GpuLodSelectorDescriptor {
+            settings: bad,
+            ..desc(std::slice::from_ref(&two), &[])
+        },
+    )
+    .err();
+    assert!(
+        matches!(
+            err,
+            Some(GpuError::Invalid {
+                parameter: "settings",
+                ..
+            })
+        ),
+        "{err:?}"
+    );
+    let mut a = GpuLodSelector::new(gpu, &desc(std::slice::from_ref(&two), &[])).unwrap();
+    let mut b = GpuLodSelector::new(gpu, &desc(std::slice::from_ref(&two), &[])).unwrap();
+    b.add_view(gpu).unwrap();
+    let foreign = b.add_view(gpu).unwrap();
+    a.add_view(gpu).unwrap();
+    let proj = glam::camera::rh::proj::directx::perspective(1.0, 1.0, 0.1, 10.0);
+    let frame = GpuSelectFrame::new(lodkit::select::LodCamera::new(glam::Vec3::ZERO, proj));
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let err = a.record(gpu, &mut encoder, foreign, &frame).err();
+    assert!(
+        matches!(
+            err,
+            Some(GpuError::Mismatch {
+                parameter: "view",
+                ..
+            })
+        ),
+        "{err:?}"
+    );
+}
