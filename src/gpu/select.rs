@@ -5,10 +5,11 @@
 //!
 //! Buffers are sized when instances are set and grow (to the next power of two) when more come;
 //! the group table is fixed at creation. Each (group, level) list starts at an offset aligned to
-//! `min_storage_buffer_offset_alignment`, so a draw binds its list with a dynamic offset and
-//! leaves `first_instance` at 0: one `draw_indexed_indirect` per list, which works on every
-//! backend with indirect execution, OpenGL included (no `MULTI_DRAW_INDIRECT` or
-//! `INDIRECT_FIRST_INSTANCE` needed).
+//! `min_storage_buffer_offset_alignment`, so a draw binds its list at that offset (its own bind
+//! group, or a dynamic offset) and leaves `first_instance` at 0: one `draw_indexed_indirect` per
+//! list, which works on every backend with indirect execution, OpenGL included (no
+//! `MULTI_DRAW_INDIRECT` or `INDIRECT_FIRST_INSTANCE` needed). `examples/gpu_select.rs` draws
+//! 102,400 instances this way.
 //!
 //! ```no_run
 //! # use lodkit::gpu::{GpuContext, GpuOptions};
