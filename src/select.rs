@@ -13,7 +13,8 @@ mod group;
 pub use batch::{InstanceBatch, select_batch};
 pub use gpu_rule::{
     SELECT_DISTANCE_INFINITE, SELECT_DISTANCE_ORTHOGRAPHIC, SELECT_DISTANCE_PERSPECTIVE,
-    SELECT_DISTANCE_ZERO, SELECT_MAX_LEVELS, SelectGroupData, distance_kind, frustum_planes,
+    SELECT_DISTANCE_ZERO, SELECT_FAR, SELECT_MAX_LEVELS, SelectGroupData, distance_kind,
+    frustum_planes,
 };
 pub use group::{LodGroup, LodLevel, LodSelection, LodSettings, LodState, TransitionMode};
 
@@ -209,7 +210,7 @@ pub fn select_distance(
 ) -> f32 {
     match kind {
         SELECT_DISTANCE_ZERO => 0.0,
-        SELECT_DISTANCE_INFINITE => f32::INFINITY,
+        SELECT_DISTANCE_INFINITE => SELECT_FAR,
         SELECT_DISTANCE_ORTHOGRAPHIC => factor / max_scale.abs(),
         _ => center.distance(camera_position) * factor / max_scale.abs(),
     }

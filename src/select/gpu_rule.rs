@@ -14,8 +14,12 @@ pub const SELECT_DISTANCE_ZERO: u32 = 0;
 pub const SELECT_DISTANCE_PERSPECTIVE: u32 = 1;
 /// `select_distance` kind: orthographic camera, factor / scale.
 pub const SELECT_DISTANCE_ORTHOGRAPHIC: u32 = 2;
-/// `select_distance` kind: an infinite bias, every distance is +inf (the last level).
+/// `select_distance` kind: an infinite bias, every distance is [`SELECT_FAR`] (the last level).
 pub const SELECT_DISTANCE_INFINITE: u32 = 3;
+/// The GPU rule's +inf, 1e38 (WGSL has no infinite constant): a NaN distance and an infinite
+/// bias select as this, which gives the levels +inf gives; a max distance above it counts as
+/// none on the GPU.
+pub const SELECT_FAR: f32 = 1e38;
 
 /// The `select_distance` kind and factor (camera bias x global bias / |P\[1\]\[1\]|) of a camera
 /// under `settings`: the same distance [`select_batch`](super::select_batch) computes.

@@ -7,7 +7,8 @@
 //
 // Exports:
 //   LODKIT_SELECT_MAX_LEVELS, LODKIT_SELECT_NONE, LODKIT_SELECT_HARD / _DISTANCE / _TIME,
-//   LODKIT_SELECT_STATE_NEW, LODKIT_SELECT_DISTANCE_ZERO / _PERSPECTIVE / _ORTHOGRAPHIC / _INFINITE
+//   LODKIT_SELECT_STATE_NEW, LODKIT_SELECT_DISTANCE_ZERO / _PERSPECTIVE / _ORTHOGRAPHIC / _INFINITE,
+//   LODKIT_SELECT_FAR
 //   LodkitSelectGroup, LodkitSelectState, LodkitSelection, LodkitSelectOutcome   (the WGSL structs)
 //   lodkit_select_distance(center, camera_position, factor, max_scale, kind) -> float
 //   lodkit_select_level(distance, group, mode, step, state) -> LodkitSelectOutcome
@@ -34,6 +35,8 @@ const uint LODKIT_SELECT_DISTANCE_ZERO = 0u;
 const uint LODKIT_SELECT_DISTANCE_PERSPECTIVE = 1u;
 const uint LODKIT_SELECT_DISTANCE_ORTHOGRAPHIC = 2u;
 const uint LODKIT_SELECT_DISTANCE_INFINITE = 3u;
+/// 1e38, the rule's +inf (SELECT_FAR of the WGSL module).
+const float LODKIT_SELECT_FAR = 1e38;
 
 /// One LOD group (std430 layout as SelectGroup: 160 bytes).
 struct LodkitSelectGroup {
@@ -75,7 +78,7 @@ float lodkit_select_distance(vec3 center, vec3 camera_position, float factor, fl
         return 0.0;
     }
     if (kind == LODKIT_SELECT_DISTANCE_INFINITE) {
-        return uintBitsToFloat(0x7f800000u);
+        return LODKIT_SELECT_FAR;
     }
     if (kind == LODKIT_SELECT_DISTANCE_ORTHOGRAPHIC) {
         return factor / abs(max_scale);
@@ -87,25 +90,24 @@ float lodkit_select_distance(vec3 center, vec3 camera_position, float factor, fl
 
 /// The selection rule (LodGroup::select): the selection and the state to store.
 LodkitSelectOutcome lodkit_select_level(float distance, LodkitSelectGroup group, uint mode, float step, LodkitSelectState state) {
-    float inf = uintBitsToFloat(0x7f800000u);
-    // NaN counts as +inf (found from its bits), negative as 0.
+    // NaN counts as LODKIT_SELECT_FAR (found from its bits), negative as 0.
     float d = max(distance, 0.0);
     if ((floatBitsToUint(distance) & 0x7fffffffu) > 0x7f800000u) {
-        d = inf;
+        d = LODKIT_SELECT_FAR;
     }
     uint n = min(group.level_count, LODKIT_SELECT_MAX_LEVELS);
-    if (group.max_distance < inf && d >= group.max_distance) {
+    if (group.max_distance <= LODKIT_SELECT_FAR && d >= group.max_distance) {
         return LodkitSelectOutcome(LodkitSelection(n - 1u, LODKIT_SELECT_NONE, 0.0, 0.0, false), LodkitSelectState(LODKIT_SELECT_STATE_NEW, 0.0));
     }
     uint level = state.packed & 0xffu;
     uint target_level = (state.packed >> 8u) & 0xffu;
     float progress = state.progress;
     if (level < n && target_level == level && d < group.fade_from) {
-        vec2 above = vec2(inf, inf);
+        vec2 above = vec2(LODKIT_SELECT_FAR, LODKIT_SELECT_FAR);
         if (level + 1u < n) {
             above = group.levels[level + 1u].yz;
         }
-        vec2 below = vec2(-inf, -inf);
+        vec2 below = vec2(-LODKIT_SELECT_FAR, -LODKIT_SELECT_FAR);
         if (level > 0u) {
             below = group.levels[level].yz;
         }

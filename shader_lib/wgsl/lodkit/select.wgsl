@@ -14,6 +14,7 @@
 //   SELECT_NONE: u32   `next` of a selection without a transition
 //   SELECT_HARD, SELECT_DISTANCE, SELECT_TIME: u32   transition modes
 //   SELECT_STATE_NEW: u32   packed word of a state with no history
+//   SELECT_FAR: f32   1e38, the rule's +inf
 //   SelectGroup   levels (x distance, y/z hysteresis band below the level), count, max distance
 //   SelectState   packed level | target << 8 | phase << 16 | blending << 17, and progress
 //   Selection     current, next, transition, fade, visible (LodSelection)
@@ -50,8 +51,12 @@ const SELECT_DISTANCE_ZERO: u32 = 0u;
 const SELECT_DISTANCE_PERSPECTIVE: u32 = 1u;
 /// `select_distance` kind: orthographic camera, factor / scale whatever the distance.
 const SELECT_DISTANCE_ORTHOGRAPHIC: u32 = 2u;
-/// `select_distance` kind: an infinite bias, every distance is +inf (the last level).
+/// `select_distance` kind: an infinite bias, every distance is SELECT_FAR (the last level).
 const SELECT_DISTANCE_INFINITE: u32 = 3u;
+/// What the rule uses for +inf, 1e38 (WGSL has no infinite constant): a NaN distance and an
+/// infinite bias select as this, which gives the levels +inf gives; a max distance above it
+/// counts as none.
+const SELECT_FAR: f32 = 1e38;
 
 /// One LOD group as the GPU selects it (160 bytes; Rust mirror lodkit::gpu::select::GpuLodGroup).
 struct SelectGroup {
@@ -113,7 +118,7 @@ fn select_distance(center: vec3<f32>, camera_position: vec3<f32>, factor: f32, m
         return 0.0;
     }
     if (kind == SELECT_DISTANCE_INFINITE) {
-        return bitcast<f32>(0x7f800000u);
+        return SELECT_FAR;
     }
     if (kind == SELECT_DISTANCE_ORTHOGRAPHIC) {
         return factor / abs(max_scale);
@@ -129,14 +134,15 @@ fn select_distance(center: vec3<f32>, camera_position: vec3<f32>, factor: f32, m
 /// dt / duration for time-driven transitions (0 when dt is not positive). The same rule, float
 /// for float, as LodGroup::select.
 fn select_level(distance: f32, group: SelectGroup, mode: u32, step: f32, state: SelectState) -> SelectOutcome {
-    let inf = bitcast<f32>(0x7f800000u);
-    // NaN counts as +inf (found from its bits: compilers may fold `d != d`), negative as 0.
+    // NaN counts as SELECT_FAR (found from its bits: compilers may fold `d != d`), negative
+    // as 0.
     var d = max(distance, 0.0);
     if ((bitcast<u32>(distance) & 0x7fffffffu) > 0x7f800000u) {
-        d = inf;
+        d = SELECT_FAR;
     }
     let n = min(group.level_count, SELECT_MAX_LEVELS);
-    if (group.max_distance < inf && d >= group.max_distance) {
+    // A max distance above SELECT_FAR is +inf: none.
+    if (group.max_distance <= SELECT_FAR && d >= group.max_distance) {
         return SelectOutcome(Selection(n - 1u, SELECT_NONE, 0.0, 0.0, false), SelectState(SELECT_STATE_NEW, 0.0));
     }
     var level = state.packed & 0xffu;
@@ -144,11 +150,11 @@ fn select_level(distance: f32, group: SelectGroup, mode: u32, step: f32, state: 
     var progress = state.progress;
     // Fast path: settled on a level and outside every band around it.
     if (level < n && target_level == level && d < group.fade_from) {
-        var above = vec2<f32>(inf, inf);
+        var above = vec2<f32>(SELECT_FAR, SELECT_FAR);
         if (level + 1u < n) {
             above = group.levels[level + 1u].yz;
         }
-        var below = vec2<f32>(-inf, -inf);
+        var below = vec2<f32>(-SELECT_FAR, -SELECT_FAR);
         if (level > 0u) {
             below = group.levels[level].yz;
         }
