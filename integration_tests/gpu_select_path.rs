@@ -297,3 +297,78 @@ fn gpu_selection_equals_select_batch_along_a_camera_path() {
         );
     }
 }
+
+/// Setting more instances grows the buffers and starts every view over: after a small set, a
+/// set 36 times larger (with instances of a group past the table, which select nothing) selects
+/// as `select_batch` does from fresh states.
+#[test]
+fn selector_grows_and_starts_over() {
+    let gpu = lodkit_test_gpu!();
+    let groups = groups();
+    let settings = LodSettings {
+        hysteresis: 4.0,
+        transition: TransitionMode::Time { seconds: 0.4 },
+        ..Default::default()
+    };
+    let mut selector = GpuLodSelector::new(
+        gpu,
+        &GpuLodSelectorDescriptor {
+            groups: &groups,
+            settings,
+            meshes: &[],
+        },
+    )
+    .unwrap();
+    let proj = glam::camera::rh::proj::directx::perspective(1.1, 1.6, 0.1, 400.0);
+    let all = instances(proj.y_axis.y.abs());
+    let view = selector.add_view(gpu).unwrap();
+    let (cam, view_proj) = camera(100, proj);
+    // The field, not the ring (whose first instances are behind the camera).
+    for n in [300, INSTANCES - 1000] {
+        let mut insts = all[1000..1000 + n].to_vec();
+        insts[n - 1].group = 7; // past the table
+        selector.set_instances(gpu, &insts).unwrap();
+        let mut states = vec![LodState::NEW; n];
+        let mut out = vec![LodSelection::default(); n];
+        let positions: Vec<Vec3> = insts.iter().map(|i| Vec3::from_array(i.center)).collect();
+        let scales: Vec<f32> = insts.iter().map(|i| i.max_scale).collect();
+        let ids: Vec<u32> = insts.iter().map(|i| i.group).collect();
+        let batch = InstanceBatch {
+            positions: &positions,
+            max_scales: &scales,
+            groups: &ids,
+        };
+        for frame in 0..3 {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let desc = GpuSelectFrame {
+                camera: cam,
+                view_proj: Some(view_proj),
+                dt: DT,
+                frame,
+                frame_sequential: false,
+            };
+            selector.record(gpu, &mut encoder, view, &desc).unwrap();
+            gpu.queue.submit([encoder.finish()]);
+            select_batch(&cam, &settings, &groups, &batch, DT, &mut states, &mut out).unwrap();
+        }
+        let got = selector.read_back(gpu, view).unwrap();
+        assert_eq!(got.states.len(), n);
+        for (i, (g, s)) in got.states.iter().zip(&states).enumerate() {
+            assert_eq!(g[0] & 0xffff, s.packed(), "{n} instances: state of {i}");
+            assert_eq!(
+                g[1],
+                s.progress().to_bits(),
+                "{n} instances: progress of {i}"
+            );
+        }
+        let listed: usize = got.lists.iter().map(Vec::len).sum();
+        assert!(listed > 0, "{n} instances: something is drawn");
+        assert!(
+            got.lists
+                .iter()
+                .flatten()
+                .all(|e| e.instance as usize != n - 1),
+            "an instance of no group is drawn"
+        );
+    }
+}
