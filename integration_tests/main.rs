@@ -14,6 +14,8 @@ mod draw_limits;
 mod frame_sequential;
 mod frame_sequential_render;
 mod framebuffer_lod;
+mod gpu_select;
+mod gpu_select_path;
 mod gpu_twins;
 mod harness;
 mod host_errors;

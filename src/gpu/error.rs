@@ -85,6 +85,17 @@ pub enum GpuError {
         /// The rule it breaks, e.g. `must be finite and positive`.
         rule: &'static str,
     },
+    /// The device lacks a capability the call needs (a downlevel flag such as compute shaders
+    /// or indirect execution).
+    #[error("{call}: the device lacks {capability}; {fallback}")]
+    MissingCapability {
+        /// The lodkit call.
+        call: &'static str,
+        /// The missing capability, e.g. `INDIRECT_EXECUTION`.
+        capability: &'static str,
+        /// What to do instead.
+        fallback: &'static str,
+    },
     /// wgpu rejected work of this call (caught by an error scope).
     #[error("{call}: wgpu validation error: {description}")]
     Validation {

@@ -16,6 +16,7 @@ pub mod lod_buffer_scene;
 pub mod readback;
 pub mod resources;
 pub mod scene;
+pub mod select;
 pub mod transition_scene;
 pub mod unpopping;
 

@@ -137,9 +137,9 @@ impl LodSelection {
 /// The part of the selection that persists between frames, per instance and per camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LodState {
-    level: u8,
-    target: u8,
-    progress: f32,
+    pub(super) level: u8,
+    pub(super) target: u8,
+    pub(super) progress: f32,
 }
 
 impl LodState {

@@ -7,9 +7,15 @@
 
 mod batch;
 pub mod config;
+mod gpu_rule;
 mod group;
 
 pub use batch::{InstanceBatch, select_batch};
+pub use gpu_rule::{
+    SELECT_DISTANCE_INFINITE, SELECT_DISTANCE_ORTHOGRAPHIC, SELECT_DISTANCE_PERSPECTIVE,
+    SELECT_DISTANCE_ZERO, SELECT_FAR, SELECT_MAX_LEVELS, SelectGroupData, distance_kind,
+    frustum_planes,
+};
 pub use group::{LodGroup, LodLevel, LodSelection, LodSettings, LodState, TransitionMode};
 
 use glam::{Mat4, Vec3};
@@ -181,4 +187,114 @@ impl LodCamera {
         };
         biased_distance(d, bias)
     }
+}
+
+/// Rust twin of `lodkit::select::select_distance`: the distance the rule compares for an instance
+/// at `center` with largest world-scale component `max_scale`, seen from `camera_position`, where
+/// `factor` is camera bias x global bias / |P\[1\]\[1\]| and `kind` one of the `SELECT_DISTANCE_*`
+/// constants ([`distance_kind`] picks it). Float for float what [`select_batch`] computes.
+///
+/// ```
+/// # use lodkit::select::*;
+/// # use glam::Vec3;
+/// let d = select_distance(Vec3::new(0.0, 0.0, -10.0), Vec3::ZERO, 0.5, 2.0, SELECT_DISTANCE_PERSPECTIVE);
+/// assert_eq!(d, 2.5);
+/// assert_eq!(select_distance(Vec3::ONE, Vec3::ZERO, 1.0, 1.0, SELECT_DISTANCE_ZERO), 0.0);
+/// ```
+pub fn select_distance(
+    center: Vec3,
+    camera_position: Vec3,
+    factor: f32,
+    max_scale: f32,
+    kind: u32,
+) -> f32 {
+    match kind {
+        SELECT_DISTANCE_ZERO => 0.0,
+        SELECT_DISTANCE_INFINITE => SELECT_FAR,
+        SELECT_DISTANCE_ORTHOGRAPHIC => factor / max_scale.abs(),
+        _ => center.distance(camera_position) * factor / max_scale.abs(),
+    }
+}
+
+/// Rust twin of `lodkit::select::select_level`: the selection rule, [`LodGroup::select`] (the
+/// GPU form takes `dt / seconds` as its step and the state packed, see [`LodState::packed`]).
+pub fn select_level(
+    distance: f32,
+    group: &LodGroup,
+    settings: &LodSettings,
+    dt: f32,
+    state: &mut LodState,
+) -> LodSelection {
+    group.select(distance, settings, dt, state)
+}
+
+/// Rust twin of `lodkit::select::select_update_phase`: the packed state word after `selection`
+/// on frame `frame`. Bit 16 is the parity of the frame a transition began (kept while it runs),
+/// bit 17 is set while one runs; the low 16 bits (level, target) are kept.
+///
+/// ```
+/// # use lodkit::select::*;
+/// let blend = LodSelection { current: 0, next: Some(1), transition: 0.2, fade: 1.0, visible: true };
+/// let w = select_update_phase(0x0000, &blend, 7); // begins on an odd frame
+/// assert_eq!(w, 0x30000);
+/// assert_eq!(select_update_phase(w, &blend, 8), 0x30000); // the phase is kept
+/// assert_eq!(select_update_phase(w, &LodSelection::default(), 9), 0);
+/// ```
+pub fn select_update_phase(packed: u32, selection: &LodSelection, frame: u32) -> u32 {
+    let low = packed & 0xffff;
+    if selection.next.is_none() {
+        return low;
+    }
+    let phase = if packed & 0x20000 != 0 {
+        (packed >> 16) & 1
+    } else {
+        frame & 1
+    };
+    low | (phase << 16) | 0x20000
+}
+
+/// Rust twin of `lodkit::select::select_draws_next`: frame-sequential interpolation draws the
+/// outgoing level on the frame a transition began and every other frame after, the incoming one
+/// between.
+///
+/// ```
+/// # use lodkit::select::select_draws_next;
+/// assert!(!select_draws_next(0x30000, 7) && select_draws_next(0x30000, 8));
+/// ```
+pub fn select_draws_next(packed: u32, frame: u32) -> bool {
+    (frame & 1) != ((packed >> 16) & 1)
+}
+
+/// Rust twin of `lodkit::select::select_screen_door_alpha`: the screen-door alpha of the current
+/// level (`incoming` false) or of the next one ([`LodSelection::screen_door_alphas`]).
+///
+/// ```
+/// # use lodkit::select::*;
+/// let s = LodSelection { current: 0, next: Some(1), transition: 0.25, fade: 1.0, visible: true };
+/// assert_eq!((select_screen_door_alpha(&s, false), select_screen_door_alpha(&s, true)), (-0.75, 0.25));
+/// ```
+pub fn select_screen_door_alpha(selection: &LodSelection, incoming: bool) -> f32 {
+    let (current, next) = selection.screen_door_alphas();
+    if incoming {
+        next.unwrap_or(selection.fade)
+    } else {
+        current
+    }
+}
+
+/// Rust twin of `lodkit::select::select_sphere_visible`: whether a bounding sphere is at least
+/// partly inside six inward planes (unit xyz normal, w offset; [`frustum_planes`] makes them).
+///
+/// ```
+/// # use lodkit::select::*;
+/// # use glam::Vec3;
+/// let proj = glam::camera::rh::proj::directx::perspective(1.0, 1.0, 0.1, 100.0);
+/// let planes = frustum_planes(&proj);
+/// assert!(select_sphere_visible(Vec3::new(0.0, 0.0, -10.0), 1.0, &planes));
+/// assert!(!select_sphere_visible(Vec3::new(0.0, 0.0, 10.0), 1.0, &planes)); // behind
+/// ```
+pub fn select_sphere_visible(center: Vec3, radius: f32, planes: &[glam::Vec4; 6]) -> bool {
+    !planes
+        .iter()
+        .any(|p| p.x * center.x + p.y * center.y + p.z * center.z + p.w < -radius)
 }
