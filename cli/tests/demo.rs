@@ -230,6 +230,22 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             c.name, c.settling_frames
         ));
     }
+    // GPU selection: every size measured on both selectors; the bytes it writes per instance
+    // are the 8-byte state and, per list it joins, a 16-byte entry and its 4-byte count.
+    let sel = &report.selection;
+    assert_eq!(
+        sel.rows.iter().map(|r| r.instances).collect::<Vec<_>>(),
+        lodkit_cli::demo::selection::SIZES
+    );
+    assert!(
+        sel.rows
+            .iter()
+            .all(|r| r.gpu_per_second > 0.0 && r.cpu_per_second > 0.0),
+        "{sel:?}"
+    );
+    assert_eq!(sel.bytes_written, (8 + 16 + 4, 8 + 2 * (16 + 4)));
+    assert!(sel.bytes_read.0 > sel.group_table_bytes && sel.bytes_read.0 <= sel.bytes_read.1);
+    say(&format!("demo figure selection: {sel:?}"));
     for run in report.closed_loop.runs() {
         say(&format!(
             "demo figure closed loop {}: settled {:?} within {:.2} overshoot {:.2} spread {:.2}",

@@ -39,8 +39,8 @@ fn cells(line: &str) -> Vec<&str> {
         .collect()
 }
 
-/// The per-scene tables of a generated doc with `columns` cells a row: (scene, technique) ->
-/// the cells after the technique, as printed. quality.md: pop static, pop moving, see-through,
+/// The per-scene tables of a generated doc with at least `columns` cells a row (columns added
+/// later go at the end): (scene, technique) -> the cells after the technique, as printed. quality.md: pop static, pop moving, see-through,
 /// silhouette error; benchmarks.md: triangles and against a hard switch, fragments and against
 /// a hard switch, frames without a t-instance.
 fn scene_tables(path: &str, columns: usize) -> HashMap<(String, String), Vec<String>> {
@@ -51,7 +51,7 @@ fn scene_tables(path: &str, columns: usize) -> HashMap<(String, String), Vec<Str
             scene = Some(name.trim_end_matches('`').to_owned());
         } else if let (Some(s), true) = (&scene, line.starts_with("| ")) {
             let c = cells(line);
-            if c.len() == columns && c[0] != "technique" {
+            if c.len() >= columns && c[0] != "technique" {
                 let figures = c[1..].iter().map(|f| f.to_string()).collect();
                 out.insert((s.clone(), c[0].to_owned()), figures);
             }

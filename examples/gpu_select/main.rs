@@ -16,12 +16,8 @@
 //! 0 green, 1 blue, 2 orange, and dithered mixes of two where a transition runs. The last frame's
 //! per-level counts are read back once, after the loop, and printed.
 //!
-//! `cargo run --release --example gpu_select -- --bench` instead times the selection alone:
-//! instances per second of the GPU dispatch (submitted and waited for, frame by frame) against
-//! `select_batch` on one core, for 10^4, 10^5 and 10^6 instances in the same run, and the bytes
-//! the pass reads and writes per instance (reads counted from the shader by
-//! `lodkit::shaders::cost`, writes from the sizes of what it stores), with what a GPU at 400 GB/s
-//! would take by bandwidth alone.
+//! The selection's throughput against `select_batch` and the bytes it moves per instance are in
+//! the demo's report (`lodkit demo`, section "GPU LOD selection").
 
 use std::error::Error;
 
@@ -85,9 +81,6 @@ fn main() -> Result<(), Box<dyn Error>> {
     let frames: u32 = arg("--frames").map_or(Ok(48), |f| f.parse())?;
     let gpu = GpuContext::new_headless(&Default::default())?;
     println!("adapter: {}", gpu.adapter_summary());
-    if args.iter().any(|a| a == "--bench") {
-        return bench::run(&gpu);
-    }
 
     // One group, three levels from view-normalized distances 0, 10 and 30; hidden beyond 120
     // (fading over the last 3), timed transitions of 0.3 s.
@@ -211,8 +204,6 @@ fn main() -> Result<(), Box<dyn Error>> {
     println!("last frame: instances per level {counts:?}");
     write_strip(&out, &strip_frames)
 }
-
-mod bench;
 
 /// What the draws need besides the selector's buffers.
 struct Drawing {

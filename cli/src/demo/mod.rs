@@ -23,6 +23,7 @@ pub mod render;
 pub mod report;
 pub mod report_fb;
 pub mod scene;
+pub mod selection;
 pub mod timing;
 pub mod transitions;
 pub mod upsampling;
@@ -189,6 +190,8 @@ pub struct DemoReport {
     pub closed_loop: closed_loop::ClosedLoop,
     /// Framerate controllers (simulated).
     pub controllers: Vec<upsampling::ControllerRow>,
+    /// GPU LOD selection against `select_batch`.
+    pub selection: selection::SelectionReport,
     /// Host-side figures (composition, selection).
     pub cpu: Vec<cpu::CpuFigure>,
     /// Whether the plots have text (a font was found).
@@ -282,7 +285,7 @@ pub fn run_on(
     let start = std::time::Instant::now();
     let out = &options.out;
     std::fs::create_dir_all(out).map_err(|e| DemoError::io(out, e))?;
-    let steps = scenes.len() * render::Technique::ALL.len() + upsampling::RESIZE_FACTORS.len() + 6;
+    let steps = scenes.len() * render::Technique::ALL.len() + upsampling::RESIZE_FACTORS.len() + 7;
     let bar = if options.progress {
         indicatif::ProgressBar::new(steps as u64)
     } else {
@@ -350,6 +353,9 @@ pub fn run_on(
     let controllers = upsampling::measure_controllers(upsampling::CONTROLLER_SEEDS);
     let cpu = cpu::cpu_figures(15)?;
     bar.inc(1);
+    bar.set_message("GPU LOD selection against select_batch");
+    let selection = selection::measure(gpu, 5)?;
+    bar.inc(1);
     let info = gpu.adapter.get_info();
     let now = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -370,6 +376,7 @@ pub fn run_on(
         frame_cost,
         closed_loop,
         controllers,
+        selection,
         cpu,
         plot_text: plots::plot_font().is_some(),
         seconds: 0.0,

@@ -210,10 +210,10 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                 "technique",
                 "pop (static)",
                 "pop (moving)",
-                "flicker (static)",
-                "flicker (moving)",
                 "see-through",
                 "silhouette error (moving)",
+                "flicker (static)",
+                "flicker (moving)",
             ],
             rows: rows
                 .map(|t| {
@@ -221,10 +221,10 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                         t.technique.clone(),
                         format!("{:.3}", t.pop_static),
                         format!("{:.3}", t.pop_moving),
-                        format!("{:.2} ({} rev.)", t.flicker_static, t.reversals_static),
-                        format!("{:.2} ({} rev.)", t.flicker_moving, t.reversals_moving),
                         pct(t.see_through),
                         pct(t.silhouette_error),
+                        format!("{:.2} ({} rev.)", t.flicker_static, t.reversals_static),
+                        format!("{:.2} ({} rev.)", t.flicker_moving, t.reversals_moving),
                     ]
                 })
                 .collect(),
@@ -432,6 +432,13 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     b.push_str(&super::report_fb::benchmarks_markdown(report));
     b.push_str("\n## Host side (CPU)\n\nMedians of repeated runs in the same process (the machine's CPU, not the GPU). The criterion benches measure the same workloads more thoroughly: `cargo bench -p lodkit-cli --bench compose`, `cargo bench -p lodkit-cli --bench select`; `cargo bench -p lodkit-cli --bench combine` and `--bench upsample` print the pass ratios above on their own.\n\n");
     b.push_str(&cpu_table(report).markdown());
+    let sel = &report.selection;
+    let _ = write!(
+        b,
+        "\n## GPU LOD selection\n\n{}\n\n",
+        super::selection::text(sel)
+    );
+    b.push_str(&super::selection::table(sel).markdown());
     write(&docs.join("benchmarks.md"), &b)
 }
 
@@ -533,6 +540,13 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
     h.push_str(&ratio_table(report).html());
     h.push_str("<h2>Host side (CPU)</h2>\n");
     h.push_str(&cpu_table(report).html());
+    let sel = &report.selection;
+    let _ = write!(
+        h,
+        "<h2>GPU LOD selection</h2>\n<p>{}</p>\n",
+        esc(&super::selection::text(sel))
+    );
+    h.push_str(&super::selection::table(sel).html());
     h.push_str("<h2>Framerate control</h2>\n");
     h.push_str(&controller_table(report).html());
     h.push_str(&img(
