@@ -71,7 +71,8 @@
 //! [`FrameSequentialLod`]); the combine needs `Msaa::Off` (with MSAA the plugin logs one
 //! warning and its groups switch levels at once, with no transition); a group in transition casts the shadow of the
 //! level drawn that frame (use `NotShadowCaster` on levels if that flickers in your scene);
-//! at most [`MAX_TAG_ID`] groups in transition at once (more switch at once, with a warning).
+//! at most [`MAX_TAG_ID`] groups in transition at once (more switch at once, with a warning);
+//! the combine reads a storage buffer in its fragment shader, which WebGL2 does not offer.
 
 mod material;
 mod render;
