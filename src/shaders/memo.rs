@@ -49,15 +49,17 @@ pub(crate) fn validate(
     module: &naga::Module,
     capabilities: Capabilities,
 ) -> Verdict {
-    let run = || {
-        Validator::new(ValidationFlags::all(), capabilities)
-            .validate(module)
-            .map_err(Box::new)
-    };
     let Some(memo) = memo else {
-        return run();
+        return run_validator(module, capabilities);
     };
     validate_keyed(memo, key(module), module, capabilities)
+}
+
+/// naga's validator on `module`, every check on.
+fn run_validator(module: &naga::Module, capabilities: Capabilities) -> Verdict {
+    Validator::new(ValidationFlags::all(), capabilities)
+        .validate(module)
+        .map_err(Box::new)
 }
 
 /// [`validate`] with the module's key computed already.
@@ -67,16 +69,11 @@ pub(crate) fn validate_keyed(
     module: &naga::Module,
     capabilities: Capabilities,
 ) -> Verdict {
-    let run = || {
-        Validator::new(ValidationFlags::all(), capabilities)
-            .validate(module)
-            .map_err(Box::new)
-    };
     if let Some(verdict) = memo.verdicts.get(&key) {
         memo.counts.reused += 1;
         return verdict.clone();
     }
-    let verdict = run();
+    let verdict = run_validator(module, capabilities);
     memo.counts.validated += 1;
     memo.verdicts.insert(key, verdict.clone());
     verdict
