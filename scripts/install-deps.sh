@@ -3,7 +3,8 @@
 #   (default)  the software GPU (lavapipe: mesa-vulkan-drivers, libvulkan1) and a TrueType font
 #              for the demo's plots;
 #   --ci       also the reference compilers (glslang-tools, spirv-tools), the GL software path
-#              (libegl1, libegl-mesa0, libgl1-mesa-dri), Chromium, Node.js and npm.
+#              (libegl1, libegl-mesa0, libgl1-mesa-dri), Chromium, Node.js and npm, and Xvfb
+#              (lodkit_bevy's window test).
 # Nothing is installed when everything is present. Uses sudo when not run as root.
 set -euo pipefail
 
@@ -29,6 +30,13 @@ if [ "$ci" -eq 1 ]; then
   grep -q 'libEGL_mesa.so.0' <<<"$libs" || need+=(libegl-mesa0 libgl1-mesa-dri)
   command -v chromium >/dev/null || need+=(chromium)
   command -v npm >/dev/null || need+=(nodejs npm)
+  command -v Xvfb >/dev/null || need+=(xvfb)
+  # What winit loads for an X11 window.
+  grep -q 'libX11.so.6' <<<"$libs" || need+=(libx11-6)
+  grep -q 'libXcursor.so.1' <<<"$libs" || need+=(libxcursor1)
+  grep -q 'libXrandr.so.2' <<<"$libs" || need+=(libxrandr2)
+  grep -q 'libXi.so.6' <<<"$libs" || need+=(libxi6)
+  grep -q 'libxkbcommon-x11.so.0' <<<"$libs" || need+=(libxkbcommon-x11-0)
 fi
 
 if [ ${#need[@]} -eq 0 ]; then

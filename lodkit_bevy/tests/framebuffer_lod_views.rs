@@ -12,6 +12,8 @@ mod frames;
 #[path = "../examples/common/headless.rs"]
 #[allow(dead_code, reason = "shared with the examples")]
 mod headless;
+#[path = "support/shade.rs"]
+mod shade;
 
 use bevy::asset::{RenderAssetUsages, uuid_handle};
 use bevy::camera::RenderTarget;
@@ -24,6 +26,7 @@ use bevy::render::{Extract, ExtractSchedule, RenderApp};
 use bevy::shader::ShaderRef;
 use frames::Frame;
 use lodkit_bevy::prelude::*;
+use shade::{Shade, mismatches, pixel, spawn_scene};
 
 const PAINT: Handle<Shader> = uuid_handle!("0c7d1f52-93a4-4b6e-8e2f-5a1b7c3d9e60");
 
@@ -44,39 +47,6 @@ fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
     return effect_output(vec4<f32>(color.rgb * t.rgb, 1.0), s);
 }
 ";
-
-const SHADE: Handle<Shader> = uuid_handle!("6a2e8b41-0d5c-4f7a-9b13-e8c4a7d2f095");
-
-/// Shades the scene's geometry: a sawtooth of view depth (period 4 m) times how much
-/// the surface faces the camera, in the uniform's color, with the uniform's alpha as coverage.
-const SHADE_SOURCE: &str = "
-import bevy_core_pipeline::fullscreen_vertex_shader::FullscreenVertexOutput;
-import lodkit::gbuffer::GBufferOutput;
-import lodkit_bevy::framebuffer_lod::{effect_sample, effect_output};
-
-@group(constants::FRAMEBUFFER_LOD_EFFECT_BIND_GROUP) @binding(0) var<uniform> tint: vec4<f32>;
-
-@fragment
-fn fragment(in: FullscreenVertexOutput) -> GBufferOutput {
-    let s = effect_sample(in.position);
-    let stripes = fract(s.view_depth * 0.25);
-    let facing = 0.5 + 0.5 * s.view_normal.z;
-    return effect_output(vec4<f32>(tint.rgb * (stripes * facing * tint.a), tint.a), s);
-}
-";
-
-/// The geometry-aware test effect of the viewport tests.
-#[derive(Asset, TypePath, AsBindGroup, Clone)]
-struct Shade {
-    #[uniform(0)]
-    tint: Vec4,
-}
-
-impl FramebufferLodEffect for Shade {
-    fn fragment_shader() -> ShaderRef {
-        SHADE.into()
-    }
-}
 
 /// The test effect: a color uniform and a texture with its sampler.
 #[derive(Asset, TypePath, AsBindGroup, Clone)]
@@ -108,7 +78,7 @@ fn app() -> App {
     let mut shaders = app.world_mut().resource_mut::<Assets<Shader>>();
     for (handle, source, path) in [
         (&PAINT, PAINT_SOURCE, "paint.wesl"),
-        (&SHADE, SHADE_SOURCE, "shade.wesl"),
+        (&shade::SHADE, shade::SHADE_SOURCE, "shade.wesl"),
     ] {
         shaders
             .insert(handle, Shader::from_wesl(source, path))
@@ -175,36 +145,6 @@ fn painted(color: Vec3) -> [u8; 3] {
     let tint = Vec3::new(f32::from(TINT[0]), f32::from(TINT[1]), f32::from(TINT[2])) / 255.0;
     let c = color * tint;
     [srgb8(c.x), srgb8(c.y), srgb8(c.z)]
-}
-
-/// A pixel that differs: x, y, what the frame has, what was expected.
-type Mismatch = (u32, u32, [u8; 3], [u8; 3]);
-
-/// Pixels of `frame` inside `rect` (x, y, w, h) whose RGB differs from `expected` by more than
-/// `tolerance` 8-bit steps in a channel, with the first one found.
-fn mismatches(
-    frame: &Frame,
-    rect: [u32; 4],
-    expected: impl Fn(u32, u32) -> [u8; 3],
-    tolerance: u8,
-) -> (usize, Option<Mismatch>) {
-    let (mut count, mut first) = (0, None);
-    for y in rect[1]..rect[1] + rect[3] {
-        for x in rect[0]..rect[0] + rect[2] {
-            let i = ((y * frame.width + x) * 4) as usize;
-            let got = [frame.rgba[i], frame.rgba[i + 1], frame.rgba[i + 2]];
-            let want = expected(x, y);
-            if got
-                .iter()
-                .zip(want)
-                .any(|(&g, w)| g.abs_diff(w) > tolerance)
-            {
-                count += 1;
-                first.get_or_insert((x, y, got, want));
-            }
-        }
-    }
-    (count, first)
 }
 
 /// Steps a few frames (pipelines compile synchronously; assets prepare a frame late), then
@@ -284,38 +224,6 @@ struct View {
     resolution_override: Option<UVec2>,
 }
 
-/// A ground plane, three boxes and a sun.
-fn spawn_scene(world: &mut World) {
-    world.spawn((
-        DirectionalLight {
-            shadow_maps_enabled: false,
-            illuminance: 5_000.0,
-            ..default()
-        },
-        Transform::from_xyz(2.0, 4.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
-    ));
-    let ground = world
-        .resource_mut::<Assets<Mesh>>()
-        .add(Plane3d::default().mesh().size(40.0, 40.0));
-    let cube = world
-        .resource_mut::<Assets<Mesh>>()
-        .add(Cuboid::new(1.0, 2.0, 1.0));
-    let material = world
-        .resource_mut::<Assets<StandardMaterial>>()
-        .add(StandardMaterial {
-            base_color: Color::srgb(0.5, 0.45, 0.4),
-            ..default()
-        });
-    world.spawn((Mesh3d(ground), MeshMaterial3d(material.clone())));
-    for (x, z) in [(-1.5, 0.0), (1.0, -2.0), (0.5, 1.5)] {
-        world.spawn((
-            Mesh3d(cube.clone()),
-            MeshMaterial3d(material.clone()),
-            Transform::from_xyz(x, 1.0, z),
-        ));
-    }
-}
-
 /// The camera of `view` with framebuffer LOD (no effect yet) rendering into `target`.
 fn lod_camera(view: &View, target: Handle<Image>) -> impl Bundle {
     (
@@ -365,12 +273,6 @@ fn render(size: UVec2, views: &[View]) -> Frame {
         }
     }
     settle_and_capture(&mut app, &target)
-}
-
-/// The pixel of `frame` at (x, y).
-fn pixel(frame: &Frame, x: u32, y: u32) -> [u8; 3] {
-    let i = ((y * frame.width + x) * 4) as usize;
-    [frame.rgba[i], frame.rgba[i + 1], frame.rgba[i + 2]]
 }
 
 /// Tolerance of a pixel against the same camera rendered alone (8-bit steps per channel).

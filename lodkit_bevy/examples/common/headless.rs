@@ -29,6 +29,10 @@ pub fn build_app(plugins: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
     app.add_plugins(
         DefaultPlugins
+            .build()
+            // The tests' window test enables winit in this crate's dev build; a headless app
+            // runs no event loop.
+            .disable::<bevy::winit::WinitPlugin>()
             .set(WindowPlugin {
                 primary_window: None,
                 exit_condition: ExitCondition::DontExit,
@@ -49,6 +53,12 @@ pub fn build_app(plugins: impl FnOnce(&mut App)) -> App {
 
 /// An sRGB image a camera can render into, `width` x `height`.
 pub fn render_target(world: &mut World, width: u32, height: u32) -> Handle<Image> {
+    let target = render_target_image(width, height);
+    world.resource_mut::<Assets<Image>>().add(target)
+}
+
+/// The image of [`render_target`], not yet added to the assets.
+pub fn render_target_image(width: u32, height: u32) -> Image {
     let size = Extent3d {
         width,
         height,
@@ -61,7 +71,7 @@ pub fn render_target(world: &mut World, width: u32, height: u32) -> Handle<Image
         RenderAssetUsages::RENDER_WORLD,
     );
     target.texture_descriptor.usage |= TextureUsages::RENDER_ATTACHMENT;
-    world.resource_mut::<Assets<Image>>().add(target)
+    target
 }
 
 /// Runs one frame and waits for the GPU to finish it.
