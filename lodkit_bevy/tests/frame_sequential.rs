@@ -143,7 +143,7 @@ fn num(r: &Value, key: &str) -> f64 {
 /// - fragments 0.735x Bevy's crossfade without a prepass (3.66 M against 4.98 M), 0.779x with
 ///   Bevy's depth and motion-vector prepass (11.93 M against 15.31 M): goal 0.8x in both;
 /// - pop 0.031 / 0.028 (static / moving) against Bevy's 0.043 / 0.035: goal 1.1x Bevy's;
-/// - flicker 2.10 / 6.64 (6.63 with the prepass) against Bevy's 1.97 / 5.52: above Bevy's,
+/// - flicker 2.09 / 6.55 (2.10 / 6.63 with the prepass) against Bevy's 1.97 / 5.52: above Bevy's,
 ///   held to the measured value + 10 % (a skipped combine measures 36.4 / 63.1);
 /// - see-through 0 and every frame covering the silhouettes both levels cover, in both apps.
 #[test]
