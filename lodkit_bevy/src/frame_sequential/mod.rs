@@ -10,7 +10,7 @@
 //! example, each technique on a camera of its own, over its transitions, frame-sequential LOD
 //! draws 0.73x the crossfade's fragments in an app without a prepass and 0.78x in an app that
 //! runs Bevy's depth and motion-vector prepass anyway (TAA, motion blur), with less pop; on the
-//! flicker measure (change over net change) it scores 2.1 / 7.6 against the crossfade's 2.0 /
+//! flicker measure (change over net change) it scores 2.1 / 6.6 against the crossfade's 2.0 /
 //! 5.5 (still / moving camera) (`cargo run --example frame_sequential -- --report report.json`,
 //! and lodkit's docs/engines.md).
 //!
