@@ -1,6 +1,6 @@
 //! The transition metrics, on captured frames (no Bevy here, so the tests hold them to
 //! hand-made cases): pop and flicker as lodkit's demo measures them (`lodkit::metrics`),
-//! see-through and coverage against the two single-level reference runs.
+//! see-through, ghosts and coverage against the two single-level reference runs.
 
 use lodkit::metrics::{self, Flicker, MetricsError};
 
@@ -49,6 +49,31 @@ pub fn see_through(
                     !is_background(pa, background)
                         && !is_background(pb, background)
                         && is_background(p, background)
+                })
+                .count()
+        })
+        .collect()
+}
+
+/// Per frame of `frames`: pixels neither reference covers, where the frame shows something other
+/// than the `background`: an object drawn where no level of it is (e.g. a moving object's last
+/// position left behind), the mirror of [`see_through`].
+pub fn ghosts(
+    frames: &[Frame],
+    fine: &[Frame],
+    coarse: &[Frame],
+    background: [u8; 3],
+) -> Vec<usize> {
+    frames
+        .iter()
+        .zip(fine.iter().zip(coarse))
+        .map(|(f, (a, b))| {
+            f.pixels()
+                .zip(a.pixels().zip(b.pixels()))
+                .filter(|&(p, (pa, pb))| {
+                    is_background(pa, background)
+                        && is_background(pb, background)
+                        && !is_background(p, background)
                 })
                 .count()
         })

@@ -12,7 +12,7 @@ use serde_json::{Map, Value};
 use crate::Args;
 use crate::frames::{Frame, strip};
 use crate::headless::save_png;
-use crate::measure::{coverage, flicker, pop, see_through};
+use crate::measure::{coverage, flicker, ghosts, pop, see_through};
 use crate::run::{BACKGROUND, Failure, HEIGHT, Harness, Pass, Run, WIDTH};
 use crate::scene::{FRAMES, Technique};
 
@@ -50,6 +50,7 @@ const CONTENDERS: [Contender; 4] = [
 #[derive(Default)]
 struct Totals {
     see_through: usize,
+    ghosts: usize,
     min_coverage: Option<f64>,
     fragments: [f64; 3],
 }
@@ -114,6 +115,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             let window: Vec<usize> = (0..FRAMES).filter(|&f| run.in_transition[f]).collect();
             let seen: usize = window.iter().map(|&f| holes[f]).sum();
             total.see_through += seen;
+            let extra = ghosts(&run.frames, &fine.frames, &coarse.frames, background);
+            let ghosted: usize = window.iter().map(|&f| extra[f]).sum();
+            total.ghosts += ghosted;
             let low = window.iter().map(|&f| shown[f]).fold(1.0, f64::min);
             total.min_coverage = Some(total.min_coverage.map_or(low, |m: f64| m.min(low)));
             let fragments = run.transition_fragments(latency);
@@ -122,7 +126,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             }
             println!(
                 "{name:30} {path:6}: pop {p:.3}, flicker {:.2} ({} reversals), see-through {seen} \
-                 px, fragments {:.0} (prepass {:.0}, opaque {:.0}, combine {:.0})",
+                 px, ghosts {ghosted} px, fragments {:.0} (prepass {:.0}, opaque {:.0}, combine {:.0})",
                 f.ratio(),
                 f.reversals,
                 fragments.iter().sum::<f64>(),
@@ -149,6 +153,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     for (c, total) in contenders.iter().zip(&totals) {
         let name = c.name;
         report.insert(format!("see_through_{name}"), total.see_through.into());
+        report.insert(format!("ghosts_{name}"), total.ghosts.into());
         report.insert(
             format!("min_coverage_{name}"),
             total.min_coverage.unwrap_or(1.0).into(),

@@ -11,7 +11,8 @@
 //! draws 0.73x the crossfade's fragments in an app without a prepass and 0.78x in an app that
 //! runs Bevy's depth and motion-vector prepass anyway (TAA, motion blur), with less pop; on the
 //! flicker measure (change over net change) it scores 2.1 / 6.6 against the crossfade's 2.0 /
-//! 5.5 (still / moving camera) (`cargo run --example frame_sequential -- --report report.json`,
+//! 5.5 (still / moving camera), and a moving group's edge shows where it was last frame in a
+//! few pixels (345 pixel-frames over the run; the crossfade none) (`cargo run --example frame_sequential -- --report report.json`,
 //! and lodkit's docs/engines.md).
 //!
 //! ```no_run

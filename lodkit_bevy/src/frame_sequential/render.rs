@@ -38,8 +38,9 @@ pub struct FrameSequentialView {
     pub clip_from_view: Mat4,
     /// This frame's clip space to last frame's (`lodkit::reproject::new_to_old_matrix`).
     pub new_to_old: Mat4,
-    /// Without motion vectors: per t-instance id whose group moved since last frame, the same
-    /// matrix with the group's motion (its pixels are reprojected with it).
+    /// Per t-instance id whose group moved since last frame, the same matrix with the group's
+    /// motion. Without motion vectors its pixels are reprojected with it; with them, the combine
+    /// uses it only to tell where the group moved away from a pixel.
     pub object_new_to_old: Vec<(u32, Mat4)>,
     /// Per t-instance drawn this frame with the pattern anchored to the screen: its id and the
     /// tau at which it is displayed next frame (as its tag carries it).

@@ -400,7 +400,7 @@ fn update(
     );
     let object = settings.anchor == VisibilitySpace::Object;
     let mut rects = Vec::new();
-    // Without Bevy's motion vectors, the world motion of each t-instance that moved.
+    // The world motion of each t-instance that moved.
     let mut moved = Vec::new();
     let mut drawn_tau_next = Vec::new();
     let mut in_transition = 0;
@@ -530,10 +530,11 @@ fn update(
         Mat4::from_cols_array(&m.to_cols_array())
     };
     let motion_vectors = settings.reprojection && has_motion;
+    // The groups' matrices in both routes: without motion vectors their pixels are reprojected
+    // with them; with motion vectors the combine still needs them to tell where a group moved
+    // away from a pixel (the pixel then shows no trace of it).
     let (new_to_old, object_new_to_old) = if !settings.reprojection {
         (Mat4::IDENTITY, Vec::new())
-    } else if motion_vectors {
-        (reproject(Mat4::IDENTITY), Vec::new())
     } else {
         let objects = moved
             .into_iter()
