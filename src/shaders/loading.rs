@@ -5,13 +5,11 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use naga_oil::compose::{
-    ComposableModuleDescriptor, Composer, ShaderLanguage, get_preprocessor_data,
-};
+use naga_oil::compose::{ComposableModuleDescriptor, Composer, ShaderLanguage};
 
 use super::ShaderError;
 use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error};
-use super::imports::{import_site, longest_prefix};
+use super::imports::{declared_imports, import_site, longest_prefix};
 use super::registry;
 
 /// Every `.<extension>` file under `dir` whose path contains none of `exclude`.
@@ -100,7 +98,9 @@ pub(super) fn add_modules(
     for (i, (file, source)) in sources.iter().enumerate() {
         // The declared path as written: naga_oil gives none for a module whose preprocessor
         // directives are malformed, and two such modules must not look like duplicates.
-        let (_, imports, _) = get_preprocessor_data(source);
+        // Every path the module's `#import`s name (lodkit's reading: naga_oil's own needs a
+        // preprocessor of its own, whose regular expressions cost more than a small module).
+        let imports = declared_imports(source);
         let name = registry::define_import_path(source).unwrap_or_else(|| file.clone());
         if let Some(&j) = by_name.get(&name) {
             let d = Diagnostic::new(
@@ -112,7 +112,7 @@ pub(super) fn add_modules(
             return Err(ShaderError::Source(Box::new(d)));
         }
         by_name.insert(name, i);
-        deps.push(imports.into_iter().map(|d| d.import).collect());
+        deps.push(imports.into_iter().map(|(import, _)| import).collect());
     }
     // Resolve each import to a module of this batch (the longest matching prefix).
     let resolve = |import: &str| -> Option<usize> {
