@@ -62,3 +62,19 @@ fn a_def_still_switches_code_in_a_file_with_directives() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("switch.wgsl:2:"), "{err}");
 }
+
+#[test]
+fn user_modules_are_ordered_by_the_paths_they_use_without_importing() {
+    // naga_oil resolves `my::b::f()` written in full without an `#import`: `my::a` must be
+    // added after `my::b` though its file sorts first and it imports nothing.
+    let a = "#define_import_path my::a\nfn g() -> f32 { return my::b::f(); }\n";
+    let b = "#define_import_path my::b\nfn f() -> f32 { return 1.0; }\n";
+    let shader = "#import my::a::g\n@fragment\nfn main() -> @location(0) vec4<f32> {\n    return vec4<f32>(g());\n}\n";
+    let dir = fixture(&[
+        ("modules/a.wgsl", a.as_bytes()),
+        ("modules/b.wgsl", b.as_bytes()),
+        ("shader.wgsl", shader.as_bytes()),
+    ]);
+    let (code, _, err) = run(&dir, &["check", "-I", "modules", "shader.wgsl"]);
+    assert_eq!(code, 0, "{err}");
+}
