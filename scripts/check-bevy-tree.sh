@@ -50,8 +50,26 @@ while read -r name dir; do
     cp "$f" "$work/tree/$name/$f"
   done)
 done <"$work/crates.txt"
+# Bevy fills in the storage format of its mip-generation shader by text before composing it
+# (`##TEXTURE_FORMAT##`, once per format; rgba16float is the HDR view's).
+sed -i 's/##TEXTURE_FORMAT##/rgba16float/g' "$work/tree/bevy_core_pipeline/mip_generation/downsample.wgsl"
 cp "$root/cli/tests/bevy/permutations-0.19.toml" "$work/tree/permutations.toml"
 cd "$work/tree"
-mapfile -t shaders < <(grep -rL --include='*.wgsl' '^[[:space:]]*#define_import_path' . | sed 's|^\./||' | sort)
+# Top-level shaders: files without `#define_import_path`. Those of bevy_pbr/meshlet belong to
+# Bevy's `meshlet` feature (off by default; it swaps in meshlet/visibility_buffer_resolve.wgsl
+# for the dummy module and needs push constants): the default build is checked.
+mapfile -t shaders < <(grep -rL --include='*.wgsl' '^[[:space:]]*#define_import_path' . |
+  sed 's|^\./||' | grep -v '^bevy_pbr/meshlet/' | sort)
 echo "Bevy 0.19.1: $(find . -name '*.wgsl' | wc -l) .wgsl files, ${#shaders[@]} top-level shaders" >&2
-"$lodkit" check --permutations permutations.toml -I . "$@" "${shaders[@]}"
+# Bevy's global defs: the pipeline cache's storage-buffer limit (wgpu's default limit, 8), the
+# mesh view types' light counts (bevy_pbr's native constants), the material bind group
+# (MATERIAL_BIND_GROUP_INDEX, 3) and the tonemapping LUT's binding indices in bevy_pbr's mesh
+# view (18, 19; the 2D pipelines set their own, which bind fewer resources). A native engine's
+# capabilities: Bevy asks for what the device has (push constants, dual-source blending, ...).
+"$lodkit" check --permutations permutations.toml -I . --exclude meshlet/visibility_buffer_resolve.wgsl \
+  --capabilities all \
+  -D AVAILABLE_STORAGE_BUFFER_BINDINGS=8u -D MAX_DIRECTIONAL_LIGHTS=10u \
+  -D MAX_CASCADES_PER_LIGHT=4u -D MAX_RECT_LIGHTS=8u \
+  -D TONEMAPPING_LUT_TEXTURE_BINDING_INDEX=18u -D TONEMAPPING_LUT_SAMPLER_BINDING_INDEX=19u \
+  -D MATERIAL_BIND_GROUP=3u \
+  "$@" "${shaders[@]}"
