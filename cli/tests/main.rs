@@ -12,6 +12,7 @@ mod combine_regions;
 mod demo;
 mod docs_figures;
 mod engine_tree;
+mod fast_path;
 mod impostor;
 mod npm_package;
 mod permutations;

@@ -422,3 +422,23 @@ fn budget_holds_each_set_and_names_the_set_over_it() {
     assert!(stdout.contains("  shader defs {}:\n"), "{stdout}");
     assert!(stdout.contains("  shader defs {EXTRA}:\n"), "{stdout}");
 }
+
+/// The permutation file `scripts/check-bevy-tree.sh` uses (Bevy's shaders are not in the
+/// repository) reads: a misspelt key or a bad value fails the load with exit 2. Its globs match
+/// nothing here, so the shader is checked as with --permute.
+#[test]
+fn bevy_permutation_file_loads() {
+    let file = crate::support::workspace_root().join("cli/tests/bevy/permutations-0.19.toml");
+    let shader =
+        "@fragment\nfn main() -> @location(0) vec4<f32> {\n    return vec4<f32>(1.0);\n}\n";
+    let dir = fixture(&[("s.wgsl", shader.as_bytes())]);
+    let (code, _, err) = run(
+        &dir,
+        &["check", "--permutations", file.to_str().unwrap(), "s.wgsl"],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("checked 1 file under 1 shader-def set"),
+        "{err}"
+    );
+}

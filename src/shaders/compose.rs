@@ -2,7 +2,7 @@
 
 use std::collections::HashMap;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use naga_oil::compose::{Composer, NagaModuleDescriptor, ShaderDefValue, ShaderType};
 
@@ -13,6 +13,7 @@ use super::registry::{self, Language, ModuleKind};
 use super::{ShaderError, closest, glsl, read_source};
 
 mod on_demand;
+mod plain;
 
 /// Shader defs by name, as naga_oil takes them (`-D NAME=VALUE` on the command line).
 pub type ShaderDefs = HashMap<String, ShaderDefValue>;
@@ -64,7 +65,9 @@ pub struct Composed {
 /// The entry object: a naga_oil [`Composer`] that knows every lodkit WGSL module, plus the
 /// user's modules and include folders. A lodkit module enters the composer when a shader or a
 /// user module first imports it (with the modules it imports), so composing one shader parses
-/// only the modules it uses.
+/// only the modules it uses. The composer itself is built when first needed: a WGSL shader
+/// without naga_oil directives (no `#import`, `#ifdef`, `#{NAME}`, `module::item` paths, ...)
+/// is parsed and validated by naga alone.
 ///
 /// ```
 /// use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
@@ -81,7 +84,7 @@ pub struct Composed {
 /// assert_eq!(composed.module.entry_points.len(), 1);
 /// ```
 pub struct ShaderLibrary {
-    composer: Composer,
+    composer: OnceLock<Composer>,
     capabilities: naga::valid::Capabilities,
     include_dirs: Vec<PathBuf>,
     user_modules: Vec<String>,
@@ -121,15 +124,8 @@ impl ShaderLibrary {
 
     /// A library of every lodkit module (loaded when first imported) and the given options.
     pub fn with_descriptor(desc: &LibraryDescriptor) -> Result<Self, ShaderError> {
-        // `with_capabilities` builds a second Composer (naga_oil compiles its regexes again, ~5 ms):
-        // only pay for it when the capabilities differ from the default.
-        let composer = if desc.capabilities == naga::valid::Capabilities::default() {
-            Composer::default()
-        } else {
-            Composer::default().with_capabilities(desc.capabilities)
-        };
         Ok(Self {
-            composer,
+            composer: OnceLock::new(),
             capabilities: desc.capabilities,
             include_dirs: Vec::new(),
             user_modules: Vec::new(),
@@ -141,14 +137,23 @@ impl ShaderLibrary {
     }
 
     /// The underlying naga_oil composer (lodkit's modules enter it as shaders import them;
-    /// [`add_to_composer`] adds them all).
+    /// [`add_to_composer`] adds them all). Built here if no shader needed it yet.
     pub fn composer(&self) -> &Composer {
-        &self.composer
+        self.composer
+            .get_or_init(|| new_composer(self.capabilities))
     }
 
     /// The underlying naga_oil composer, to add modules of your own by hand.
     pub fn composer_mut(&mut self) -> &mut Composer {
-        &mut self.composer
+        composer_in(&mut self.composer, self.capabilities)
+    }
+
+    /// Whether naga_oil's composer has been built: a library builds it when the first shader
+    /// or module needs composition (or [`composer`](Self::composer) is called). Building it
+    /// costs milliseconds (naga_oil compiles its preprocessor's regular expressions), more than
+    /// parsing and validating a small shader.
+    pub fn has_composer(&self) -> bool {
+        self.composer.get().is_some()
     }
 
     /// Import paths of the user modules added so far, in the order they were added.
@@ -201,17 +206,21 @@ impl ShaderLibrary {
                 sources.push((file.display().to_string(), Arc::from(text)));
             }
         }
+        if sources.is_empty() {
+            return Ok(Vec::new());
+        }
         self.load_lodkit_for(sources.iter().map(|(_, text)| &**text))?;
         split_duplicates(&mut sources, &mut self.unavailable);
         // naga_oil parses each module: on a deep stack, as `compose` does.
-        let (composer, unavailable) = (&mut self.composer, &mut self.unavailable);
+        let composer = composer_in(&mut self.composer, self.capabilities);
+        let unavailable = &mut self.unavailable;
         super::limits::on_deep_stack_once(|| {
             add_modules(composer, sources, false, Some(unavailable))
         })
         .unwrap_or_else(|()| Err(deep_stack_failed("the user modules")))?;
         // What the composer gained: the modules that were added (others are unavailable).
         let mut names: Vec<String> = self
-            .composer
+            .composer()
             .module_sets
             .keys()
             .filter(|n| registry::find_module(n).is_none() && !self.user_modules.contains(n))
@@ -235,7 +244,7 @@ impl ShaderLibrary {
             return Err(super::limits::limit_error(file_path, source, e));
         }
         self.load_lodkit_for([source])?;
-        let composer = &mut self.composer;
+        let composer = composer_in(&mut self.composer, self.capabilities);
         let sources = vec![(file_path.to_owned(), Arc::from(source))];
         super::limits::on_deep_stack_once(|| add_modules(composer, sources, false, None))
             .unwrap_or_else(|()| Err(deep_stack_failed(file_path)))?;
@@ -267,8 +276,10 @@ impl ShaderLibrary {
             ..desc.clone()
         };
         let module = match desc.language {
-            SourceLanguage::Wgsl if self.memo.is_some() => return self.compose_wgsl_once(desc),
-            SourceLanguage::Wgsl => self.compose_wgsl(desc)?,
+            SourceLanguage::Wgsl if !plain::needs_composer(desc.source) => {
+                return self.compose_plain(desc);
+            }
+            SourceLanguage::Wgsl => return self.compose_wgsl_validated(desc),
             SourceLanguage::Glsl(stage) => return self.compose_glsl(desc, stage),
             SourceLanguage::Wesl => self.compose_wesl(desc)?,
         };
@@ -309,18 +320,26 @@ impl ShaderLibrary {
     fn compose_wgsl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
         self.load_lodkit_for([desc.source])?;
         self.check_imports(desc)?;
-        self.composer
-            .make_naga_module(NagaModuleDescriptor {
+        let composed = composer_in(&mut self.composer, self.capabilities).make_naga_module(
+            NagaModuleDescriptor {
                 source: desc.source,
                 file_path: desc.file_path,
                 shader_type: ShaderType::Wgsl,
                 shader_defs: desc.shader_defs.clone(),
                 additional_imports: &[],
-            })
-            .map_err(|e| {
-                let d = from_composer_error(&e, &self.composer, Some(desc.source));
-                ShaderError::Source(Box::new(self.with_import_hint(d)))
-            })
+            },
+        );
+        composed.map_err(|e| {
+            let d = from_composer_error(&e, self.composer(), Some(desc.source));
+            ShaderError::Source(Box::new(self.with_import_hint(d)))
+        })
+    }
+
+    /// Whether the composer has the module `import_path` (no composer: no module).
+    fn contains_module(&self, import_path: &str) -> bool {
+        self.composer
+            .get()
+            .is_some_and(|c| c.contains_module(import_path))
     }
 
     /// Every `#import` must name a module the composer has, used or not (naga_oil itself only
@@ -330,7 +349,7 @@ impl ShaderLibrary {
             if let Some(d) = self.unavailable_import(&import, desc, line_at) {
                 return Err(ShaderError::Source(Box::new(d)));
             }
-            let found = longest_prefix(&import, |p| self.composer.contains_module(p).then_some(()));
+            let found = longest_prefix(&import, |p| self.contains_module(p).then_some(()));
             if found.is_none() {
                 let name = module_prefix(&import);
                 // Search from this statement on: an earlier import may contain the name too.
@@ -481,6 +500,25 @@ impl ShaderLibrary {
         })?;
         Ok(Composed { module, info })
     }
+}
+
+/// A naga_oil composer validating with `capabilities`.
+fn new_composer(capabilities: naga::valid::Capabilities) -> Composer {
+    // Setting the field (not `with_capabilities`, which builds a second composer and so
+    // compiles naga_oil's regular expressions twice) on a composer that has no modules yet.
+    let mut composer = Composer::default();
+    composer.capabilities = capabilities;
+    composer
+}
+
+/// The composer in `cell`, built first if it is not there yet.
+fn composer_in(
+    cell: &mut OnceLock<Composer>,
+    capabilities: naga::valid::Capabilities,
+) -> &mut Composer {
+    cell.get_or_init(|| new_composer(capabilities));
+    cell.get_mut()
+        .expect("the composer was built by get_or_init just above")
 }
 
 /// The error when the deep-stack thread that parses `what` panicked or could not start.

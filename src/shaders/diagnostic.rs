@@ -343,13 +343,7 @@ pub(crate) fn from_composer_error(
         .with_label("no module has this import path"),
         ComposerErrorInner::ImportParseError(_, pos) => at(DiagnosticKind::Parse, *pos..*pos + 1),
         ComposerErrorInner::WgslParseError(e) => {
-            let (span, label) = e
-                .labels()
-                .next()
-                .map(|(s, l)| (s.to_range().unwrap_or(0..0), l.to_owned()))
-                .unwrap_or((0..0, String::new()));
-            let d = at(DiagnosticKind::Parse, local_span(span, offset)).with_label(label);
-            e.notes().fold(d, |d, n| d.with_note(undecorate(n)))
+            wgsl_parse_diagnostic(e, file.clone(), source.clone(), |s| local_span(s, offset))
         }
         ComposerErrorInner::GlslParseError(e) => {
             let first = e.errors.first();
@@ -376,6 +370,25 @@ pub(crate) fn from_composer_error(
         ComposerErrorInner::DecorationInSource(range) => at(DiagnosticKind::Parse, range.clone()),
         _ => Diagnostic::new(DiagnosticKind::Parse, file, message),
     }
+}
+
+/// A naga WGSL parse error as a diagnostic: the first label's span (through `map`) and text,
+/// the error's notes. The same whether naga_oil or naga alone parsed the shader.
+pub(crate) fn wgsl_parse_diagnostic(
+    err: &naga::front::wgsl::ParseError,
+    file: String,
+    source: Arc<str>,
+    map: impl Fn(Range<usize>) -> Range<usize>,
+) -> Diagnostic {
+    let (span, label) = err
+        .labels()
+        .next()
+        .map(|(s, l)| (s.to_range().unwrap_or(0..0), l.to_owned()))
+        .unwrap_or((0..0, String::new()));
+    let d = Diagnostic::new(DiagnosticKind::Parse, file, undecorate(&err.to_string()))
+        .with_span(source, map(span))
+        .with_label(label);
+    err.notes().fold(d, |d, n| d.with_note(undecorate(n)))
 }
 
 /// A naga validation error as a diagnostic: the first span is the primary one, the error's chain of

@@ -5,13 +5,11 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use naga_oil::compose::{
-    ComposableModuleDescriptor, Composer, ShaderLanguage, get_preprocessor_data,
-};
+use naga_oil::compose::{ComposableModuleDescriptor, Composer, ShaderLanguage};
 
 use super::ShaderError;
 use super::diagnostic::{Diagnostic, DiagnosticKind, from_composer_error};
-use super::imports::{import_site, longest_prefix};
+use super::imports::{declared_imports, import_site, longest_prefix};
 use super::registry;
 
 /// Every `.<extension>` file under `dir` whose path contains none of `exclude`.
@@ -84,6 +82,48 @@ pub(super) fn split_duplicates(
     });
 }
 
+/// Every path a module names: its `#import`s, and the `module::item` paths it writes in full
+/// without importing them (naga_oil resolves those too), outside `//` comments. What
+/// naga_oil's own scan finds, without building a second preprocessor (its regular
+/// expressions cost more than composing a small shader).
+fn named_paths(source: &str) -> Vec<String> {
+    let mut out: Vec<String> = declared_imports(source)
+        .into_iter()
+        .map(|(p, _)| p)
+        .collect();
+    let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_';
+    for line in source.lines() {
+        let code = line.split("//").next().unwrap_or_default();
+        if code.trim_start().starts_with('#') {
+            continue;
+        }
+        let bytes = code.as_bytes();
+        let mut i = 0;
+        while i < bytes.len() {
+            if !(bytes[i].is_ascii_alphabetic() || bytes[i] == b'_') {
+                i += 1;
+                continue;
+            }
+            let start = i;
+            loop {
+                while i < bytes.len() && word(bytes[i]) {
+                    i += 1;
+                }
+                if bytes[i..].starts_with(b"::") && bytes.get(i + 2).is_some_and(|&b| word(b)) {
+                    i += 2;
+                } else {
+                    break;
+                }
+            }
+            let path = &code[start..i];
+            if path.contains("::") {
+                out.push(path.to_owned());
+            }
+        }
+    }
+    out
+}
+
 /// Adds `(file, source)` modules to `composer` so that every module comes after those it imports.
 /// A module whose import path the composer already has is skipped when `skip_existing` (adding
 /// the lodkit modules twice is harmless) and an error otherwise. With `unavailable`, a module
@@ -100,7 +140,7 @@ pub(super) fn add_modules(
     for (i, (file, source)) in sources.iter().enumerate() {
         // The declared path as written: naga_oil gives none for a module whose preprocessor
         // directives are malformed, and two such modules must not look like duplicates.
-        let (_, imports, _) = get_preprocessor_data(source);
+        let imports = named_paths(source);
         let name = registry::define_import_path(source).unwrap_or_else(|| file.clone());
         if let Some(&j) = by_name.get(&name) {
             let d = Diagnostic::new(
@@ -112,7 +152,7 @@ pub(super) fn add_modules(
             return Err(ShaderError::Source(Box::new(d)));
         }
         by_name.insert(name, i);
-        deps.push(imports.into_iter().map(|d| d.import).collect());
+        deps.push(imports);
     }
     // Resolve each import to a module of this batch (the longest matching prefix).
     let resolve = |import: &str| -> Option<usize> {

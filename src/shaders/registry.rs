@@ -116,6 +116,18 @@ pub fn find_module(import_path: &str) -> Option<&'static ModuleInfo> {
     })
 }
 
+/// The library path (`wgsl/lodkit/<topic>.wgsl`) and source of the WGSL module with import
+/// path `import_path`: what [`find_module`] finds, without describing the whole library first
+/// (the cold start of a check that composes one shader).
+#[cfg(feature = "compose")]
+pub(crate) fn find_module_source(import_path: &str) -> Option<(&'static str, &'static str)> {
+    FILES
+        .iter()
+        .filter(|(path, _)| path.ends_with(".wgsl") && !path.starts_with("passes/"))
+        .find(|(_, source)| define_import_path(source).as_deref() == Some(import_path))
+        .map(|&(path, source)| (path, source))
+}
+
 /// The GLSL twin whose include path is `include_path` (e.g. `lodkit/normal_distance.glsl`).
 pub fn find_glsl_include(include_path: &str) -> Option<&'static ModuleInfo> {
     modules()

@@ -439,8 +439,22 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
         super::selection::text(sel)
     );
     b.push_str(&super::selection::table(sel).markdown());
-    write(&docs.join("benchmarks.md"), &b)
+    // Sections the demo does not measure (`lodkit check` against naga-cli) follow a marker in
+    // the file; they are kept as they are.
+    let path = docs.join("benchmarks.md");
+    if let Ok(old) = std::fs::read_to_string(&path)
+        && let Some(at) = old.find(HAND_WRITTEN)
+    {
+        b.push('\n');
+        b.push_str(&old[at..]);
+    }
+    write(&path, &b)
 }
+
+/// The line in `benchmarks.md` after which the text is written by hand, and kept by
+/// `lodkit demo --docs`.
+pub const HAND_WRITTEN: &str =
+    "<!-- Written by hand from here on; `lodkit demo --docs` keeps this part. -->";
 
 /// An image with its caption, for `index.html`.
 pub(super) fn img(src: &str, alt: &str) -> String {

@@ -4,8 +4,8 @@
 use std::sync::Arc;
 
 use super::{
-    ComposeDescriptor, Composed, ShaderError, ShaderLibrary, add_modules, declared_imports,
-    deep_stack_failed, longest_prefix, registry, validation_error,
+    ComposeDescriptor, Composed, ShaderError, ShaderLibrary, add_modules, composer_in,
+    declared_imports, longest_prefix, registry, validation_error,
 };
 
 impl ShaderLibrary {
@@ -21,29 +21,29 @@ impl ShaderLibrary {
             wanted.extend(declared_imports(source).into_iter().map(|(p, _)| p));
             wanted.extend(registry::define_import_path(source));
         }
-        let mut needed: Vec<&'static registry::ModuleInfo> = Vec::new();
+        let mut needed: Vec<(&'static str, &'static str)> = Vec::new();
         while let Some(import) = wanted.pop() {
-            let Some((_, m)) = longest_prefix(&import, registry::find_module) else {
+            let Some((import_path, (path, source))) =
+                longest_prefix(&import, registry::find_module_source)
+            else {
                 continue;
             };
-            let loaded = m
-                .import_path
-                .as_deref()
-                .is_some_and(|p| self.composer.contains_module(p));
-            if loaded || needed.iter().any(|n| std::ptr::eq(*n, m)) {
+            let loaded = self.contains_module(import_path);
+            if loaded || needed.iter().any(|(p, _)| *p == path) {
                 continue;
             }
-            needed.push(m);
-            wanted.extend(declared_imports(m.source).into_iter().map(|(p, _)| p));
+            needed.push((path, source));
+            wanted.extend(declared_imports(source).into_iter().map(|(p, _)| p));
         }
         if needed.is_empty() {
             return Ok(());
         }
         let sources = needed
             .iter()
-            .map(|m| (format!("shader_lib/{}", m.path), Arc::from(m.source)))
+            .map(|(path, source)| (format!("shader_lib/{path}"), Arc::from(*source)))
             .collect();
-        add_modules(&mut self.composer, sources, true, None)
+        let composer = composer_in(&mut self.composer, self.capabilities);
+        add_modules(composer, sources, true, None)
     }
 
     /// From now on, validates each distinct composed module once: a composition whose module
@@ -59,28 +59,41 @@ impl ShaderLibrary {
         self.memo.as_ref().map(|m| m.counts)
     }
 
-    /// Composes WGSL with naga_oil's own validation off and validates each distinct module
-    /// once ([`remember_validations`](Self::remember_validations)). An invalid module is
-    /// composed again with naga_oil validating, which places the error in the user's source;
-    /// that diagnostic is remembered too.
-    pub(super) fn compose_wgsl_once(
+    /// Composes WGSL with naga_oil's own validation off and validates the module once (each
+    /// distinct module once after [`remember_validations`](Self::remember_validations)). A
+    /// shader that fails is composed again with naga_oil validating, which places the error in
+    /// the user's source; with the memo, that diagnostic is remembered too.
+    pub(super) fn compose_wgsl_validated(
         &mut self,
         desc: &ComposeDescriptor,
     ) -> Result<Composed, ShaderError> {
-        self.composer.validate = false;
+        composer_in(&mut self.composer, self.capabilities).validate = false;
         let module = self.compose_wgsl(desc);
-        self.composer.validate = true;
-        let module = module?;
-        let key = crate::shaders::memo::key(&module);
-        let Some(memo) = self.memo.as_mut() else {
-            return Err(deep_stack_failed(desc.file_path));
+        composer_in(&mut self.composer, self.capabilities).validate = true;
+        let module = match module {
+            Ok(module) => module,
+            // naga_oil's checks of its own (identifiers its WGSL writer renamed) run only when
+            // it validates: the diagnostic comes from that composition.
+            Err(first) => return Err(self.compose_wgsl(desc).err().unwrap_or(first)),
         };
-        let e = match crate::shaders::memo::validate_keyed(memo, key, &module, self.capabilities) {
+        let key = self
+            .memo
+            .as_ref()
+            .map(|_| crate::shaders::memo::key(&module));
+        let verdict = match (self.memo.as_mut(), key) {
+            (Some(memo), Some(key)) => {
+                crate::shaders::memo::validate_keyed(memo, key, &module, self.capabilities)
+            }
+            _ => crate::shaders::memo::validate(None, &module, self.capabilities),
+        };
+        let e = match verdict {
             Ok(info) => return Ok(Composed { module, info }),
             Err(e) => e,
         };
-        let located = (key, desc.file_path.to_owned());
-        if let Some(d) = memo.located.get(&located) {
+        let located = key.map(|key| (key, desc.file_path.to_owned()));
+        if let (Some(memo), Some(located)) = (&self.memo, &located)
+            && let Some(d) = memo.located.get(located)
+        {
             return Err(ShaderError::Source(Box::new(d.clone())));
         }
         let d = match self.compose_wgsl(desc) {
@@ -90,7 +103,7 @@ impl ShaderLibrary {
                 other => return Err(other),
             },
         };
-        if let Some(memo) = self.memo.as_mut() {
+        if let (Some(memo), Some(located)) = (self.memo.as_mut(), located) {
             memo.located.insert(located, d.clone());
         }
         Err(ShaderError::Source(Box::new(d)))
