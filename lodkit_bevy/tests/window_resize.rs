@@ -218,11 +218,11 @@ fn script(
 }
 
 /// Records the window camera's target size in this frame (after `camera_system`).
-fn record_camera_size(script: Res<Script>, cameras: Query<(&Camera, Has<RenderTarget>)>) {
+fn record_camera_size(script: Res<Script>, cameras: Query<&Camera>) {
     let Some(frame) = script.frame.checked_sub(1) else {
         return;
     };
-    for (camera, _) in cameras.iter().filter(|(c, _)| c.order == 0) {
+    for camera in cameras.iter().filter(|c| c.order == 0) {
         if let Some(size) = camera.physical_target_size() {
             script
                 .camera_sizes

@@ -13,7 +13,7 @@
 //!
 //! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_<run>.png` (7 frames over the
 //! moving camera's transitions), with `--report` the figures as JSON (pop, flicker, reversals,
-//! see-through, coverage, fragments per pass), with `--frames DIR` every frame of every run as
+//! see-through, ghosts, coverage, fragments per pass), with `--frames DIR` every frame of every run as
 //! `DIR/<run>_<static|moving>/<frame>.png` (the references as `reference_fine` and
 //! `reference_coarse`), so anyone can recompute the figures. `--no-reprojection` breaks the
 //! combine on purpose (the older frame read at the same pixel): the moving camera then shows the
