@@ -31,6 +31,28 @@ pub fn flicker(run: &[Frame], reference: &[Frame]) -> Result<Flicker, MetricsErr
     metrics::flicker(&bytes(run), &bytes(reference))
 }
 
+/// Per frame of `frames`: the pixels where `counts(shown, fine, coarse)` holds, each argument
+/// whether that frame covers the pixel (shows something other than `background`).
+fn count_pixels(
+    frames: &[Frame],
+    fine: &[Frame],
+    coarse: &[Frame],
+    background: [u8; 3],
+    counts: impl Fn(bool, bool, bool) -> bool,
+) -> Vec<usize> {
+    let covers = |p| !is_background(p, background);
+    frames
+        .iter()
+        .zip(fine.iter().zip(coarse))
+        .map(|(f, (a, b))| {
+            f.pixels()
+                .zip(a.pixels().zip(b.pixels()))
+                .filter(|&(p, (pa, pb))| counts(covers(p), covers(pa), covers(pb)))
+                .count()
+        })
+        .collect()
+}
+
 /// Per frame of `frames`: pixels both references (the finest and the coarsest level alone)
 /// cover, where the frame shows the `background`: the object's silhouette seen through.
 pub fn see_through(
@@ -39,20 +61,9 @@ pub fn see_through(
     coarse: &[Frame],
     background: [u8; 3],
 ) -> Vec<usize> {
-    frames
-        .iter()
-        .zip(fine.iter().zip(coarse))
-        .map(|(f, (a, b))| {
-            f.pixels()
-                .zip(a.pixels().zip(b.pixels()))
-                .filter(|&(p, (pa, pb))| {
-                    !is_background(pa, background)
-                        && !is_background(pb, background)
-                        && is_background(p, background)
-                })
-                .count()
-        })
-        .collect()
+    count_pixels(frames, fine, coarse, background, |shown, a, b| {
+        a && b && !shown
+    })
 }
 
 /// Per frame of `frames`: pixels neither reference covers, where the frame shows something other
@@ -64,20 +75,9 @@ pub fn ghosts(
     coarse: &[Frame],
     background: [u8; 3],
 ) -> Vec<usize> {
-    frames
-        .iter()
-        .zip(fine.iter().zip(coarse))
-        .map(|(f, (a, b))| {
-            f.pixels()
-                .zip(a.pixels().zip(b.pixels()))
-                .filter(|&(p, (pa, pb))| {
-                    is_background(pa, background)
-                        && is_background(pb, background)
-                        && !is_background(p, background)
-                })
-                .count()
-        })
-        .collect()
+    count_pixels(frames, fine, coarse, background, |shown, a, b| {
+        !a && !b && shown
+    })
 }
 
 /// Per frame: the share of the pixels both references cover that the frame covers (1: the
@@ -89,17 +89,10 @@ pub fn coverage(
     background: [u8; 3],
 ) -> Vec<f64> {
     let holes = see_through(frames, fine, coarse, background);
-    fine.iter()
-        .zip(coarse)
+    let both = count_pixels(fine, fine, coarse, background, |_, a, b| a && b);
+    both.into_iter()
         .zip(holes)
-        .map(|((a, b), hole)| {
-            let both = a
-                .pixels()
-                .zip(b.pixels())
-                .filter(|&(pa, pb)| {
-                    !is_background(pa, background) && !is_background(pb, background)
-                })
-                .count();
+        .map(|(both, hole)| {
             if both == 0 {
                 1.0
             } else {

@@ -200,16 +200,8 @@ pub fn run(
         ));
     }
 
-    // The fog at full resolution, then at r = 2 and 3 with each upsample.
-    let mut frames = Vec::new();
-    let mut fragments = Vec::new();
-    for (name, upsample, r) in [
-        ("reference", bilateral, 1.0),
-        ("bilinear_r2", FramebufferLodUpsample::Bilinear, 2.0),
-        ("bilateral_r2", bilateral, 2.0),
-        ("bilinear_r3", FramebufferLodUpsample::Bilinear, 3.0),
-        ("bilateral_r3", bilateral, 3.0),
-    ] {
+    // The fog with `upsample` at a fixed r, captured and written as `<name>.png`.
+    let fog_frame = |app: &mut App, upsample, r, name: &str| -> Result<Frame, Failure> {
         let r = FramebufferLodResolution::Fixed(r);
         configure(
             app,
@@ -220,8 +212,21 @@ pub fn run(
             Tonemapping::AcesFitted,
         );
         let frame = settled_capture(app, target)?;
-        fragments.push(effect_fragments(app));
         save_png(&frame, &path(&format!("{name}.png"))).map_err(io)?;
+        Ok(frame)
+    };
+    // The fog at full resolution, then at r = 2 and 3 with each upsample.
+    let mut frames = Vec::new();
+    let mut fragments = Vec::new();
+    for (name, upsample, r) in [
+        ("reference", bilateral, 1.0),
+        ("bilinear_r2", FramebufferLodUpsample::Bilinear, 2.0),
+        ("bilateral_r2", bilateral, 2.0),
+        ("bilinear_r3", FramebufferLodUpsample::Bilinear, 3.0),
+        ("bilateral_r3", bilateral, 3.0),
+    ] {
+        let frame = fog_frame(app, upsample, r, name)?;
+        fragments.push(effect_fragments(app));
         frames.push(frame);
     }
     // Fine-grained resizing: the transmittance as a factor on the full-resolution scene.
@@ -236,18 +241,7 @@ pub fn run(
         ),
         ("modulate_bilateral_r2", bilateral, 2.0),
     ] {
-        let r = FramebufferLodResolution::Fixed(r);
-        configure(
-            app,
-            camera,
-            Effect::Fog,
-            upsample,
-            r,
-            Tonemapping::AcesFitted,
-        );
-        let frame = settled_capture(app, target)?;
-        save_png(&frame, &path(&format!("{name}.png"))).map_err(io)?;
-        factor_frames.push(frame);
+        factor_frames.push(fog_frame(app, upsample, r, name)?);
     }
     set_composite(app, camera, FramebufferLodComposite::Over, 0.0);
     let modulate_psnr = |i: usize| psnr_rgba8(&factor_frames[0].rgba, &factor_frames[i].rgba);
