@@ -8,7 +8,7 @@
 //! ```text
 //! cargo run --example frame_sequential [-- [--out DIR] [--report FILE] [--frames DIR]
 //!     [--schedule complementary|paper] [--anchor screen|object] [--no-reprojection]
-//!     [--without-prepass-only]]
+//!     [--exact-coverage] [--without-prepass-only]]
 //! ```
 //!
 //! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_<run>.png` (7 frames over the
@@ -17,7 +17,10 @@
 //! `DIR/<run>_<static|moving>/<frame>.png` (the references as `reference_fine` and
 //! `reference_coarse`), so anyone can recompute the figures. `--no-reprojection` breaks the
 //! combine on purpose (the older frame read at the same pixel): the moving camera then shows the
-//! background through the objects. `--without-prepass-only` skips the app with a prepass.
+//! background through the objects. `--exact-coverage` turns on
+//! `FrameSequentialLod::exact_coverage` (the older-level depth pass; its depth samples are the
+//! report's `fragments_<run>_older_depth`). `--without-prepass-only` skips the app with a
+//! prepass.
 //! Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
 //!
 //! The scene is `scene.rs` (what a Bevy app writes to use the plugin is there, in
@@ -52,11 +55,12 @@ pub struct Args {
     schedule: Schedule,
     anchor: VisibilitySpace,
     reprojection: bool,
+    exact_coverage: bool,
 }
 
 const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] [--frames DIR] \
 [--schedule complementary|paper] [--anchor screen|object] [--no-reprojection] \
-[--without-prepass-only]";
+[--exact-coverage] [--without-prepass-only]";
 
 fn parse() -> Result<Option<Args>, String> {
     let mut args = Args {
@@ -67,6 +71,7 @@ fn parse() -> Result<Option<Args>, String> {
         schedule: Schedule::Complementary,
         anchor: VisibilitySpace::Screen,
         reprojection: true,
+        exact_coverage: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -92,6 +97,7 @@ fn parse() -> Result<Option<Args>, String> {
                 }
             }
             "--no-reprojection" => args.reprojection = false,
+            "--exact-coverage" => args.exact_coverage = true,
             _ => return Err(format!("unexpected argument `{arg}`")),
         }
     }

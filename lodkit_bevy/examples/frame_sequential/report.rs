@@ -13,7 +13,7 @@ use crate::Args;
 use crate::frames::{Frame, strip};
 use crate::headless::save_png;
 use crate::measure::{coverage, flicker, ghosts, pop, see_through};
-use crate::run::{BACKGROUND, Failure, HEIGHT, Harness, Pass, Run, WIDTH};
+use crate::run::{BACKGROUND, Failure, HEIGHT, Harness, PARTS, Pass, Run, WIDTH};
 use crate::scene::{FRAMES, Technique};
 
 /// A technique in a kind of app: its report name and what its camera has.
@@ -52,7 +52,7 @@ struct Totals {
     see_through: usize,
     ghosts: usize,
     min_coverage: Option<f64>,
-    fragments: [f64; 3],
+    fragments: [f64; PARTS],
 }
 
 fn io(message: String) -> Failure {
@@ -126,13 +126,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             }
             println!(
                 "{name:30} {path:6}: pop {p:.3}, flicker {:.2} ({} reversals), see-through {seen} \
-                 px, ghosts {ghosted} px, fragments {:.0} (prepass {:.0}, opaque {:.0}, combine {:.0})",
+                 px, ghosts {ghosted} px, fragments {:.0} (prepass {:.0}, opaque {:.0}, older depth \
+                 {:.0}, combine {:.0})",
                 f.ratio(),
                 f.reversals,
                 fragments.iter().sum::<f64>(),
                 fragments[0],
                 fragments[1],
                 fragments[2],
+                fragments[3],
             );
             report.insert(format!("pop_{name}_{path}"), p.into());
             report.insert(format!("flicker_{name}_{path}"), f.ratio().into());
@@ -195,6 +197,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         format!("{:?}", args.anchor).to_lowercase().into(),
     );
     report.insert("reprojection".into(), args.reprojection.into());
+    report.insert("exact_coverage".into(), args.exact_coverage.into());
     if let Some(dir) = &args.frames {
         report.insert("frames_dir".into(), dir.display().to_string().into());
     }

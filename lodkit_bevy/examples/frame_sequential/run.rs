@@ -12,7 +12,9 @@ use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use lodkit::select::{LodSettings, TransitionMode};
-use lodkit_bevy::frame_sequential::{COMBINE_PASS, FrameSequentialLod, FrameSequentialLodPlugin};
+use lodkit_bevy::frame_sequential::{
+    COMBINE_PASS, FrameSequentialLod, FrameSequentialLodPlugin, OLDER_DEPTH_PASS,
+};
 
 use crate::Args;
 use crate::frames::Frame;
@@ -31,14 +33,18 @@ const DRAIN_UPDATES: usize = 12;
 /// made, and the runs start alike.
 const WARMUP_UPDATES: usize = 3;
 /// The passes whose fragment-shader invocations are the groups' cost (the scene has nothing
-/// else), with the part of the report each adds to: Bevy's prepass, its opaque pass, and
-/// lodkit's combine.
-pub const PASSES: [(&str, Pass); 4] = [
+/// else), with the part of the report each adds to: Bevy's prepass, its opaque pass, lodkit's
+/// older-level depth pass (depth only: no fragment stage) and lodkit's combine.
+pub const PASSES: [(&str, Pass); 5] = [
     ("early prepass", Pass::Prepass),
     ("late prepass", Pass::Prepass),
     ("main_opaque_pass_3d", Pass::Opaque),
+    (OLDER_DEPTH_PASS, Pass::OlderDepth),
     (COMBINE_PASS, Pass::Combine),
 ];
+
+/// How many parts the fragments are reported in.
+pub const PARTS: usize = 4;
 
 /// Where fragments go.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,17 +53,20 @@ pub enum Pass {
     Prepass,
     /// Bevy's opaque main pass.
     Opaque,
+    /// lodkit's older-level depth pass.
+    OlderDepth,
     /// lodkit's combine.
     Combine,
 }
 
 impl Pass {
-    pub const ALL: [Pass; 3] = [Pass::Prepass, Pass::Opaque, Pass::Combine];
+    pub const ALL: [Pass; PARTS] = [Pass::Prepass, Pass::Opaque, Pass::OlderDepth, Pass::Combine];
 
     pub fn name(self) -> &'static str {
         match self {
             Pass::Prepass => "prepass",
             Pass::Opaque => "opaque",
+            Pass::OlderDepth => "older_depth",
             Pass::Combine => "combine",
         }
     }
@@ -75,15 +84,15 @@ pub struct Run {
     pub frames: Vec<Frame>,
     /// Per update: fragment-shader invocations of each [`Pass`] (in `Pass::ALL` order) reported
     /// that update (Bevy's render diagnostics arrive `latency` updates after their frame).
-    pub fragments: Vec<[f64; 3]>,
+    pub fragments: Vec<[f64; PARTS]>,
     /// Per frame: whether a group was in its transition band.
     pub in_transition: Vec<bool>,
 }
 
 impl Run {
     /// Fragments of each pass over the frames in transition, with the diagnostics `latency`.
-    pub fn transition_fragments(&self, latency: usize) -> [f64; 3] {
-        let mut sum = [0.0; 3];
+    pub fn transition_fragments(&self, latency: usize) -> [f64; PARTS] {
+        let mut sum = [0.0; PARTS];
         for (f, _) in self.in_transition.iter().enumerate().filter(|(_, t)| **t) {
             if let Some(counts) = self.fragments.get(f + latency) {
                 for (s, c) in sum.iter_mut().zip(counts) {
@@ -130,9 +139,9 @@ impl Harness {
     }
 
     /// Fragment invocations per [`Pass`] reported since the last call.
-    fn fragments(&mut self) -> [f64; 3] {
+    fn fragments(&mut self) -> [f64; PARTS] {
         let store = self.app.world().resource::<DiagnosticsStore>();
-        let mut sum = [0.0; 3];
+        let mut sum = [0.0; PARTS];
         for ((pass, part), seen) in PASSES.iter().zip(&mut self.seen) {
             let path = DiagnosticPath::new(format!("render/{pass}/fragment_shader_invocations"));
             let Some(m) = store.get(&path).and_then(|d| d.measurement()) else {
@@ -146,7 +155,7 @@ impl Harness {
         sum
     }
 
-    fn step(&mut self) -> [f64; 3] {
+    fn step(&mut self) -> [f64; PARTS] {
         step(&mut self.app);
         self.fragments()
     }
@@ -181,6 +190,7 @@ impl Harness {
                     ..default()
                 },
                 reprojection: args.reprojection,
+                exact_coverage: args.exact_coverage,
             });
         }
         camera.id()

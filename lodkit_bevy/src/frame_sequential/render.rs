@@ -12,6 +12,8 @@ use bevy::log::warn_once;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex, ExtractComponent};
+use bevy::render::mesh::RenderMesh;
+use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::render_asset::RenderAssets;
 use bevy::render::render_resource::binding_types::{
     storage_buffer_read_only_sized, texture_2d, texture_depth_2d, uniform_buffer,
@@ -22,6 +24,8 @@ use bevy::render::sync_component::SyncComponent;
 use bevy::render::texture::{FallbackImage, GpuImage};
 use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
 use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
+
+use super::older_depth::{self, OLDER_DEPTH_PASS, OlderDepthDraws, OlderDepthPipeline, OlderLevel};
 
 /// Name of the combine pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
 /// `render/<name>/elapsed_gpu` and `render/<name>/fragment_shader_invocations`.
@@ -47,6 +51,12 @@ pub struct FrameSequentialView {
     pub drawn_tau_next: Vec<(u32, f32)>,
     /// Last frame's `drawn_tau_next`: the levels the older buffer holds.
     pub older_tau: Vec<(u32, f32)>,
+    /// The levels this frame does not draw of the groups in transition, for the older-level
+    /// depth pass (empty unless `exact_coverage`).
+    pub older_levels: Vec<OlderLevel>,
+    /// Whether the older-level depth pass runs and the combine reads it
+    /// (`FrameSequentialLod::exact_coverage`).
+    pub exact_coverage: bool,
     /// Whether the combine reads Bevy's motion vectors (the camera has `MotionVectorPrepass`).
     pub motion_vectors: bool,
     /// The combine's rectangles (pixels, top left origin), not overlapping.
@@ -65,6 +75,7 @@ impl SyncComponent<RenderApp> for FrameSequentialView {
         FrameSequentialTextures,
         CombineBindGroup,
         CombinePipelineId,
+        OlderDepthDraws,
     );
 }
 
@@ -76,7 +87,12 @@ impl ExtractComponent<RenderApp> for FrameSequentialView {
     fn extract_component(view: QueryItem<'_, '_, Self::QueryData>) -> Option<Self::Out> {
         let params = CombineParams {
             new_to_old: view.new_to_old,
-            flags: UVec4::new(u32::from(view.motion_vectors), 0, 0, 0),
+            flags: UVec4::new(
+                u32::from(view.motion_vectors),
+                u32::from(view.exact_coverage),
+                0,
+                0,
+            ),
         };
         Some((view.clone(), params))
     }
@@ -90,6 +106,14 @@ pub struct CombineParams {
     flags: UVec4,
 }
 
+impl CombineParams {
+    /// Whether the combine reads the older-level depth pass this frame (exact coverage, and
+    /// every older level drawn).
+    pub(super) fn set_exact_coverage(&mut self, on: bool) {
+        self.flags.y = u32::from(on);
+    }
+}
+
 pub(super) fn build(render_app: &mut SubApp) {
     render_app.add_systems(
         Render,
@@ -97,6 +121,7 @@ pub(super) fn build(render_app: &mut SubApp) {
             prepare_pipelines.in_set(RenderSystems::Prepare),
             prepare_textures.in_set(RenderSystems::PrepareResources),
             prepare_bind_groups.in_set(RenderSystems::PrepareBindGroups),
+            older_depth::prepare_draws.in_set(RenderSystems::QueueMeshes),
         ),
     );
     render_app.add_systems(
@@ -110,7 +135,9 @@ pub(super) fn build(render_app: &mut SubApp) {
 pub(super) fn finish(render_app: &mut SubApp) {
     render_app
         .init_gpu_resource::<CombinePipeline>()
-        .init_gpu_resource::<SpecializedRenderPipelines<CombinePipeline>>();
+        .init_gpu_resource::<SpecializedRenderPipelines<CombinePipeline>>()
+        .init_gpu_resource::<OlderDepthPipeline>()
+        .init_gpu_resource::<SpecializedMeshPipelines<OlderDepthPipeline>>();
 }
 
 /// The combine's bind group layout and shaders.
@@ -137,6 +164,7 @@ impl FromWorld for CombinePipeline {
                     uniform_buffer::<CombineParams>(true),
                     storage_buffer_read_only_sized(false, None),
                     texture_2d(TextureSampleType::Float { filterable: false }),
+                    texture_depth_2d(),
                 ),
             ),
         );
@@ -197,24 +225,34 @@ pub struct FrameSequentialTextures {
     format: TextureFormat,
     color: [(Texture, TextureView); 2],
     depth: [(Texture, TextureView); 2],
+    /// The older-level depth pass's target: the camera's size with exact coverage, else one
+    /// texel (bound, never read).
+    older_level_depth: (Texture, TextureView),
+    /// Whether the textures were made for exact coverage.
+    exact_coverage: bool,
 }
 
 fn prepare_textures(
     mut commands: Commands,
     device: Res<RenderDevice>,
-    views: Query<
-        (Entity, &ViewTarget, Option<&FrameSequentialTextures>),
-        With<FrameSequentialView>,
-    >,
+    views: Query<(
+        Entity,
+        &ViewTarget,
+        &FrameSequentialView,
+        Option<&FrameSequentialTextures>,
+    )>,
 ) {
-    for (entity, target, textures) in &views {
+    for (entity, target, view, textures) in &views {
         let size = target.main_texture().size();
         let size = UVec2::new(size.width, size.height);
         let format = target.main_texture_format();
-        if textures.is_some_and(|t| t.size == size && t.format == format) {
+        let exact_coverage = view.exact_coverage;
+        if textures.is_some_and(|t| {
+            t.size == size && t.format == format && t.exact_coverage == exact_coverage
+        }) {
             continue;
         }
-        let make = |label, format| {
+        let make = |label, format, usage, size: UVec2| {
             let texture = device.create_texture(&TextureDescriptor {
                 label: Some(label),
                 size: Extent3d {
@@ -226,19 +264,40 @@ fn prepare_textures(
                 sample_count: 1,
                 dimension: TextureDimension::D2,
                 format,
-                usage: TextureUsages::COPY_DST | TextureUsages::TEXTURE_BINDING,
+                usage: usage | TextureUsages::TEXTURE_BINDING,
                 view_formats: &[],
             });
             let view = texture.create_view(&TextureViewDescriptor::default());
             (texture, view)
         };
-        let color = || make("lodkit_frame_sequential_color", format);
-        let depth = || make("lodkit_frame_sequential_depth", CORE_3D_DEPTH_FORMAT);
+        let color = || {
+            make(
+                "lodkit_frame_sequential_color",
+                format,
+                TextureUsages::COPY_DST,
+                size,
+            )
+        };
+        let depth = || {
+            make(
+                "lodkit_frame_sequential_depth",
+                CORE_3D_DEPTH_FORMAT,
+                TextureUsages::COPY_DST,
+                size,
+            )
+        };
         commands.entity(entity).insert(FrameSequentialTextures {
             size,
             format,
             color: [color(), color()],
             depth: [depth(), depth()],
+            older_level_depth: make(
+                OLDER_DEPTH_PASS,
+                CORE_3D_DEPTH_FORMAT,
+                TextureUsages::RENDER_ATTACHMENT,
+                if exact_coverage { size } else { UVec2::ONE },
+            ),
+            exact_coverage,
         });
     }
 }
@@ -301,6 +360,7 @@ fn prepare_bind_groups(
                 params.clone(),
                 object_buffer.as_entire_binding(),
                 &visibility.texture_view,
+                &textures.older_level_depth.1,
             )),
         );
         commands.entity(entity).insert(CombineBindGroup(bind_group));
@@ -338,13 +398,21 @@ type PassView = (
     &'static DynamicUniformIndex<CombineParams>,
     Option<&'static CombineBindGroup>,
     Option<&'static CombinePipelineId>,
+    Option<&'static OlderDepthDraws>,
 );
 
 /// Copies this frame's main color and depth where the frame is kept (the combine's newer input
 /// and the next frame's older buffer), then combines within the rectangles. A frame not kept
 /// has no rectangles: nothing is in transition, and nothing is copied.
-fn combine_pass(view: ViewQuery<PassView>, cache: Res<PipelineCache>, mut ctx: RenderContext) {
-    let (_, target, depth, frame, textures, params, bind_group, pipeline_id) = view.into_inner();
+fn combine_pass(
+    view: ViewQuery<PassView>,
+    cache: Res<PipelineCache>,
+    meshes: Res<RenderAssets<RenderMesh>>,
+    allocator: Res<MeshAllocator>,
+    mut ctx: RenderContext,
+) {
+    let (_, target, depth, frame, textures, params, bind_group, pipeline_id, older) =
+        view.into_inner();
     let newer = frame.buffer;
     let main = target.main_texture();
     let extent = main.size();
@@ -372,6 +440,28 @@ fn combine_pass(view: ViewQuery<PassView>, cache: Res<PipelineCache>, mut ctx: R
     };
     let diagnostics = ctx.diagnostic_recorder();
     let diagnostics = diagnostics.as_deref();
+    if let Some(older) = older {
+        // Runs every frame, cleared to far when no group is in transition, so its diagnostics
+        // count every frame and the combine never reads a stale frame's levels.
+        let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
+            label: Some(OLDER_DEPTH_PASS),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(RenderPassDepthStencilAttachment {
+                view: &textures.older_level_depth.1,
+                depth_ops: Some(Operations {
+                    load: LoadOp::Clear(0.0),
+                    store: StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let span = diagnostics.pass_span(&mut pass, OLDER_DEPTH_PASS);
+        older_depth::draw(&mut pass, older, &cache, &meshes, &allocator);
+        span.end(&mut pass);
+    }
     let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
         label: Some(COMBINE_PASS),
         color_attachments: &[Some(RenderPassColorAttachment {

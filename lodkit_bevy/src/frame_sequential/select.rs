@@ -9,13 +9,14 @@ use bevy::core_pipeline::prepass::MotionVectorPrepass;
 use bevy::log::warn_once;
 use bevy::mesh::{MeshTag, VertexAttributeValues};
 use bevy::prelude::*;
-use bevy::render::render_resource::TextureUsages;
+use bevy::render::render_resource::{Face, TextureUsages};
 use bevy::transform::TransformSystems;
 use lodkit::combine::{ScreenRect, merge_rects, screen_rect};
 use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection, LodState};
 
+use super::older_depth::OlderLevel;
 use super::render::FrameSequentialView;
 use super::tag::{decode_tag, encode_tag};
 use super::{
@@ -339,6 +340,7 @@ fn update(
     mut commands: Commands,
     time: Res<Time>,
     meshes: Res<Assets<Mesh>>,
+    materials: Res<Assets<FrameSequentialMaterial>>,
     mut scheduler: ResMut<Scheduler>,
     mut stats: ResMut<FrameSequentialStats>,
     cameras: CameraQuery,
@@ -403,6 +405,7 @@ fn update(
     // The world motion of each t-instance that moved.
     let mut moved = Vec::new();
     let mut drawn_tau_next = Vec::new();
+    let mut older_levels = Vec::new();
     let mut in_transition = 0;
     // The combine needs last frame's picture: a transition begins only after a frame that the
     // render world kept, and frames are kept only while a group is in transition or about to be.
@@ -463,6 +466,21 @@ fn update(
                     }),
                     None => level_bounds(levels, &meshes),
                 };
+            }
+            // The level this frame does not draw: the combine shows it from last frame's
+            // picture, and the older-level depth pass draws where it is now.
+            let other = state
+                .transition
+                .map(|(from, to)| if lod == from { to } else { from })
+                .and_then(|other| levels.0.get(usize::from(other)));
+            if let Some(other) = other.filter(|_| selection.visible && settings.exact_coverage) {
+                older_levels.push(OlderLevel {
+                    mesh: other.mesh.id(),
+                    world_from_local: model,
+                    cull_mode: materials
+                        .get(&other.material)
+                        .map_or(Some(Face::Back), |m| m.base.cull_mode),
+                });
             }
             let previous = state.previous_model.unwrap_or(model);
             if previous != model {
@@ -552,6 +570,8 @@ fn update(
         object_new_to_old,
         older_tau: last.map_or_else(Vec::new, |l| l.drawn_tau_next.clone()),
         drawn_tau_next,
+        older_levels,
+        exact_coverage: settings.exact_coverage,
         motion_vectors,
         rects: rects
             .iter()

@@ -13,6 +13,7 @@ fn world_with_group(msaa: Msaa) -> (World, Entity) {
     let mut world = World::new();
     world.init_resource::<Time>();
     world.init_resource::<Assets<Mesh>>();
+    world.init_resource::<Assets<FrameSequentialMaterial>>();
     world.init_resource::<Scheduler>();
     world.init_resource::<FrameSequentialStats>();
     let mut camera = Camera::default();
