@@ -128,6 +128,17 @@ pub(crate) fn find_module_source(import_path: &str) -> Option<(&'static str, &'s
         .map(|&(path, source)| (path, source))
 }
 
+/// `(library path, import path, source)` of every WESL module (`wesl/lodkit/<topic>.wesl`,
+/// imported as `lodkit::<topic>`): what [`wesl_modules`] lists, without describing the whole
+/// library first (the cold start of a check that links one WESL shader).
+#[cfg(feature = "wesl")]
+pub(crate) fn wesl_module_sources() -> impl Iterator<Item = (&'static str, String, &'static str)> {
+    FILES.iter().filter_map(|&(path, source)| {
+        let topic = path.strip_prefix("wesl/lodkit/")?.strip_suffix(".wesl")?;
+        Some((path, format!("lodkit::{topic}"), source))
+    })
+}
+
 /// The GLSL twin whose include path is `include_path` (e.g. `lodkit/normal_distance.glsl`).
 pub fn find_glsl_include(include_path: &str) -> Option<&'static ModuleInfo> {
     modules()
