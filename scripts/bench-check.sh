@@ -20,7 +20,8 @@ command -v naga >/dev/null || { echo "error: naga-cli is not on PATH" >&2; exit 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 for file in "$@"; do
-  composed="$work/$(basename "$file")"
+  # naga reads the composed shader as WGSL whatever the source's dialect (.wesl, GLSL).
+  composed="$work/$(basename "${file%.*}").wgsl"
   "$lodkit" export --to wgsl "$file" -o "$composed" 2>/dev/null
   python3 - "$runs" "$lodkit" "$file" "$composed" <<'PY'
 import os, resource, statistics, subprocess, sys, time

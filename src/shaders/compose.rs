@@ -281,35 +281,72 @@ impl ShaderLibrary {
             }
             SourceLanguage::Wgsl => return self.compose_wgsl_validated(desc),
             SourceLanguage::Glsl(stage) => return self.compose_glsl(desc, stage),
-            SourceLanguage::Wesl => self.compose_wesl(desc)?,
+            SourceLanguage::Wesl => {
+                // Linked first without wesl-rs's own checks, which naga repeats on the linked
+                // shader (names defined, no duplicates or cycles, call arities) and which cost
+                // more than naga's validation. A shader that fails, or that links a module of
+                // the user's (whose unused declarations only wesl-rs reads), is linked again
+                // with them: verdicts and diagnostics are those of the checked link, whose WGSL
+                // is the same text.
+                if let Ok((module, false)) = self.compose_wesl(desc, false) {
+                    return match super::memo::validate(
+                        self.memo.as_mut(),
+                        &module,
+                        self.capabilities,
+                    ) {
+                        Ok(info) => Ok(Composed { module, info }),
+                        Err(e) => {
+                            self.compose_wesl(desc, true)?;
+                            Err(validation_error(&e, desc.file_path))
+                        }
+                    };
+                }
+                self.compose_wesl(desc, true)?.0
+            }
         };
         let info = super::memo::validate(self.memo.as_mut(), &module, self.capabilities)
             .map_err(|e| validation_error(&e, desc.file_path))?;
         Ok(Composed { module, info })
     }
 
+    /// Links a WESL shader (with wesl-rs's checks when `checked`) and parses the WGSL; `true`
+    /// beside the module when a module of the user's was linked in.
     #[cfg(feature = "wesl")]
-    fn compose_wesl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
+    fn compose_wesl(
+        &mut self,
+        desc: &ComposeDescriptor,
+        checked: bool,
+    ) -> Result<(naga::Module, bool), ShaderError> {
         let mut defs: Vec<(String, ShaderDefValue)> = desc
             .shader_defs
             .iter()
             .map(|(k, v)| (k.clone(), *v))
             .collect();
         defs.sort_by(|a, b| a.0.cmp(&b.0));
-        let linked =
-            super::wesl_link::link(desc.source, desc.file_path, &defs, &self.wesl_modules)?;
-        naga::front::wgsl::parse_str(&linked.wgsl).map_err(|e| {
+        let linked = super::wesl_link::link(
+            desc.source,
+            desc.file_path,
+            &defs,
+            &self.wesl_modules,
+            checked,
+        )?;
+        let module = naga::front::wgsl::parse_str(&linked.wgsl).map_err(|e| {
             ShaderError::Source(Box::new(super::wesl_link::front_end_diagnostic(
                 &e,
                 &linked,
                 desc.file_path,
                 desc.source,
             )))
-        })
+        })?;
+        Ok((module, linked.with_user_modules))
     }
 
     #[cfg(not(feature = "wesl"))]
-    fn compose_wesl(&mut self, desc: &ComposeDescriptor) -> Result<naga::Module, ShaderError> {
+    fn compose_wesl(
+        &mut self,
+        desc: &ComposeDescriptor,
+        _checked: bool,
+    ) -> Result<(naga::Module, bool), ShaderError> {
         Err(ShaderError::Source(Box::new(Diagnostic::new(
             DiagnosticKind::Parse,
             desc.file_path,

@@ -255,10 +255,11 @@ pub(crate) fn expression_too_deep(text: &str, defines: &[(String, String)]) -> O
 /// makes the count larger.
 pub(crate) fn wgsl_too_deep(source: &str) -> Option<TooDeep> {
     let mut nesting = Nesting::new();
+    let code = super::blank_comments(source, super::CommentSyntax::Wgsl);
+    let source = &*code;
     let mut chars = source.char_indices().peekable();
     let mut line_start = true;
     while let Some((i, c)) = chars.next() {
-        let rest = &source[i..];
         let tok = match c {
             '\n' => {
                 line_start = true;
@@ -267,23 +268,6 @@ pub(crate) fn wgsl_too_deep(source: &str) -> Option<TooDeep> {
             c if c.is_whitespace() => continue,
             '#' if line_start => {
                 while chars.next_if(|&(_, c)| c != '\n').is_some() {}
-                continue;
-            }
-            '/' if rest.starts_with("//") => {
-                while chars.next_if(|&(_, c)| c != '\n').is_some() {}
-                continue;
-            }
-            '/' if rest.starts_with("/*") => {
-                // WGSL block comments nest.
-                let (mut open, mut last) = (0usize, '\0');
-                for (_, c) in chars.by_ref() {
-                    match (last, c) {
-                        ('/', '*') => (open, last) = (open + 1, '\0'),
-                        ('*', '/') if open == 0 => break,
-                        ('*', '/') => (open, last) = (open - 1, '\0'),
-                        _ => last = c,
-                    }
-                }
                 continue;
             }
             '(' | '[' | '{' => Tok::Open,
@@ -311,21 +295,12 @@ pub(crate) fn wgsl_too_deep(source: &str) -> Option<TooDeep> {
 /// The first bracket of `source` that opens level `MAX_NESTING + 1`, skipping `//` and `/* */`
 /// comments; `None` when the source stays within the limit.
 pub(crate) fn too_deep(source: &str) -> Option<TooDeep> {
-    let bytes = source.as_bytes();
+    let code = super::blank_comments(source, super::CommentSyntax::Glsl);
+    let bytes = code.as_bytes();
     let mut depth = 0usize;
     let mut i = 0;
     while i < bytes.len() {
         match bytes[i] {
-            b'/' if bytes.get(i + 1) == Some(&b'/') => {
-                i = source[i..].find('\n').map_or(bytes.len(), |n| i + n);
-                continue;
-            }
-            b'/' if bytes.get(i + 1) == Some(&b'*') => {
-                i = source[i + 2..]
-                    .find("*/")
-                    .map_or(bytes.len(), |n| i + 2 + n + 2);
-                continue;
-            }
             b'(' | b'[' | b'{' => {
                 depth += 1;
                 if depth > MAX_NESTING {

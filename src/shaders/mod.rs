@@ -16,6 +16,7 @@
 //! and their descriptions only ([`modules`], [`find_module`], ...): no naga in the tree, so an
 //! engine on another naga (Bevy's) registers the sources with its own composer.
 
+mod comments;
 #[cfg(feature = "compose")]
 mod compose;
 #[cfg(feature = "compose")]
@@ -48,6 +49,7 @@ pub(crate) use errors::closest;
 #[cfg(feature = "compose")]
 pub use errors::{ShaderError, read_source};
 
+pub use comments::{CommentSyntax, blank_comments};
 #[cfg(feature = "compose")]
 pub use compose::{
     ComposeDescriptor, Composed, LibraryDescriptor, ShaderDefs, ShaderLibrary, SourceLanguage,

@@ -2,6 +2,8 @@
 
 use std::sync::OnceLock;
 
+use super::comments::{CommentSyntax, blank_comments};
+
 /// `(path relative to shader_lib/, source)` for every `.wgsl`, `.wesl` and `.glsl` file, sorted
 /// by path.
 static FILES: &[(&str, &str)] = include!(concat!(env!("OUT_DIR"), "/shader_lib.rs"));
@@ -128,6 +130,17 @@ pub(crate) fn find_module_source(import_path: &str) -> Option<(&'static str, &'s
         .map(|&(path, source)| (path, source))
 }
 
+/// `(library path, import path, source)` of every WESL module (`wesl/lodkit/<topic>.wesl`,
+/// imported as `lodkit::<topic>`): what [`wesl_modules`] lists, without describing the whole
+/// library first (the cold start of a check that links one WESL shader).
+#[cfg(feature = "wesl")]
+pub(crate) fn wesl_module_sources() -> impl Iterator<Item = (&'static str, String, &'static str)> {
+    FILES.iter().filter_map(|&(path, source)| {
+        let topic = path.strip_prefix("wesl/lodkit/")?.strip_suffix(".wesl")?;
+        Some((path, format!("lodkit::{topic}"), source))
+    })
+}
+
 /// The GLSL twin whose include path is `include_path` (e.g. `lodkit/normal_distance.glsl`).
 pub fn find_glsl_include(include_path: &str) -> Option<&'static ModuleInfo> {
     modules()
@@ -200,7 +213,7 @@ fn describe(path: &'static str, source: &'static str) -> ModuleInfo {
         })
         .unwrap_or_default();
     let guard = format!("LODKIT_{}_GLSL", stem.to_ascii_uppercase());
-    let shader_defs = used_shader_defs(source)
+    let shader_defs = used_shader_defs(source, language)
         .into_iter()
         .filter(|d| *d != guard)
         .map(|name| ShaderDefInfo {
@@ -254,15 +267,20 @@ fn header_def_doc(header: &[&str], name: &str) -> String {
         .unwrap_or_default()
 }
 
-/// Shader defs the source tests or substitutes, in order of first use.
-pub(crate) fn used_shader_defs(source: &str) -> Vec<String> {
+/// Shader defs the source tests or substitutes outside comments, in order of first use.
+pub(crate) fn used_shader_defs(source: &str, language: Language) -> Vec<String> {
     let mut defs: Vec<String> = Vec::new();
     let mut push = |name: &str| {
         if !name.is_empty() && !defs.iter().any(|d| d == name) {
             defs.push(name.to_owned());
         }
     };
-    for line in source.lines() {
+    let syntax = match language {
+        Language::Glsl => CommentSyntax::Glsl,
+        Language::Wgsl | Language::Wesl => CommentSyntax::Wgsl,
+    };
+    let code = blank_comments(source, syntax);
+    for line in code.lines() {
         let t = line.trim_start();
         let t = t.strip_prefix("#else").map(str::trim_start).unwrap_or(t);
         for directive in ["#ifdef", "#ifndef", "#if"] {
@@ -275,9 +293,8 @@ pub(crate) fn used_shader_defs(source: &str) -> Vec<String> {
         }
         let mut rest = line;
         // WESL conditions: every name in `@if(...)` / `@elif(...)`.
-        let code = line.split("//").next().unwrap_or_default();
         for attr in ["@if(", "@elif("] {
-            let mut rest = code;
+            let mut rest = line;
             while let Some(i) = rest.find(attr) {
                 let after = &rest[i + attr.len()..];
                 let end = after.find(')').unwrap_or(after.len());

@@ -57,6 +57,8 @@ pub(crate) fn collect_user_modules(
 pub(crate) struct Linked {
     pub wgsl: String,
     renames: Vec<(String, String)>,
+    /// Whether a module of the user's (an include folder's) was linked in.
+    pub with_user_modules: bool,
 }
 
 impl Linked {
@@ -85,12 +87,15 @@ impl Linked {
 }
 
 /// Links `source` (the file `file`) against lodkit's WESL modules and `user_modules`, with
-/// `defs`, and returns the WGSL. Errors point into the file they are in.
+/// `defs`, and returns the WGSL. Errors point into the file they are in. `validate` runs
+/// wesl-rs's own checks (names defined, no duplicates or cycles, call arities) on every module
+/// linked and on the result; without them a link only fails where it cannot go on.
 pub(crate) fn link(
     source: &str,
     file: &str,
     defs: &[(String, ShaderDefValue)],
     user_modules: &[WeslUserModule],
+    validate: bool,
 ) -> Result<Linked, ShaderError> {
     let sources = Sources {
         root: (file.to_owned(), Arc::from(source)),
@@ -99,10 +104,8 @@ pub(crate) fn link(
     let path = |p: &str| -> ModulePath { p.parse().expect("lodkit's module paths parse") };
     let mut resolver = VirtualResolver::new();
     resolver.add_module(path(ROOT), source.to_owned().into());
-    for m in registry::wesl_modules() {
-        if let Some(import) = &m.import_path {
-            resolver.add_module(path(import), m.source.into());
-        }
+    for (_, import, source) in registry::wesl_module_sources() {
+        resolver.add_module(path(&import), source.into());
     }
     // Brackets or operator chains nested past the limits would recurse the WESL parser off the
     // stack.
@@ -145,6 +148,7 @@ pub(crate) fn link(
         // too; imported modules contribute what is used.
         keep_root: true,
         mangle_root: false,
+        validate,
         ..Default::default()
     });
     for (name, value) in defs {
@@ -160,6 +164,11 @@ fn finish(compiler: &Wesl<VirtualResolver<'_>>, sources: &Sources) -> Result<Lin
         .compile(&root)
         .map_err(|e| source_error(sources.diagnostic(e)))?;
     let wgsl = result.to_string();
+    // Anything but the root, lodkit's modules and the defs' constants counts as the user's.
+    let with_user_modules = result.modules.iter().any(|m| {
+        let m = m.to_string();
+        m != ROOT && m != "constants" && !m.starts_with("lodkit::")
+    });
     let mut renames: Vec<(String, String)> = Vec::new();
     if let Some(map) = &result.sourcemap {
         for word in wgsl.split(|c: char| !(c.is_alphanumeric() || c == '_')) {
@@ -171,7 +180,11 @@ fn finish(compiler: &Wesl<VirtualResolver<'_>>, sources: &Sources) -> Result<Lin
             }
         }
     }
-    Ok(Linked { wgsl, renames })
+    Ok(Linked {
+        wgsl,
+        renames,
+        with_user_modules,
+    })
 }
 
 fn source_error(d: Diagnostic) -> ShaderError {
@@ -193,8 +206,9 @@ impl Sources<'_> {
         if let Some(m) = self.user.iter().find(|m| m.module_path == path) {
             return Some((m.file.clone(), m.source.clone()));
         }
-        registry::find_wesl_module(path)
-            .map(|m| (format!("shader_lib/{}", m.path), Arc::from(m.source)))
+        registry::wesl_module_sources()
+            .find(|(_, import, _)| import == path)
+            .map(|(file, _, source)| (format!("shader_lib/{file}"), Arc::from(source)))
     }
 
     /// A diagnostic for a wesl-rs error: in the module it names, at its span when it has one;

@@ -86,6 +86,8 @@ impl Sources {
         let mut queue = vec![(path.to_path_buf(), source.to_owned())];
         while let Some((path, text)) = queue.pop() {
             let language = Lang::of(&path);
+            // A def or an import named in a comment is not one.
+            let text = shaders::blank_comments(&text, language.comments());
             scan_defs(&text, language, &mut found);
             for (key, next) in self.imports(&path, &text, language) {
                 if seen.insert(key) {
@@ -191,6 +193,13 @@ enum Lang {
 }
 
 impl Lang {
+    fn comments(self) -> shaders::CommentSyntax {
+        match self {
+            Self::Wgsl | Self::Wesl => shaders::CommentSyntax::Wgsl,
+            Self::Glsl => shaders::CommentSyntax::Glsl,
+        }
+    }
+
     fn of(path: &Path) -> Self {
         match path.extension().and_then(|e| e.to_str()) {
             Some("wgsl") => Self::Wgsl,
@@ -321,5 +330,63 @@ mod tests {
         );
         assert_eq!(w.flags, ["G", "H"].map(String::from).into());
         assert!(w.valued.contains_key("K"));
+    }
+
+    /// The flags and valued defs `source` (the file `name`) tests, imports not followed.
+    fn defs(name: &str, source: &str) -> (Vec<String>, Vec<String>) {
+        let found = Sources::scan(&[], &[]).defs_of(Path::new(name), source);
+        (
+            found.flags.into_iter().collect(),
+            found.valued.into_keys().collect(),
+        )
+    }
+
+    #[test]
+    fn a_def_named_only_in_a_wgsl_comment_is_not_one() {
+        let src = "// #ifdef LINE_COMMENT\n\
+                   /* #ifdef BLOCK\n\
+                   #if VALUE == 3 /* nested */ #{SUBST}\n\
+                   */\n\
+                   #ifdef REAL /* #ifdef AFTER */\n\
+                   #endif\n\
+                   fn f() -> f32 { return #{N}.0; } // #{NOT_N}\n";
+        assert_eq!(defs("a.wgsl", src), (vec!["REAL".into()], vec!["N".into()]));
+    }
+
+    #[test]
+    fn a_condition_named_only_in_a_wesl_comment_is_not_one() {
+        let src = "// @if(LINE_COMMENT) fn g() {}\n\
+                   /* @if(BLOCK) /* @elif(NESTED) */ constants::HIDDEN */\n\
+                   @if(REAL) fn f() -> f32 { return constants::K; } // constants::NOT_K\n";
+        assert_eq!(defs("a.wesl", src), (vec!["REAL".into()], vec!["K".into()]));
+    }
+
+    #[test]
+    fn a_def_named_only_in_a_glsl_comment_is_not_one() {
+        let src = "#version 450\n\
+                   // #ifdef LINE_COMMENT\n\
+                   /* #if defined(BLOCK)\n\
+                   #elif VALUE == 2 */\n\
+                   #if defined(REAL) && LEVEL > 1 // #ifdef TRAILING\n\
+                   #endif\n\
+                   void main() {}\n";
+        assert_eq!(
+            defs("a.frag", src),
+            (vec!["REAL".into()], vec!["LEVEL".into()])
+        );
+    }
+
+    #[test]
+    fn an_import_named_only_in_a_comment_is_not_followed() {
+        // lodkit::screen_door tests LODKIT_SCREEN_DOOR_BLUE_NOISE: only an import brings it in.
+        let wgsl = "/*\n#import lodkit::screen_door::screen_door_keep\n*/\nfn f() {}\n";
+        assert_eq!(defs("a.wgsl", wgsl), (vec![], vec![]));
+        let wesl = "/*\nimport lodkit::screen_door::screen_door_keep;\n*/\nfn f() {}\n";
+        assert_eq!(defs("a.wesl", wesl), (vec![], vec![]));
+        let imported = "#import lodkit::screen_door::screen_door_keep\nfn f() {}\n";
+        assert_eq!(
+            defs("a.wgsl", imported).0,
+            vec!["LODKIT_SCREEN_DOOR_BLUE_NOISE".to_owned()]
+        );
     }
 }

@@ -17,32 +17,12 @@ pub(super) fn needs_composer(source: &str) -> bool {
     if source.contains("X_naga_oil_") || source.contains("@binding(auto)") {
         return true;
     }
-    let bytes = source.as_bytes();
+    let code = crate::shaders::blank_comments(source, crate::shaders::CommentSyntax::Wgsl);
+    let bytes = code.as_bytes();
     let mut i = 0;
-    // WGSL block comments nest.
-    let mut open_comments = 0usize;
     while i < bytes.len() {
         let rest = &bytes[i..];
-        if open_comments > 0 {
-            if rest.starts_with(b"/*") {
-                open_comments += 1;
-                i += 2;
-            } else if rest.starts_with(b"*/") {
-                open_comments -= 1;
-                i += 2;
-            } else {
-                i += 1;
-            }
-            continue;
-        }
         match bytes[i] {
-            b'/' if rest.starts_with(b"//") => {
-                i += rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
-            }
-            b'/' if rest.starts_with(b"/*") => {
-                open_comments = 1;
-                i += 2;
-            }
             b'#' => return true,
             b':' if rest.starts_with(b"::") => return true,
             b if b.is_ascii_alphabetic() || b == b'_' => {
