@@ -60,6 +60,9 @@ enum Target {
     Glsl,
     GlslEs,
     Wgsl,
+    /// The naga_oil WGSL file itself in WESL form, not composed: `#import`s become `import`s,
+    /// `#ifdef` blocks `@if` attributes (lodkit's converter, as its WESL package is made).
+    Wesl,
 }
 
 #[derive(clap::Args)]
@@ -167,7 +170,8 @@ enum Command {
         #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
         fb_size: (u32, u32),
     },
-    /// Compose a shader and write it through one of naga's back ends.
+    /// Compose a shader and write it through one of naga's back ends (`--to wesl`: convert a
+    /// naga_oil WGSL file to WESL instead).
     Export {
         #[command(flatten)]
         compose: ComposeArgs,
@@ -327,6 +331,54 @@ fn main() -> ExitCode {
     }
 }
 
+/// Writes `bytes` to `output` (`-` for stdout), saying what it wrote as `what`.
+fn write_output(output: &Path, bytes: &[u8], what: &str) -> ExitCode {
+    if output == Path::new("-") {
+        let mut out = Output::default();
+        out.write(bytes);
+        return out.finish(ExitCode::SUCCESS);
+    }
+    match std::fs::write(output, bytes) {
+        Ok(()) => {
+            output::eprintln(&format!("wrote {} ({what})", output.display()));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            output::eprintln(&format!("error: cannot write `{}`: {e}", output.display()));
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// `export --to wesl`: the file converted, not composed. A construct with no WESL form is an
+/// error naming its line (exit 1); an unreadable file exits 2.
+fn export_wesl(file: &Path, output: &Path) -> ExitCode {
+    let source = match std::fs::read_to_string(file) {
+        Ok(s) => s,
+        Err(e) => {
+            output::eprintln(&format!("error: cannot read `{}`: {e}", file.display()));
+            return ExitCode::from(2);
+        }
+    };
+    // No package of its own: imports of lodkit's modules stay `lodkit::...`.
+    match shaders::naga_oil_to_wesl(&source, "", "") {
+        Ok(wesl) => write_output(
+            output,
+            wesl.as_bytes(),
+            &format!("{} bytes of WESL", wesl.len()),
+        ),
+        Err(e) => {
+            output::eprintln(&format!(
+                "error: {}:{}: no WESL form: {}",
+                file.display(),
+                e.line,
+                e.message
+            ));
+            ExitCode::from(1)
+        }
+    }
+}
+
 fn export(
     args: &ComposeArgs,
     to: Target,
@@ -334,6 +386,15 @@ fn export(
     output: &Path,
     file: &Path,
 ) -> ExitCode {
+    let target = match to {
+        Target::Spv => ExportTarget::SpirV,
+        Target::Msl => ExportTarget::Msl,
+        Target::Hlsl => ExportTarget::Hlsl,
+        Target::Glsl => ExportTarget::Glsl,
+        Target::GlslEs => ExportTarget::GlslEs,
+        Target::Wgsl => ExportTarget::Wgsl,
+        Target::Wesl => return export_wesl(file, output),
+    };
     let mut library = match compose::library(args) {
         Ok(l) => l,
         Err(e) => {
@@ -356,14 +417,6 @@ fn export(
             return ExitCode::from(2);
         }
     };
-    let target = match to {
-        Target::Spv => ExportTarget::SpirV,
-        Target::Msl => ExportTarget::Msl,
-        Target::Hlsl => ExportTarget::Hlsl,
-        Target::Glsl => ExportTarget::Glsl,
-        Target::GlslEs => ExportTarget::GlslEs,
-        Target::Wgsl => ExportTarget::Wgsl,
-    };
     let exported = match shaders::export(&composed, target, &ExportOptions { entry_point: entry }) {
         Ok(x) => x,
         Err(e) => {
@@ -373,24 +426,9 @@ fn export(
             return ExitCode::from(if usage { 2 } else { 1 });
         }
     };
-    if output == Path::new("-") {
-        let mut out = Output::default();
-        out.write(&exported.to_bytes());
-        return out.finish(ExitCode::SUCCESS);
-    }
-    let result = std::fs::write(output, exported.to_bytes());
-    match result {
-        Ok(()) => {
-            let what = match exported {
-                Exported::SpirV(w) => format!("{} SPIR-V words", w.len()),
-                Exported::Text(t) => format!("{} bytes of {target}", t.len()),
-            };
-            output::eprintln(&format!("wrote {} ({what})", output.display()));
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            output::eprintln(&format!("error: cannot write `{}`: {e}", output.display()));
-            ExitCode::from(2)
-        }
-    }
+    let what = match &exported {
+        Exported::SpirV(w) => format!("{} SPIR-V words", w.len()),
+        Exported::Text(t) => format!("{} bytes of {target}", t.len()),
+    };
+    write_output(output, &exported.to_bytes(), &what)
 }

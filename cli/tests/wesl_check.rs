@@ -68,3 +68,72 @@ fn wesl_type_error_points_at_the_argument_as_written() {
     );
     assert!(!stderr.contains("lodkit__"), "no mangled names: {stderr}");
 }
+
+/// Every lodkit pass converts to WESL (`lodkit export --to wesl`, as a Bevy 0.20 project holds
+/// its shaders) and the WESL form checks under every combination of the defs it tests. A pass
+/// whose `#ifdef` blocks declare what later code uses would convert to blocks it cannot leave.
+#[test]
+fn every_pass_exports_to_wesl_that_checks_under_every_def_set() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let passes = concat!(env!("CARGO_MANIFEST_DIR"), "/../shader_lib/passes");
+    let mut converted = Vec::new();
+    for entry in std::fs::read_dir(passes).expect("shader_lib/passes") {
+        let path = entry.expect("an entry").path();
+        let out = dir
+            .path()
+            .join(path.file_stem().expect("a name"))
+            .with_extension("wesl");
+        let status = crate::cli::lodkit()
+            .args(["export", "--to", "wesl"])
+            .arg(&path)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .expect("run lodkit");
+        assert!(
+            status.status.success(),
+            "{}: {}",
+            path.display(),
+            String::from_utf8_lossy(&status.stderr)
+        );
+        converted.push(out);
+    }
+    assert_eq!(converted.len(), 7, "lodkit's passes");
+    let check = crate::cli::lodkit()
+        .args(["check", "--permute"])
+        .args(&converted)
+        .output()
+        .expect("run lodkit");
+    let stdout = String::from_utf8_lossy(&check.stdout);
+    assert!(
+        check.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+    assert_eq!(
+        stdout.lines().filter(|l| l.starts_with("ok: ")).count(),
+        7,
+        "{stdout}"
+    );
+}
+
+/// A value condition has no WESL form: `export --to wesl` names its line and exits 1.
+#[test]
+fn export_to_wesl_names_the_line_without_a_wesl_form() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let file = dir.path().join("valued.wgsl");
+    std::fs::write(
+        &file,
+        "@fragment\nfn main() -> @location(0) vec4<f32> {\n#if SAMPLES == 4\n    return vec4<f32>(1.0);\n#else\n    return vec4<f32>(0.0);\n#endif\n}\n",
+    )
+    .expect("write the shader");
+    let out = crate::cli::lodkit()
+        .args(["export", "--to", "wesl"])
+        .arg(&file)
+        .args(["-o", "-"])
+        .output()
+        .expect("run lodkit");
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("valued.wgsl:3:"), "{stderr}");
+}

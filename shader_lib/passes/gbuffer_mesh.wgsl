@@ -55,15 +55,14 @@ fn vs_main(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
     return VertexOut(camera.view_proj * world, (draw.model * vec4<f32>(normal, 0.0)).xyz, view_pos, position);
 }
 
-#ifdef GBUFFER_MESH_PACKED
-/// Stripes over Lambert; writes color, view depth and the screen-space normal.
-@fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<u32> {
-#else
-/// Stripes over Lambert; writes color, view depth and the screen-space normal.
-@fragment
-fn fs_main(in: VertexOut) -> GBufferOutput {
-#endif
+/// What the fragment writes: the color and the view-space normal.
+struct Shaded {
+    color: vec3<f32>,
+    view_normal: vec3<f32>,
+}
+
+/// Stripes over Lambert.
+fn shade(in: VertexOut) -> Shaded {
     let n = normalize(in.world_normal);
     let lambert = max(dot(n, normalize(camera.light_dir.xyz)), 0.0);
     let stripes = 0.5 + 0.5 * sin(18.0 * (in.object_pos.x + in.object_pos.y));
@@ -76,17 +75,27 @@ fn fs_main(in: VertexOut) -> GBufferOutput {
     let ambient = select(0.3, 0.45 * sky / f32(max(work, 1u)), work > 0u);
     let lighting = vec3<f32>(ambient + 0.7 * lambert);
     let albedo = draw.color.rgb * (0.6 + 0.4 * stripes);
+    var color = albedo * lighting;
 #ifdef GBUFFER_MESH_LIGHTING_ONLY
-    let color = lighting;
+    color = lighting;
 #else ifdef GBUFFER_MESH_ALBEDO_ONLY
-    let color = albedo;
-#else
-    let color = albedo * lighting;
+    color = albedo;
 #endif
-    let view_normal = normalize((camera.view * vec4<f32>(n, 0.0)).xyz);
-#ifdef GBUFFER_MESH_PACKED
-    return gbuffer_pack_texel(vec4<f32>(color, 1.0), -in.view_pos.z, view_normal);
-#else
-    return gbuffer_output(vec4<f32>(color, 1.0), -in.view_pos.z, view_normal);
-#endif
+    return Shaded(color, normalize((camera.view * vec4<f32>(n, 0.0)).xyz));
 }
+
+#ifdef GBUFFER_MESH_PACKED
+/// Stripes over Lambert; writes color, view depth and the screen-space normal.
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<u32> {
+    let s = shade(in);
+    return gbuffer_pack_texel(vec4<f32>(s.color, 1.0), -in.view_pos.z, s.view_normal);
+}
+#else
+/// Stripes over Lambert; writes color, view depth and the screen-space normal.
+@fragment
+fn fs_main(in: VertexOut) -> GBufferOutput {
+    let s = shade(in);
+    return gbuffer_output(vec4<f32>(s.color, 1.0), -in.view_pos.z, s.view_normal);
+}
+#endif

@@ -72,8 +72,9 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(v.position.xy);
     let full = textureLoad(full_geometry, pixel, 0);
+    var color: vec4<f32>;
 #ifdef LODKIT_UPSAMPLE_PACKED
-    let color = bilateral_upsample_packed_at(
+    color = bilateral_upsample_packed_at(
         low,
         params.low_viewport,
         params.full_size,
@@ -84,7 +85,7 @@ fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
         params.sigma_n,
     );
 #else
-    let color = bilateral_upsample_at(
+    color = bilateral_upsample_at(
         low_color,
         low_geometry,
         params.low_viewport,
