@@ -12,6 +12,7 @@
 //   vs_main   @location(0) position, @location(1) normal (object space)
 //   fs_main   GBufferOutput (location 0 color, location 1 rgba16float geometry); with
 //             GBUFFER_MESH_PACKED, location 0 the packed rgba32uint texel
+//   (shade    the color and view-space normal both forms of fs_main write)
 // Bindings: group 0: 0 `camera: GCamera` (uniform); group 1: 0 `draw: GDraw` (uniform, dynamic
 // offset).
 // Shader defs: (with neither set, color is the full shading, albedo x lighting)
