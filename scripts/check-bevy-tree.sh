@@ -20,6 +20,10 @@ while [ $# -gt 0 ]; do
     *) echo "usage: check-bevy-tree.sh [--lodkit PATH] [--offline] [-- LODKIT_CHECK_ARGS...]" >&2; exit 2 ;;
   esac
 done
+# The check runs from a scratch folder: a relative path to lodkit is taken from here.
+case $lodkit in
+  */*) lodkit=$(cd "$(dirname "$lodkit")" && pwd)/$(basename "$lodkit") ;;
+esac
 crates=(bevy_pbr bevy_core_pipeline bevy_render bevy_sprite_render bevy_ui_render
   bevy_gizmos_render bevy_anti_alias bevy_post_process)
 work=$(mktemp -d)
