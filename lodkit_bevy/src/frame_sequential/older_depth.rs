@@ -110,9 +110,11 @@ impl SpecializedMeshPipeline for OlderDepthPipeline {
     }
 }
 
-/// The camera's draws this frame: a pipeline, a mesh and a uniform offset each.
-#[derive(Component)]
+/// The camera's draws this frame: a pipeline, a mesh and a uniform offset each, and the
+/// uniform buffer they read (kept from frame to frame, rewritten in place).
+#[derive(Component, Default)]
 pub struct OlderDepthDraws {
+    uniforms: DynamicUniformBuffer<OlderLevelUniform>,
     bind_group: Option<BindGroup>,
     draws: Vec<(CachedRenderPipelineId, AssetId<Mesh>, u32)>,
 }
@@ -134,18 +136,31 @@ pub(super) fn prepare_draws(
         &ExtractedView,
         &FrameSequentialView,
         &mut CombineParams,
+        Option<&mut OlderDepthDraws>,
     )>,
 ) {
-    for (entity, view, frame, mut params) in &mut views {
+    for (entity, view, frame, mut params, kept) in &mut views {
         if !frame.exact_coverage {
-            commands.entity(entity).remove::<OlderDepthDraws>();
+            if kept.is_some() {
+                commands.entity(entity).remove::<OlderDepthDraws>();
+            }
             continue;
         }
         let clip_from_world = view
             .clip_from_world
             .unwrap_or_else(|| view.clip_from_view * view.world_from_view.to_matrix().inverse());
-        let mut uniforms = DynamicUniformBuffer::<OlderLevelUniform>::default();
-        let mut draws = Vec::new();
+        let mut fresh = OlderDepthDraws::default();
+        let (draws_of_view, is_new) = match kept {
+            Some(kept) => (kept.into_inner(), false),
+            None => (&mut fresh, true),
+        };
+        let OlderDepthDraws {
+            uniforms,
+            bind_group,
+            draws,
+        } = draws_of_view;
+        uniforms.clear();
+        draws.clear();
         // Until every level can be drawn (a pipeline still compiling, a mesh not uploaded),
         // the combine places the older levels from last frame's picture instead.
         let mut ready = true;
@@ -174,7 +189,7 @@ pub(super) fn prepare_draws(
             draws.push((id, level.mesh, offset));
         }
         uniforms.write_buffer(&device, &queue);
-        let bind_group = uniforms.binding().map(|binding| {
+        *bind_group = uniforms.binding().map(|binding| {
             device.create_bind_group(
                 OLDER_DEPTH_PASS,
                 &cache.get_bind_group_layout(&pipeline.layout),
@@ -182,9 +197,9 @@ pub(super) fn prepare_draws(
             )
         });
         params.set_exact_coverage(ready);
-        commands
-            .entity(entity)
-            .insert(OlderDepthDraws { bind_group, draws });
+        if is_new {
+            commands.entity(entity).insert(fresh);
+        }
     }
 }
 
