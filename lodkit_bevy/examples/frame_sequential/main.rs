@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! cargo run --example frame_sequential [-- [--out DIR] [--report FILE] [--frames DIR]
-//!     [--schedule complementary|paper] [--anchor screen|object] [--no-reprojection]
+//!     [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection]
 //!     [--exact-coverage] [--without-prepass-only]]
 //! ```
 //!
@@ -15,7 +15,8 @@
 //! moving camera's transitions), with `--report` the figures as JSON (pop, flicker, reversals,
 //! see-through, ghosts, coverage, fragments per pass), with `--frames DIR` every frame of every run as
 //! `DIR/<run>_<static|moving>/<frame>.png` (the references as `reference_fine` and
-//! `reference_coarse`), so anyone can recompute the figures. `--no-reprojection` breaks the
+//! `reference_coarse`), so anyone can recompute the figures. `--schedule` picks how the two
+//! levels share the pattern (default `paper`, the plugin's default). `--no-reprojection` breaks the
 //! combine on purpose (the older frame read at the same pixel): the moving camera then shows the
 //! background through the objects. `--exact-coverage` turns on
 //! `FrameSequentialLod::exact_coverage` (the older-level depth pass; its depth samples are the
@@ -59,7 +60,7 @@ pub struct Args {
 }
 
 const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] [--frames DIR] \
-[--schedule complementary|paper] [--anchor screen|object] [--no-reprojection] \
+[--schedule paper|complementary] [--anchor screen|object] [--no-reprojection] \
 [--exact-coverage] [--without-prepass-only]";
 
 fn parse() -> Result<Option<Args>, String> {
@@ -68,7 +69,7 @@ fn parse() -> Result<Option<Args>, String> {
         report: None,
         frames: None,
         with_prepass: true,
-        schedule: Schedule::Complementary,
+        schedule: Schedule::default(),
         anchor: VisibilitySpace::Screen,
         reprojection: true,
         exact_coverage: false,

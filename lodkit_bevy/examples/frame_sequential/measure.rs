@@ -31,6 +31,47 @@ pub fn flicker(run: &[Frame], reference: &[Frame]) -> Result<Flicker, MetricsErr
     metrics::flicker(&bytes(run), &bytes(reference))
 }
 
+/// [`flicker`] over the still pixels only: those where neither reference run (`fine`, `coarse`)
+/// changes from its first frame to its last (objects that do not move, under a camera that does
+/// not). Each such pixel has two fixed colors to move between, so a run that switches it once, or
+/// once through a blend of the two, scores 1 exactly; any back-and-forth of even one level scores
+/// above 1. Elsewhere the run is taken as the fine reference (no change counted).
+pub fn still_flicker(
+    run: &[Frame],
+    fine: &[Frame],
+    coarse: &[Frame],
+) -> Result<Flicker, MetricsError> {
+    let (Some(first), Some(coarse_first)) = (fine.first(), coarse.first()) else {
+        return metrics::flicker(&[] as &[Vec<u8>], &[] as &[Vec<u8>]);
+    };
+    let same = |a: &Frame, b: &Frame, i: usize| a.rgba[i..i + 3] == b.rgba[i..i + 3];
+    let still: Vec<bool> = (0..first.rgba.len())
+        .step_by(4)
+        .map(|i| {
+            fine.iter()
+                .all(|f| f.rgba.len() == first.rgba.len() && same(f, first, i))
+                && coarse
+                    .iter()
+                    .all(|c| c.rgba.len() == first.rgba.len() && same(c, coarse_first, i))
+        })
+        .collect();
+    let masked: Vec<Vec<u8>> = run
+        .iter()
+        .zip(fine)
+        .map(|(r, f)| {
+            let mut out = f.rgba.clone();
+            for (i, _) in still.iter().enumerate().filter(|(_, s)| **s) {
+                if let Some(px) = r.rgba.get(4 * i..4 * i + 4) {
+                    out[4 * i..4 * i + 4].copy_from_slice(px);
+                }
+            }
+            out
+        })
+        .collect();
+    let reference: Vec<&[u8]> = fine.iter().map(|f| f.rgba.as_slice()).collect();
+    metrics::flicker(&masked, &reference)
+}
+
 /// Per frame of `frames`: the pixels where `counts(shown, fine, coarse)` holds, each argument
 /// whether that frame covers the pixel (shows something other than `background`).
 fn count_pixels(

@@ -12,7 +12,7 @@ use serde_json::{Map, Value};
 use crate::Args;
 use crate::frames::{Frame, strip};
 use crate::headless::save_png;
-use crate::measure::{coverage, flicker, ghosts, pop, see_through};
+use crate::measure::{coverage, flicker, ghosts, pop, see_through, still_flicker};
 use crate::run::{BACKGROUND, Failure, HEIGHT, Harness, PARTS, Pass, Run, WIDTH};
 use crate::scene::{FRAMES, Technique};
 
@@ -139,6 +139,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             report.insert(format!("pop_{name}_{path}"), p.into());
             report.insert(format!("flicker_{name}_{path}"), f.ratio().into());
             report.insert(format!("reversals_{name}_{path}"), f.reversals.into());
+            if !moving {
+                let still = still_flicker(&run.frames, &fine.frames, &coarse.frames)
+                    .map_err(|e| Failure(1, e.to_string()))?;
+                report.insert(format!("flicker_{name}_still_pixels"), still.ratio().into());
+            }
             if moving {
                 let file = args.out.join(format!("strip_{name}.png"));
                 save_png(&strip_of(&run), &file).map_err(io)?;

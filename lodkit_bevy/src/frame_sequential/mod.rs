@@ -7,15 +7,17 @@
 //! the group draws one level per frame, not two as a crossfade does.
 //!
 //! No prepass is needed, as for Bevy's `VisibilityRange` crossfade. In the `frame_sequential`
-//! example, each technique on a camera of its own, over its transitions, frame-sequential LOD
-//! draws 0.73x the crossfade's fragments in an app without a prepass and 0.78x in an app that
-//! runs Bevy's depth and motion-vector prepass anyway (TAA, motion blur), with less pop; on the
-//! flicker measure (change over net change) it scores 2.08 / 6.34 against the crossfade's
-//! 1.97 / 5.52 (still / moving camera), and a moving group's edge shows where it was last frame
-//! in a few pixels (345 pixel-frames over the run; the crossfade none). With
+//! example (the plugin's defaults), each technique on a camera of its own, over its transitions,
+//! frame-sequential LOD draws 0.73x the crossfade's fragments in an app without a prepass and
+//! 0.78x in an app that runs Bevy's depth and motion-vector prepass anyway (TAA, motion blur),
+//! with less pop; on the flicker measure (change over net change) it scores 2.07 / 6.17 against
+//! the crossfade's 1.97 / 5.52 (still / moving camera), and a moving group's edge shows where it
+//! was last frame in a few pixels (497 pixel-frames over the run; the crossfade none). With
 //! [`FrameSequentialLod::exact_coverage`] (a depth-only pass of the levels not drawn this frame)
-//! flicker is 1.99 / 5.63 and no pixel shows a ghost (`cargo run --example frame_sequential --
-//! --report report.json [--exact-coverage]`, and lodkit's docs/engines.md).
+//! it flickers less than the crossfade, 1.91 / 5.12, and no pixel shows a ghost, but the depth
+//! pass's samples bring it to 1.15x the crossfade's fragments without a prepass (0.91x with one)
+//! (`cargo run --example frame_sequential -- --report report.json [--exact-coverage]`, and
+//! lodkit's docs/engines.md).
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -197,8 +199,8 @@ pub struct FrameSequentialLod {
     /// pixels that level covers and reads its colors at its own depth; without it, it places the
     /// level from last frame's picture, whose pixel centers put a silhouette only to within a
     /// texel. On: no trace of a moved group and no silhouette shown a pixel off every other
-    /// frame (in the frame_sequential example, flicker 1.99 / 5.63 against 2.08 / 6.34 off,
-    /// Bevy's crossfade 1.97 / 5.52; ghost pixels 0 against 345). The cost: the pass rasterizes
+    /// frame (in the frame_sequential example, flicker 1.91 / 5.12 against 2.07 / 6.17 off,
+    /// Bevy's crossfade 1.97 / 5.52; ghost pixels 0 against 497). The cost: the pass rasterizes
     /// the older levels of the groups in transition each frame with no fragment stage (lavapipe
     /// still counts its samples as fragment invocations: 2.08 M over the example's transitions,
     /// next to 3.66 M shaded), and one `Depth32Float` target of the camera's size. It draws the

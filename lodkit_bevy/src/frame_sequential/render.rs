@@ -49,7 +49,9 @@ pub struct FrameSequentialView {
     /// Per t-instance drawn this frame with the pattern anchored to the screen: its id and the
     /// tau at which it is displayed next frame (as its tag carries it).
     pub drawn_tau_next: Vec<(u32, f32)>,
-    /// Last frame's `drawn_tau_next`: the levels the older buffer holds.
+    /// Per t-instance whose other level the older buffer holds (drawn last frame, screen
+    /// pattern): its id and the tau at which that level is displayed this frame, this frame's
+    /// threshold for it (complementary to the level drawn now).
     pub older_tau: Vec<(u32, f32)>,
     /// The levels this frame does not draw of the groups in transition, for the older-level
     /// depth pass (empty unless `exact_coverage`).

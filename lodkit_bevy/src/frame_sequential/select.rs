@@ -405,6 +405,7 @@ fn update(
     // The world motion of each t-instance that moved.
     let mut moved = Vec::new();
     let mut drawn_tau_next = Vec::new();
+    let mut older_tau = Vec::new();
     let mut older_levels = Vec::new();
     let mut in_transition = 0;
     // The combine needs last frame's picture: a transition begins only after a frame that the
@@ -456,6 +457,18 @@ fn update(
             in_transition += 1;
             if !object {
                 drawn_tau_next.push((tag_id, tau_next));
+                // The older buffer holds this id's other level when last frame drew the id: the
+                // combine shows that level at this frame's threshold for it, exactly
+                // complementary to the level drawn now. (Last frame's tau_next was a prediction
+                // of this frame's progress; where it missed, pixels had both levels or neither.)
+                if let Some(d) = draw.filter(|_| {
+                    last.is_some_and(|l| l.drawn_tau_next.iter().any(|&(id, _)| id == tag_id))
+                }) {
+                    older_tau.push((
+                        tag_id,
+                        scheduler.schedule().threshold(d.progress, !d.incoming),
+                    ));
+                }
             }
             if state.bounds.is_none() {
                 state.bounds = match group.bounds {
@@ -568,7 +581,7 @@ fn update(
         clip_from_view,
         new_to_old,
         object_new_to_old,
-        older_tau: last.map_or_else(Vec::new, |l| l.drawn_tau_next.clone()),
+        older_tau,
         drawn_tau_next,
         older_levels,
         exact_coverage: settings.exact_coverage,

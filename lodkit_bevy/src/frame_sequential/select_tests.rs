@@ -139,3 +139,35 @@ fn changed_levels_release_the_groups_transition() {
     let levels = world.get::<FrameSequentialLevels>(group).unwrap();
     assert_eq!((levels.key, levels.transition), (None, None));
 }
+
+/// With the pattern on the screen, the combine shows the older level at this frame's threshold
+/// for it, complementary to the level drawn now, also when the transition's progress jumps
+/// (last frame's tau_next, a prediction, would miss: pixels with both levels or neither).
+#[test]
+fn the_older_level_is_shown_at_this_frames_threshold() {
+    let (mut world, group) = world_with_group(Msaa::Off);
+    let mut cameras = world.query::<&mut FrameSequentialLod>();
+    cameras.single_mut(&mut world).unwrap().schedule =
+        lodkit::frame_sequential::Schedule::Complementary;
+    // The band is 3.75..4.25: progress 0.1, 0.1 (begun), 0.2, then 0.7 (predicted 0.3).
+    for z in [1.0, 3.8, 3.8, 3.85, 4.1] {
+        frame(&mut world, group, z);
+    }
+    let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+    let (id, drawn_tau, ..) = decode_tag(world.get::<MeshTag>(levels.entity).unwrap().value);
+    let mut views = world.query::<&FrameSequentialView>();
+    let view = views.single(&world).unwrap();
+    let &(older_id, older_tau) = view
+        .older_tau
+        .iter()
+        .find(|&&(i, _)| i == id)
+        .expect("the older level's tau");
+    assert_eq!(older_id, id);
+    // Complementary: one level shows v <= p (tau p), the other the rest (tau -(1 - p)).
+    assert!(
+        drawn_tau * older_tau < 0.0 && (drawn_tau.abs() + older_tau.abs() - 1.0).abs() < 2e-3,
+        "drawn at {drawn_tau}, older shown at {older_tau}"
+    );
+    let progress = drawn_tau.max(older_tau);
+    assert!((progress - 0.7).abs() < 2e-3, "progress {progress}");
+}
