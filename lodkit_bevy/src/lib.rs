@@ -47,7 +47,7 @@ pub mod prelude {
     pub use crate::frame_sequential::{
         FrameSequentialExtension, FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod,
         FrameSequentialLodPlugin, FrameSequentialMaterial, FrameSequentialStats, LodLevel,
-        LodLevels, VisibilitySpace,
+        LodLevels, OlderCoverage, VisibilitySpace,
     };
     pub use crate::framebuffer_lod::{
         FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodComposite,

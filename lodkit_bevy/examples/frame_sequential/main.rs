@@ -8,7 +8,7 @@
 //! ```text
 //! cargo run --example frame_sequential [-- [--out DIR] [--report FILE] [--frames DIR]
 //!     [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection]
-//!     [--exact-coverage] [--without-prepass-only]]
+//!     [--coverage estimated|silhouette|depth-pass] [--without-prepass-only]]
 //! ```
 //!
 //! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_<run>.png` (7 frames over the
@@ -18,9 +18,9 @@
 //! `reference_coarse`), so anyone can recompute the figures. `--schedule` picks how the two
 //! levels share the pattern (default `paper`, the plugin's default). `--no-reprojection` breaks the
 //! combine on purpose (the older frame read at the same pixel): the moving camera then shows the
-//! background through the objects. `--exact-coverage` turns on
-//! `FrameSequentialLod::exact_coverage` (the older-level depth pass; its depth samples are the
-//! report's `fragments_<run>_older_depth`). `--without-prepass-only` skips the app with a
+//! background through the objects. `--coverage` sets `FrameSequentialLod::coverage` (default
+//! `estimated`; with `depth-pass` the older-level depth pass's samples are the report's
+//! `fragments_<run>_older_depth`). `--without-prepass-only` skips the app with a
 //! prepass.
 //! Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
 //!
@@ -45,7 +45,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use lodkit::frame_sequential::Schedule;
-use lodkit_bevy::frame_sequential::VisibilitySpace;
+use lodkit_bevy::frame_sequential::{OlderCoverage, VisibilitySpace};
 
 /// Parsed command line.
 pub struct Args {
@@ -56,12 +56,12 @@ pub struct Args {
     schedule: Schedule,
     anchor: VisibilitySpace,
     reprojection: bool,
-    exact_coverage: bool,
+    coverage: OlderCoverage,
 }
 
 const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] [--frames DIR] \
 [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection] \
-[--exact-coverage] [--without-prepass-only]";
+[--coverage estimated|silhouette|depth-pass] [--without-prepass-only]";
 
 fn parse() -> Result<Option<Args>, String> {
     let mut args = Args {
@@ -72,7 +72,7 @@ fn parse() -> Result<Option<Args>, String> {
         schedule: Schedule::default(),
         anchor: VisibilitySpace::Screen,
         reprojection: true,
-        exact_coverage: false,
+        coverage: OlderCoverage::default(),
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -98,7 +98,14 @@ fn parse() -> Result<Option<Args>, String> {
                 }
             }
             "--no-reprojection" => args.reprojection = false,
-            "--exact-coverage" => args.exact_coverage = true,
+            "--coverage" => {
+                args.coverage = match value()?.as_str() {
+                    "estimated" => OlderCoverage::Estimated,
+                    "silhouette" => OlderCoverage::Silhouette,
+                    "depth-pass" => OlderCoverage::DepthPass,
+                    other => return Err(format!("unknown coverage `{other}`")),
+                }
+            }
             _ => return Err(format!("unexpected argument `{arg}`")),
         }
     }

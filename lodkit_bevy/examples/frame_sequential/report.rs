@@ -202,7 +202,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         format!("{:?}", args.anchor).to_lowercase().into(),
     );
     report.insert("reprojection".into(), args.reprojection.into());
-    report.insert("exact_coverage".into(), args.exact_coverage.into());
+    report.insert(
+        "coverage".into(),
+        format!("{:?}", args.coverage).to_lowercase().into(),
+    );
     if let Some(dir) = &args.frames {
         report.insert("frames_dir".into(), dir.display().to_string().into());
     }

@@ -190,7 +190,7 @@ impl Harness {
                     ..default()
                 },
                 reprojection: args.reprojection,
-                exact_coverage: args.exact_coverage,
+                coverage: args.coverage,
             });
         }
         camera.id()

@@ -10,14 +10,13 @@
 //! example (the plugin's defaults), each technique on a camera of its own, over its transitions,
 //! frame-sequential LOD draws 0.73x the crossfade's fragments in an app without a prepass and
 //! 0.78x in an app that runs Bevy's depth and motion-vector prepass anyway (TAA, motion blur),
-//! with less pop; on the flicker measure (change over net change) it scores 2.07 / 6.17 against
-//! the crossfade's 1.97 / 5.52 (still / moving camera), and a moving group's edge shows where it
-//! was last frame in a few pixels (497 pixel-frames over the run; the crossfade none). With
-//! [`FrameSequentialLod::exact_coverage`] (a depth-only pass of the levels not drawn this frame)
-//! it flickers less than the crossfade, 1.91 / 5.12, and no pixel shows a ghost, but the depth
-//! pass's samples bring it to 1.15x the crossfade's fragments without a prepass (0.91x with one)
-//! (`cargo run --example frame_sequential -- --report report.json [--exact-coverage]`, and
-//! lodkit's docs/engines.md).
+//! pops less (0.031 / 0.028 against 0.043 / 0.035, still / moving camera), shows no background
+//! through an object, and flickers less on the change-over-net measure (1.91 / 5.17 against
+//! 1.97 / 5.52): the level not drawn is placed exactly by its silhouette
+//! ([`OlderCoverage::Silhouette`], found on the CPU), and where the paper's schedule shows both
+//! levels a pixel shows their average, a true half blend the crossfade's dither cannot make
+//! (`cargo run --example frame_sequential -- --report report.json`, and lodkit's
+//! docs/engines.md).
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -81,8 +80,10 @@
 
 mod material;
 mod older_depth;
+mod rects;
 mod render;
 mod select;
+mod silhouette;
 mod tag;
 
 use bevy::asset::embedded_asset;
@@ -194,19 +195,44 @@ pub struct FrameSequentialLod {
     /// seeing what reprojection does; a moving camera then shows the background through
     /// objects in transition.
     pub reprojection: bool,
-    /// Whether the level a group does not draw this frame is drawn again, depth only, with
-    /// this frame's camera and transform (default false). The combine then knows exactly which
-    /// pixels that level covers and reads its colors at its own depth; without it, it places the
-    /// level from last frame's picture, whose pixel centers put a silhouette only to within a
-    /// texel. On: no trace of a moved group and no silhouette shown a pixel off every other
-    /// frame (in the frame_sequential example, flicker 1.91 / 5.12 against 2.07 / 6.17 off,
-    /// Bevy's crossfade 1.97 / 5.52; ghost pixels 0 against 497). The cost: the pass rasterizes
-    /// the older levels of the groups in transition each frame with no fragment stage (lavapipe
-    /// still counts its samples as fragment invocations: 2.08 M over the example's transitions,
-    /// next to 3.66 M shaded), and one `Depth32Float` target of the camera's size. It draws the
-    /// level's mesh with the group's transform: skinned, morphed or vertex-animated levels are
-    /// drawn in their rest pose.
-    pub exact_coverage: bool,
+    /// How the combine knows which pixels the level a group does not draw this frame covers
+    /// (default [`OlderCoverage::Silhouette`]; see there for what each costs).
+    #[reflect(ignore)]
+    pub coverage: OlderCoverage,
+}
+
+/// How the combine knows which pixels the older level (the one a group in transition does not
+/// draw this frame) covers now: [`FrameSequentialLod::coverage`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OlderCoverage {
+    /// Exact, from each older level's silhouette (the default): the edges between its faces
+    /// turned to the camera and those turned away, found on the CPU each frame with this frame's
+    /// camera and the group's transform (one facing test per triangle; the mesh's welded
+    /// topology is built once), and tested per pixel in the combine by their winding number.
+    /// No pass is added. Needs a closed triangle mesh whose positions stay in the main world
+    /// (the default `RenderAssetUsages`); a level without one is drawn by the older-level depth
+    /// pass instead, as with [`DepthPass`](Self::DepthPass). Skinned, morphed or
+    /// vertex-animated levels are taken in their rest pose.
+    #[default]
+    Silhouette,
+    /// Exact, from the older-level depth pass: the older levels drawn again each frame, depth
+    /// only (no fragment stage), with this frame's camera and the group's transform, into one
+    /// `Depth32Float` target of the camera's size; the combine also reads the older colors at
+    /// that depth. Works for any mesh; costs the rasterization of those levels (lavapipe counts
+    /// its samples as fragment invocations). Levels are drawn in their rest pose.
+    DepthPass,
+    /// From last frame's picture alone: no extra work, but its pixel centers put a silhouette
+    /// only to within a texel, so a silhouette that moved by a fraction of one shows the other
+    /// level or the background every other frame, and a moving group's edge leaves a trace
+    /// where it was last frame.
+    Estimated,
+}
+
+impl OlderCoverage {
+    /// Whether the coverage is exact (not estimated).
+    pub fn is_exact(self) -> bool {
+        self != Self::Estimated
+    }
 }
 
 impl Default for FrameSequentialLod {
@@ -219,7 +245,7 @@ impl Default for FrameSequentialLod {
                 ..default()
             },
             reprojection: true,
-            exact_coverage: false,
+            coverage: OlderCoverage::default(),
         }
     }
 }

@@ -54,10 +54,13 @@ pub struct FrameSequentialView {
     /// threshold for it (complementary to the level drawn now).
     pub older_tau: Vec<(u32, f32)>,
     /// The levels this frame does not draw of the groups in transition, for the older-level
-    /// depth pass (empty unless `exact_coverage`).
+    /// depth pass (empty unless the coverage is exact; levels with a silhouette are not here).
     pub older_levels: Vec<OlderLevel>,
-    /// Whether the older-level depth pass runs and the combine reads it
-    /// (`FrameSequentialLod::exact_coverage`).
+    /// Per t-instance whose older level's silhouette is known (`OlderCoverage::Silhouette`):
+    /// its id and the silhouette's segments in pixels; the depth pass does not draw it.
+    pub silhouettes: Vec<(u32, Vec<[f32; 4]>)>,
+    /// Whether the coverage is exact (`FrameSequentialLod::coverage` is not `Estimated`): the
+    /// combine reads the silhouettes and the older-level depth pass, which then runs.
     pub exact_coverage: bool,
     /// Whether the combine reads Bevy's motion vectors (the camera has `MotionVectorPrepass`).
     pub motion_vectors: bool,
@@ -167,6 +170,7 @@ impl FromWorld for CombinePipeline {
                     storage_buffer_read_only_sized(false, None),
                     texture_2d(TextureSampleType::Float { filterable: false }),
                     texture_depth_2d(),
+                    storage_buffer_read_only_sized(false, None),
                 ),
             ),
         );
@@ -343,10 +347,15 @@ fn prepare_bind_groups(
             // Not read (flags.x = 0): any texture of the layout's type.
             None => &fallback.d2.texture_view,
         };
-        let objects = object_data(view);
+        let (objects, segments) = object_data(view);
         let object_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
             label: Some("lodkit_frame_sequential_objects"),
             contents: &objects,
+            usage: BufferUsages::STORAGE,
+        });
+        let segment_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
+            label: Some("lodkit_frame_sequential_silhouettes"),
+            contents: &segments,
             usage: BufferUsages::STORAGE,
         });
         let (newer, older) = (view.buffer, 1 - view.buffer);
@@ -363,32 +372,56 @@ fn prepare_bind_groups(
                 object_buffer.as_entire_binding(),
                 &visibility.texture_view,
                 &textures.older_level_depth.1,
+                segment_buffer.as_entire_binding(),
             )),
         );
         commands.entity(entity).insert(CombineBindGroup(bind_group));
     }
 }
 
-/// combine.wesl's `objects`, as bytes: per t-instance id (up to the largest named), the
-/// reprojection of its pixels and the tau its older level is displayed at.
-fn object_data(view: &FrameSequentialView) -> Vec<u8> {
+/// combine.wesl's `objects` and `silhouettes`, as bytes: per t-instance id (up to the largest
+/// named), the reprojection of its pixels, the tau its older level is displayed at and where its
+/// older level's silhouette lies among the segments; then the segments (one zero segment when
+/// there are none: a storage buffer is not empty).
+fn object_data(view: &FrameSequentialView) -> (Vec<u8>, Vec<u8>) {
     let ids = view.object_new_to_old.iter().map(|&(id, _)| id);
     let slots = ids
         .chain(view.older_tau.iter().map(|&(id, _)| id))
+        .chain(view.silhouettes.iter().map(|&(id, _)| id))
         .max()
         .map_or(1, |id| id as usize + 1);
-    let mut objects = vec![(view.new_to_old, Vec4::ZERO); slots];
+    let mut objects = vec![(view.new_to_old, Vec4::ZERO, UVec4::ZERO); slots];
     for &(id, m) in &view.object_new_to_old {
         objects[id as usize].0 = m;
     }
     for &(id, tau) in &view.older_tau {
         objects[id as usize].1 = Vec4::new(tau, 1.0, 0.0, 0.0);
     }
-    objects
+    let mut segments: Vec<[f32; 4]> = Vec::new();
+    for (id, outline) in &view.silhouettes {
+        objects[*id as usize].2 = UVec4::new(segments.len() as u32, outline.len() as u32, 1, 0);
+        segments.extend_from_slice(outline);
+    }
+    if segments.is_empty() {
+        segments.push([0.0; 4]);
+    }
+    let objects = objects
         .iter()
-        .flat_map(|(m, t)| m.to_cols_array().into_iter().chain(t.to_array()))
-        .flat_map(f32::to_le_bytes)
-        .collect()
+        .flat_map(|(m, t, s)| {
+            let floats = m.to_cols_array().into_iter().chain(t.to_array());
+            floats
+                .map(f32::to_le_bytes)
+                .chain(s.to_array().map(u32::to_le_bytes))
+                .collect::<Vec<_>>()
+        })
+        .flatten()
+        .collect();
+    let segments = segments
+        .iter()
+        .flatten()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    (objects, segments)
 }
 
 type PassView = (

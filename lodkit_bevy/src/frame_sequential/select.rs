@@ -3,35 +3,40 @@
 //! reprojection matrix).
 
 use bevy::camera::CameraUpdateSystems;
-use bevy::camera::primitives::MeshAabb;
 use bevy::camera::visibility::VisibilitySystems;
 use bevy::core_pipeline::prepass::MotionVectorPrepass;
 use bevy::log::warn_once;
-use bevy::mesh::{MeshTag, VertexAttributeValues};
+use bevy::mesh::MeshTag;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Face, TextureUsages};
 use bevy::transform::TransformSystems;
-use lodkit::combine::{ScreenRect, merge_rects, screen_rect};
+use lodkit::combine::{ScreenRect, merge_rects};
 use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection, LodState};
 
 use super::older_depth::OlderLevel;
+use super::rects::{Bounds, group_rect, level_bounds, to_lodkit};
 use super::render::FrameSequentialView;
+use super::silhouette::{NoSilhouette, Surfaces, forget_changed_meshes};
 use super::tag::{decode_tag, encode_tag};
 use super::{
-    FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, VisibilitySpace,
+    FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, OlderCoverage,
+    VisibilitySpace,
 };
-
-/// Pixels the combine rectangles grow by on each side (rasterization and reprojection reach).
-const RECT_DILATE: u32 = 1;
 
 pub(super) fn build(app: &mut App) {
     app.init_resource::<Scheduler>()
         .init_resource::<FrameSequentialStats>()
+        .init_resource::<Surfaces>()
         .add_systems(
             PostUpdate,
-            (configure_depth_copies, spawn_levels, update)
+            (
+                configure_depth_copies,
+                spawn_levels,
+                forget_changed_meshes,
+                update,
+            )
                 .chain()
                 .after(TransformSystems::Propagate)
                 .after(CameraUpdateSystems)
@@ -62,14 +67,6 @@ pub struct FrameSequentialLevels {
     /// The group's model matrix last frame (where the older buffer holds it).
     previous_model: Option<Mat4>,
     bounds: Option<Bounds>,
-}
-
-/// A group's bounds: the box, and the sphere around the box's center holding every vertex.
-#[derive(Clone, Copy, Debug)]
-struct Bounds {
-    lo: Vec3,
-    hi: Vec3,
-    radius: f32,
 }
 
 /// What the last frame's selection did, for reports and tests.
@@ -143,111 +140,6 @@ fn spawn_levels(
             previous_model: None,
             bounds: None,
         });
-    }
-}
-
-/// Bevy 0.20's glam and lodkit's differ in version: matrices cross as arrays.
-fn to_lodkit(m: Mat4) -> glam::Mat4 {
-    glam::Mat4::from_cols_array(&m.to_cols_array())
-}
-
-/// The union of the level meshes' bounds, once every mesh is loaded.
-fn level_bounds(levels: &LodLevels, meshes: &Assets<Mesh>) -> Option<Bounds> {
-    let mut boxed: Option<(Vec3, Vec3)> = None;
-    for level in &levels.0 {
-        let aabb = meshes.get(&level.mesh)?.get_aabb()?;
-        let (lo, hi) = (Vec3::from(aabb.min()), Vec3::from(aabb.max()));
-        boxed = Some(boxed.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
-    }
-    let (lo, hi) = boxed?;
-    let center = (lo + hi) / 2.0;
-    let mut radius = 0.0f32;
-    for level in &levels.0 {
-        let Some(VertexAttributeValues::Float32x3(positions)) = meshes
-            .get(&level.mesh)
-            .and_then(|m| m.attribute(Mesh::ATTRIBUTE_POSITION))
-        else {
-            radius = (hi - lo).length() / 2.0;
-            break;
-        };
-        for p in positions {
-            radius = radius.max(Vec3::from(*p).distance(center));
-        }
-    }
-    Some(Bounds { lo, hi, radius })
-}
-
-/// The screen rectangle of a sphere (world `center`, `radius`) under a symmetric perspective
-/// projection: the tangent planes through the eye in x and y. None where it does not apply
-/// (an orthographic projection, the eye within the sphere's depth).
-fn sphere_rect(
-    center: Vec3,
-    radius: f32,
-    view_from_world: Mat4,
-    clip_from_view: Mat4,
-    size: UVec2,
-    dilate: u32,
-) -> Option<ScreenRect> {
-    if clip_from_view.w_axis.w != 0.0 {
-        return None;
-    }
-    let c = view_from_world.transform_point3(center);
-    let z = -c.z;
-    let denom = z * z - radius * radius;
-    if z <= radius || denom <= 0.0 {
-        return None;
-    }
-    let slopes = |a: f32| {
-        let t = (a * a + denom).sqrt();
-        ((a * z - radius * t) / denom, (a * z + radius * t) / denom)
-    };
-    let (x0, x1) = slopes(c.x);
-    let (y0, y1) = slopes(c.y);
-    let (w, h) = (size.x as f32, size.y as f32);
-    let px = |s: f32| (clip_from_view.x_axis.x * s * 0.5 + 0.5) * w;
-    let py = |s: f32| (0.5 - clip_from_view.y_axis.y * s * 0.5) * h;
-    let d = dilate as f32;
-    let left = (px(x0) - d).floor().clamp(0.0, w);
-    let right = (px(x1) + d).ceil().clamp(0.0, w);
-    let top = (py(y1) - d).floor().clamp(0.0, h);
-    let bottom = (py(y0) + d).ceil().clamp(0.0, h);
-    Some(ScreenRect {
-        x: left as u32,
-        y: top as u32,
-        width: (right - left).max(0.0) as u32,
-        height: (bottom - top).max(0.0) as u32,
-    })
-}
-
-/// The combine rectangle of a group drawn with `model` by a camera: its box's rectangle
-/// (lodkit::combine::screen_rect) cut down to its bounding sphere's. None: off screen.
-fn group_rect(
-    bounds: Bounds,
-    model: Mat4,
-    view_from_world: Mat4,
-    clip_from_view: Mat4,
-    size: UVec2,
-) -> Option<ScreenRect> {
-    let v = |v: Vec3| glam::Vec3::from_array(v.to_array());
-    let boxed = screen_rect(
-        (v(bounds.lo), v(bounds.hi)),
-        to_lodkit(model),
-        &[to_lodkit(clip_from_view * view_from_world)],
-        (size.x, size.y),
-        RECT_DILATE,
-    )?;
-    let scale = model.to_scale_rotation_translation().0.abs().max_element();
-    let center = model.transform_point3((bounds.lo + bounds.hi) / 2.0);
-    match sphere_rect(
-        center,
-        bounds.radius * scale,
-        view_from_world,
-        clip_from_view,
-        size,
-        RECT_DILATE,
-    ) {
-        Some(sphere) => boxed.intersection(&sphere),
-        None => Some(boxed),
     }
 }
 
@@ -343,6 +235,7 @@ fn update(
     materials: Res<Assets<FrameSequentialMaterial>>,
     mut scheduler: ResMut<Scheduler>,
     mut stats: ResMut<FrameSequentialStats>,
+    mut surfaces: ResMut<Surfaces>,
     cameras: CameraQuery,
     mut groups: GroupQuery,
     mut drawers: Query<(
@@ -407,6 +300,7 @@ fn update(
     let mut drawn_tau_next = Vec::new();
     let mut older_tau = Vec::new();
     let mut older_levels = Vec::new();
+    let mut silhouettes = Vec::new();
     let mut in_transition = 0;
     // The combine needs last frame's picture: a transition begins only after a frame that the
     // render world kept, and frames are kept only while a group is in transition or about to be.
@@ -486,14 +380,40 @@ fn update(
                 .transition
                 .map(|(from, to)| if lod == from { to } else { from })
                 .and_then(|other| levels.0.get(usize::from(other)));
-            if let Some(other) = other.filter(|_| selection.visible && settings.exact_coverage) {
-                older_levels.push(OlderLevel {
-                    mesh: other.mesh.id(),
-                    world_from_local: model,
-                    cull_mode: materials
-                        .get(&other.material)
-                        .map_or(Some(Face::Back), |m| m.base.cull_mode),
-                });
+            if let Some(other) = other.filter(|_| selection.visible && settings.coverage.is_exact())
+            {
+                let cull_mode = materials
+                    .get(&other.material)
+                    .map_or(Some(Face::Back), |m| m.base.cull_mode);
+                // Where the level's silhouette can be had on the CPU (a closed triangle mesh
+                // with its positions, culled as usual), it tells the coverage; else the
+                // older-level depth pass draws the level.
+                let outline = if settings.coverage != OlderCoverage::Silhouette
+                    || cull_mode == Some(Face::Front)
+                {
+                    Err(NoSilhouette::NoTriangles)
+                } else {
+                    surfaces.get(other.mesh.id(), &meshes).and_then(|surface| {
+                        surface.silhouette(
+                            clip_from_view * view_from_world * model,
+                            model
+                                .inverse()
+                                .transform_point3(camera_transform.translation()),
+                            size,
+                            model.determinant() > 0.0,
+                        )
+                    })
+                };
+                match outline {
+                    Ok(segments) => {
+                        silhouettes.push((tag_id, segments));
+                    }
+                    _ => older_levels.push(OlderLevel {
+                        mesh: other.mesh.id(),
+                        world_from_local: model,
+                        cull_mode,
+                    }),
+                }
             }
             let previous = state.previous_model.unwrap_or(model);
             if previous != model {
@@ -584,7 +504,8 @@ fn update(
         older_tau,
         drawn_tau_next,
         older_levels,
-        exact_coverage: settings.exact_coverage,
+        silhouettes,
+        exact_coverage: settings.coverage.is_exact(),
         motion_vectors,
         rects: rects
             .iter()

@@ -16,6 +16,7 @@ fn world_with_group(msaa: Msaa) -> (World, Entity) {
     world.init_resource::<Assets<FrameSequentialMaterial>>();
     world.init_resource::<Scheduler>();
     world.init_resource::<FrameSequentialStats>();
+    world.init_resource::<Surfaces>();
     let mut camera = Camera::default();
     // P[1][1] = 1: lodkit::select's distance is the distance itself.
     camera.computed.clip_from_view = Mat4::from_cols_array(
