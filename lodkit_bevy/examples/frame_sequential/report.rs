@@ -139,6 +139,30 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             report.insert(format!("pop_{name}_{path}"), p.into());
             report.insert(format!("flicker_{name}_{path}"), f.ratio().into());
             report.insert(format!("reversals_{name}_{path}"), f.reversals.into());
+            // The silhouettes' CPU time per frame, over the frames that found any (the first
+            // of a mesh builds its surface too).
+            let times: Vec<f64> = run
+                .silhouettes
+                .iter()
+                .filter(|(_, triangles)| *triangles > 0)
+                .map(|(us, _)| *us)
+                .collect();
+            if c.technique == Technique::FrameSequential && !times.is_empty() {
+                let triangles = run.silhouettes.iter().map(|s| s.1).max().unwrap_or(0);
+                println!(
+                    "{name:30} {path:6}: silhouettes {:.1} us per frame (median of {}), up to {triangles} triangles",
+                    lodkit::metrics::median(&times),
+                    times.len()
+                );
+                report.insert(
+                    format!("silhouette_us_{name}_{path}"),
+                    lodkit::metrics::median(&times).into(),
+                );
+                report.insert(
+                    format!("silhouette_triangles_{name}_{path}"),
+                    triangles.into(),
+                );
+            }
             if !moving {
                 let still = still_flicker(&run.frames, &fine.frames, &coarse.frames)
                     .map_err(|e| Failure(1, e.to_string()))?;

@@ -13,7 +13,8 @@ use bevy::render::diagnostic::RenderDiagnosticsPlugin;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use lodkit::select::{LodSettings, TransitionMode};
 use lodkit_bevy::frame_sequential::{
-    COMBINE_PASS, FrameSequentialLod, FrameSequentialLodPlugin, OLDER_DEPTH_PASS,
+    COMBINE_PASS, FrameSequentialLod, FrameSequentialLodPlugin, FrameSequentialStats,
+    OLDER_DEPTH_PASS,
 };
 
 use crate::Args;
@@ -87,6 +88,9 @@ pub struct Run {
     pub fragments: Vec<[f64; PARTS]>,
     /// Per frame: whether a group was in its transition band.
     pub in_transition: Vec<bool>,
+    /// Per frame: the CPU time (microseconds) the plugin spent on silhouettes, and the
+    /// triangles they tested (`FrameSequentialStats`; 0 for other techniques).
+    pub silhouettes: Vec<(f64, u64)>,
 }
 
 impl Run {
@@ -233,6 +237,7 @@ impl Harness {
             frames: Vec::new(),
             fragments: Vec::new(),
             in_transition: Vec::new(),
+            silhouettes: Vec::new(),
         };
         for frame in 0..FRAMES {
             let world = self.app.world_mut();
@@ -252,6 +257,11 @@ impl Harness {
             run.in_transition.push(banded);
             let fragments = self.step();
             run.fragments.push(fragments);
+            let stats = self.app.world().resource::<FrameSequentialStats>();
+            run.silhouettes.push((
+                stats.silhouette_time.as_secs_f64() * 1e6,
+                stats.silhouette_triangles,
+            ));
         }
         for _ in 0..DRAIN_UPDATES {
             if self.app.world().resource::<Inbox>().0.len() >= FRAMES {

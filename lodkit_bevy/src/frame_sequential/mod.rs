@@ -209,7 +209,9 @@ pub enum OlderCoverage {
     /// turned to the camera and those turned away, found on the CPU each frame with this frame's
     /// camera and the group's transform (one facing test per triangle; the mesh's welded
     /// topology is built once), and tested per pixel in the combine by their winding number.
-    /// No pass is added. Needs a closed triangle mesh whose positions stay in the main world
+    /// No pass is added; the CPU time is in [`FrameSequentialStats::silhouette_time`] (in the
+    /// frame_sequential example, a median of 29-47 µs per frame for up to 6,624 triangles).
+    /// Needs a closed triangle mesh whose positions stay in the main world
     /// (the default `RenderAssetUsages`); a level without one is drawn by the older-level depth
     /// pass instead, as with [`DepthPass`](Self::DepthPass). Skinned, morphed or
     /// vertex-animated levels are taken in their rest pose.

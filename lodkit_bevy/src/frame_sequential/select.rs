@@ -2,11 +2,14 @@
 //! scheduler, and what the render world needs of the frame (the combine's rectangles and the
 //! reprojection matrix).
 
+use std::time::Duration;
+
 use bevy::camera::CameraUpdateSystems;
 use bevy::camera::visibility::VisibilitySystems;
 use bevy::core_pipeline::prepass::MotionVectorPrepass;
 use bevy::log::warn_once;
 use bevy::mesh::MeshTag;
+use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Face, TextureUsages};
 use bevy::transform::TransformSystems;
@@ -83,6 +86,12 @@ pub struct FrameSequentialStats {
     pub frame_kept: bool,
     /// Frames kept so far (of [`frames`](Self::frames)).
     pub frames_kept: u64,
+    /// CPU time this frame spent finding the older levels' silhouettes
+    /// ([`OlderCoverage::Silhouette`]), building a mesh's surface the first time it is needed
+    /// included.
+    pub silhouette_time: Duration,
+    /// Triangles whose facing this frame's silhouettes tested.
+    pub silhouette_triangles: u64,
 }
 
 /// The combine copies the main pass's depth (the older frame's, next frame): Bevy's depth
@@ -301,6 +310,8 @@ fn update(
     let mut older_tau = Vec::new();
     let mut older_levels = Vec::new();
     let mut silhouettes = Vec::new();
+    let mut silhouette_time = Duration::ZERO;
+    let mut silhouette_triangles = 0;
     let mut in_transition = 0;
     // The combine needs last frame's picture: a transition begins only after a frame that the
     // render world kept, and frames are kept only while a group is in transition or about to be.
@@ -393,7 +404,9 @@ fn update(
                 {
                     Err(NoSilhouette::NoTriangles)
                 } else {
-                    surfaces.get(other.mesh.id(), &meshes).and_then(|surface| {
+                    let start = Instant::now();
+                    let outline = surfaces.get(other.mesh.id(), &meshes).and_then(|surface| {
+                        silhouette_triangles += surface.triangles() as u64;
                         surface.silhouette(
                             clip_from_view * view_from_world * model,
                             model
@@ -402,7 +415,9 @@ fn update(
                             size,
                             model.determinant() > 0.0,
                         )
-                    })
+                    });
+                    silhouette_time += start.elapsed();
+                    outline
                 };
                 match outline {
                     Ok(segments) => {
@@ -467,6 +482,8 @@ fn update(
     }
     let rects = merge_rects(&rects);
     stats.in_transition = in_transition;
+    stats.silhouette_time = silhouette_time;
+    stats.silhouette_triangles = silhouette_triangles;
     stats.frame_kept = !multisampled && (keep_frame || in_transition > 0);
     stats.frames_kept += u64::from(stats.frame_kept);
     stats.combine_pixels = rects.iter().map(ScreenRect::area).sum();

@@ -92,6 +92,11 @@ impl Surface {
         })
     }
 
+    /// Its triangles (degenerate ones left out).
+    pub fn triangles(&self) -> usize {
+        self.triangles.len()
+    }
+
     /// The silhouette under `clip_from_local` (the camera's clip_from_world times the level's
     /// world_from_local) seen from `eye` (the camera position in the mesh's space), on a target
     /// of `size` pixels. `front_ccw`: whether front faces wind counterclockwise in the mesh's
