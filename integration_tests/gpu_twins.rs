@@ -305,3 +305,89 @@ fn alpha_mask_twins_match_on_a_real_mask() {
         "{kept} of 200 kept: the cases miss the disk's edge"
     );
 }
+
+/// Points and segments for the silhouette functions: the point on the segment's line, at its
+/// ends, on either side, a zero-length segment, and a deterministic spread in pixels.
+fn silhouette_cases() -> Vec<[f32; 6]> {
+    let mut cases = vec![
+        [1.0, 1.0, 2.0, 0.0, 2.0, 2.0],
+        [1.0, 1.0, 2.0, 2.0, 2.0, 0.0],
+        [1.0, 1.0, 0.0, 0.0, 0.0, 2.0],
+        [1.0, 1.0, 2.0, 1.0, 2.0, 2.0],
+        [1.0, 1.0, 2.0, 0.0, 2.0, 1.0],
+        [1.0, 1.0, 1.0, 4.0, 1.0, 4.0],
+        [10.5, 20.5, 10.5, 0.0, 10.5, 40.0],
+    ];
+    let mut state = 0x2545_f491_u32;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        (state as f32 / u32::MAX as f32) * 64.0
+    };
+    for _ in 0..96 {
+        cases.push(std::array::from_fn(|_| next()));
+    }
+    cases
+}
+
+/// `lodkit::silhouette`'s crossing (exactly) and distance, WGSL and GLSL, against the Rust twins.
+#[test]
+fn silhouette_wgsl_and_glsl_match_rust_twins() {
+    use glam::Vec2;
+    use lodkit::silhouette::{silhouette_crossing, silhouette_distance};
+    let gpu = lodkit_test_gpu!();
+    let cases = silhouette_cases();
+    let inputs = words(&cases.concat());
+    let wgsl = Probe {
+        header: "#import lodkit::silhouette::{silhouette_crossing, silhouette_distance}",
+        body: "let p = vec2<f32>(inp_f(0u), inp_f(1u));
+               let a = vec2<f32>(inp_f(2u), inp_f(3u));
+               let b = vec2<f32>(inp_f(4u), inp_f(5u));
+               out_u(0u, bitcast<u32>(silhouette_crossing(p, a, b)));
+               out_f(1u, silhouette_distance(p, a, b));",
+        inputs: 6,
+        outputs: 2,
+        texture: None,
+        rgba: &[],
+        urgba: &[],
+    };
+    let glsl = Probe {
+        header: "#include \"lodkit/silhouette.glsl\"",
+        body: "vec2 p = vec2(inp_f(0u), inp_f(1u));
+               vec2 a = vec2(inp_f(2u), inp_f(3u));
+               vec2 b = vec2(inp_f(4u), inp_f(5u));
+               out_u(0u, uint(lodkit_silhouette_crossing(p, a, b)));
+               out_f(1u, lodkit_silhouette_distance(p, a, b));",
+        inputs: 6,
+        outputs: 2,
+        texture: None,
+        rgba: &[],
+        urgba: &[],
+    };
+    let v = |c: &[f32; 6], k: usize| Vec2::new(c[k], c[k + 1]);
+    let crossings: Vec<i32> = cases
+        .iter()
+        .map(|c| silhouette_crossing(v(c, 0), v(c, 2), v(c, 4)))
+        .collect();
+    let distances: Vec<f32> = cases
+        .iter()
+        .map(|c| silhouette_distance(v(c, 0), v(c, 2), v(c, 4)))
+        .collect();
+    assert_eq!(&crossings[..5], &[1, -1, 0, 1, 0], "hand-made cases");
+    assert!(crossings.iter().any(|&c| c != 0) && crossings[7..].contains(&0));
+    for (language, out) in [
+        ("WGSL", run_wgsl(gpu, &wgsl, &inputs)),
+        ("GLSL", run_glsl(gpu, &glsl, &inputs)),
+    ] {
+        let got: Vec<i32> = out.chunks_exact(2).map(|w| w[0] as i32).collect();
+        assert_eq!(got, crossings, "{language} silhouette_crossing");
+        let got: Vec<u32> = out.chunks_exact(2).map(|w| w[1]).collect();
+        assert_close(
+            &floats(&got),
+            &distances,
+            1e-4,
+            &format!("{language} silhouette_distance"),
+        );
+    }
+}

@@ -15,7 +15,9 @@
 //! - [`fullscreen`]: Rust twins of the shader functions of the same names.
 //! - [`frame_sequential`] with [`visibility`], [`lod_buffer`], [`reproject`], [`combine`]:
 //!   frame-sequential LOD interpolation (Scherzer & Wimmer 2008): the transition scheduler, the
-//!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders.
+//!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders;
+//!   [`silhouette`]: where the level not drawn this frame covers the screen, from its mesh's
+//!   silhouette (no rasterization).
 //! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
 //! - [`metrics`]: how a transition looks on read-back frames: pop, flicker (change over net
 //!   change, direction reversals), PSNR, medians.
@@ -54,6 +56,7 @@ pub mod reproject;
 pub mod screen_door;
 pub mod select;
 pub mod shaders;
+pub mod silhouette;
 pub mod unpopping;
 pub mod visibility;
 

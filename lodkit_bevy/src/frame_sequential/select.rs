@@ -407,14 +407,15 @@ fn update(
                     let start = Instant::now();
                     let outline = surfaces.get(other.mesh.id(), &meshes).and_then(|surface| {
                         silhouette_triangles += surface.triangles() as u64;
-                        surface.silhouette(
-                            clip_from_view * view_from_world * model,
-                            model
-                                .inverse()
-                                .transform_point3(camera_transform.translation()),
-                            size,
+                        let eye = model
+                            .inverse()
+                            .transform_point3(camera_transform.translation());
+                        Ok(surface.silhouette(
+                            to_lodkit(clip_from_view * view_from_world * model),
+                            glam::Vec3::from_array(eye.to_array()),
+                            (size.x, size.y),
                             model.determinant() > 0.0,
-                        )
+                        )?)
                     });
                     silhouette_time += start.elapsed();
                     outline
