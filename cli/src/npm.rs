@@ -163,9 +163,11 @@ export default weslBundle;
 
 fn readme() -> String {
     let mut list = String::new();
+    // From the WGSL sources the package is generated from (the same import paths and functions):
+    // the embedded WESL files are the last generation's, without a module just added.
     for m in shaders::modules()
         .iter()
-        .filter(|m| m.language == Language::Wesl && m.kind == ModuleKind::Module)
+        .filter(|m| m.language == Language::Wgsl && m.kind == ModuleKind::Module)
     {
         let functions: Vec<String> = m
             .functions
