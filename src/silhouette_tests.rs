@@ -173,36 +173,21 @@ fn what_has_no_silhouette_says_why() {
 #[test]
 fn crossings_and_distances_by_hand() {
     let p = Vec2::new(1.0, 1.0);
-    assert_eq!(
-        silhouette_crossing(p, Vec2::new(2.0, 0.0), Vec2::new(2.0, 2.0)),
-        1
-    );
-    assert_eq!(
-        silhouette_crossing(p, Vec2::new(2.0, 2.0), Vec2::new(2.0, 0.0)),
-        -1
-    );
-    assert_eq!(
-        silhouette_crossing(p, Vec2::new(0.0, 0.0), Vec2::new(0.0, 2.0)),
-        0
-    );
-    assert_eq!(
-        silhouette_crossing(p, Vec2::new(2.0, 1.0), Vec2::new(2.0, 2.0)),
-        1
-    );
-    assert_eq!(
-        silhouette_crossing(p, Vec2::new(2.0, 0.0), Vec2::new(2.0, 1.0)),
-        0
-    );
-    assert_eq!(
-        silhouette_distance(p, Vec2::new(4.0, 0.0), Vec2::new(4.0, 3.0)),
-        3.0
-    );
-    assert_eq!(
-        silhouette_distance(p, Vec2::new(4.0, 5.0), Vec2::new(4.0, 9.0)),
-        5.0
-    );
-    assert_eq!(
-        silhouette_distance(p, Vec2::new(1.0, 4.0), Vec2::new(1.0, 4.0)),
-        3.0
-    );
+    let v = Vec2::new;
+    for (a, b, crossing) in [
+        (v(2.0, 0.0), v(2.0, 2.0), 1),  // upwards, p on its left
+        (v(2.0, 2.0), v(2.0, 0.0), -1), // downwards, p on its right
+        (v(0.0, 0.0), v(0.0, 2.0), 0),  // upwards, p on its right
+        (v(2.0, 1.0), v(2.0, 2.0), 1),  // starting on p's line
+        (v(2.0, 0.0), v(2.0, 1.0), 0),  // ending on it
+    ] {
+        assert_eq!(silhouette_crossing(p, a, b), crossing, "{a} -> {b}");
+    }
+    for (a, b, distance) in [
+        (v(4.0, 0.0), v(4.0, 3.0), 3.0), // beside the segment
+        (v(4.0, 5.0), v(4.0, 9.0), 5.0), // past its end
+        (v(1.0, 4.0), v(1.0, 4.0), 3.0), // a point
+    ] {
+        assert_eq!(silhouette_distance(p, a, b), distance, "{a} -> {b}");
+    }
 }

@@ -149,15 +149,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 .collect();
             if c.technique == Technique::FrameSequential && !times.is_empty() {
                 let triangles = run.silhouettes.iter().map(|s| s.1).max().unwrap_or(0);
+                let us = lodkit::metrics::median(&times);
                 println!(
-                    "{name:30} {path:6}: silhouettes {:.1} us per frame (median of {}), up to {triangles} triangles",
-                    lodkit::metrics::median(&times),
+                    "{name:30} {path:6}: silhouettes {us:.1} us per frame (median of {}), up to {triangles} triangles",
                     times.len()
                 );
-                report.insert(
-                    format!("silhouette_us_{name}_{path}"),
-                    lodkit::metrics::median(&times).into(),
-                );
+                report.insert(format!("silhouette_us_{name}_{path}"), us.into());
                 report.insert(
                     format!("silhouette_triangles_{name}_{path}"),
                     triangles.into(),

@@ -21,7 +21,7 @@ use lodkit::select::{LodCamera, LodSelection, LodState};
 use super::older_depth::OlderLevel;
 use super::rects::{Bounds, group_rect, level_bounds, to_lodkit};
 use super::render::FrameSequentialView;
-use super::silhouette::{NoSilhouette, Surfaces, forget_changed_meshes};
+use super::silhouette::{Surfaces, forget_changed_meshes};
 use super::tag::{decode_tag, encode_tag};
 use super::{
     FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, OlderCoverage,
@@ -399,11 +399,9 @@ fn update(
                 // Where the level's silhouette can be had on the CPU (a closed triangle mesh
                 // with its positions, culled as usual), it tells the coverage; else the
                 // older-level depth pass draws the level.
-                let outline = if settings.coverage != OlderCoverage::Silhouette
-                    || cull_mode == Some(Face::Front)
-                {
-                    Err(NoSilhouette::NoTriangles)
-                } else {
+                let wants_outline = settings.coverage == OlderCoverage::Silhouette
+                    && cull_mode != Some(Face::Front);
+                let outline = wants_outline.then(|| {
                     let start = Instant::now();
                     let outline = surfaces.get(other.mesh.id(), &meshes).and_then(|surface| {
                         silhouette_triangles += surface.triangles() as u64;
@@ -419,11 +417,9 @@ fn update(
                     });
                     silhouette_time += start.elapsed();
                     outline
-                };
+                });
                 match outline {
-                    Ok(segments) => {
-                        silhouettes.push((tag_id, segments));
-                    }
+                    Some(Ok(segments)) => silhouettes.push((tag_id, segments)),
                     _ => older_levels.push(OlderLevel {
                         mesh: other.mesh.id(),
                         world_from_local: model,
