@@ -62,11 +62,10 @@ struct Shaded {
     view_normal: vec3<f32>,
 }
 
-/// Stripes over Lambert.
-fn shade(in: VertexOut) -> Shaded {
-    let n = normalize(in.world_normal);
+/// The lighting term: Lambert plus `camera.light_dir.w` directions of a smooth sky (the synthetic
+/// shading cost), or a constant ambient when that is 0.
+fn lighting(n: vec3<f32>) -> vec3<f32> {
     let lambert = max(dot(n, normalize(camera.light_dir.xyz)), 0.0);
-    let stripes = 0.5 + 0.5 * sin(18.0 * (in.object_pos.x + in.object_pos.y));
     let work = u32(max(camera.light_dir.w, 0.0));
     var sky = 0.0;
     for (var k = 0u; k < work; k++) {
@@ -74,13 +73,28 @@ fn shade(in: VertexOut) -> Shaded {
         sky += max(dot(n, normalize(vec3<f32>(cos(a), 1.0, sin(a)))), 0.0);
     }
     let ambient = select(0.3, 0.45 * sky / f32(max(work, 1u)), work > 0u);
-    let lighting = vec3<f32>(ambient + 0.7 * lambert);
-    let albedo = draw.color.rgb * (0.6 + 0.4 * stripes);
-    var color = albedo * lighting;
+    return vec3<f32>(ambient + 0.7 * lambert);
+}
+
+/// The striped albedo (object-space stripes over the draw's color).
+fn albedo(in: VertexOut) -> vec3<f32> {
+    let stripes = 0.5 + 0.5 * sin(18.0 * (in.object_pos.x + in.object_pos.y));
+    return draw.color.rgb * (0.6 + 0.4 * stripes);
+}
+
+/// Stripes over Lambert, or one of the two terms alone. Each variant computes only the term it
+/// writes: the albedo variant, drawn at full resolution beside a low-resolution lighting pass,
+/// must not pay for the lighting it would throw away (a compiler that keeps a loop whose result
+/// is unused, as NVIDIA's does, would otherwise time the sky loop in it).
+fn shade(in: VertexOut) -> Shaded {
+    let n = normalize(in.world_normal);
+    var color: vec3<f32>;
 #ifdef GBUFFER_MESH_LIGHTING_ONLY
-    color = lighting;
+    color = lighting(n);
 #else ifdef GBUFFER_MESH_ALBEDO_ONLY
-    color = albedo;
+    color = albedo(in);
+#else
+    color = albedo(in) * lighting(n);
 #endif
     return Shaded(color, normalize((camera.view * vec4<f32>(n, 0.0)).xyz));
 }

@@ -282,8 +282,13 @@ pub(crate) fn used_shader_defs(source: &str, language: Language) -> Vec<String> 
     let code = blank_comments(source, syntax);
     for line in code.lines() {
         let t = line.trim_start();
-        let t = t.strip_prefix("#else").map(str::trim_start).unwrap_or(t);
-        for directive in ["#ifdef", "#ifndef", "#if"] {
+        // naga_oil's `#else ifdef X` (and `#else if ...`) names its def without a second `#`.
+        let (t, hash) = match t.strip_prefix("#else") {
+            Some(rest) => (rest.trim_start(), ""),
+            None => (t, "#"),
+        };
+        for directive in ["ifdef", "ifndef", "if"] {
+            let Some(t) = t.strip_prefix(hash) else { break };
             if let Some(rest) = t.strip_prefix(directive) {
                 if rest.starts_with(char::is_whitespace) {
                     push(identifier(rest.trim_start()));
@@ -400,4 +405,21 @@ fn constants(source: &str, language: Language) -> Vec<String> {
             Some(name.to_owned())
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// naga_oil's `#else ifdef B` reads B as much as `#ifdef A` reads A: a def used only there
+    /// must be found, or `lodkit check` never sets it and its variant goes unchecked.
+    #[test]
+    fn every_directive_names_its_def_the_else_branches_too() {
+        let source =
+            "#ifdef A\nx\n#else ifdef B\ny\n#else ifndef D\n#else\nz\n#endif\n#if C == 3\n#endif\n";
+        assert_eq!(
+            used_shader_defs(source, Language::Wgsl),
+            ["A", "B", "D", "C"]
+        );
+    }
 }
