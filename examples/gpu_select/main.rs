@@ -131,12 +131,14 @@ fn main() -> Result<(), Box<dyn Error>> {
         .iter()
         .map(|_| lodkit::gpu::resources::uniform_buffer(&gpu, 80, "camera"))
         .collect::<Result<_, _>>()?;
-    let entries = selector.entries_buffer(view).ok_or("view")?;
+    // One bind group per list: a list is a (group, level) slot of one chunk of instances (one
+    // chunk unless a storage binding cannot hold them all), bound from its chunk's entries.
     let slot_groups: Vec<Option<wgpu::BindGroup>> = selector
         .slots()
         .iter()
-        .zip(&uniforms)
-        .map(|(slot, uniform)| {
+        .map(|slot| {
+            let uniform = &uniforms[slot.slot as usize];
+            let entries = selector.entries_buffer(view, slot.chunk)?;
             (slot.capacity > 0).then(|| {
                 gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("level"),
@@ -372,13 +374,9 @@ fn draw(
     });
     pass.set_pipeline(&drawing.pipeline);
     pass.set_bind_group(0, &drawing.instances, &[]);
-    let levels = selector
-        .slots()
-        .iter()
-        .zip(slot_groups)
-        .zip(&drawing.meshes);
-    for ((slot, group), (vertices, indices)) in levels {
+    for (slot, group) in selector.slots().iter().zip(slot_groups) {
         let Some(group) = group else { continue };
+        let (vertices, indices) = &drawing.meshes[slot.slot as usize];
         pass.set_bind_group(1, group, &[]);
         pass.set_vertex_buffer(0, vertices.slice(..));
         pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);

@@ -27,6 +27,9 @@ pub struct GpuOptions {
     pub backends: Vec<wgpu::Backends>,
     /// Optional features to enable when the adapter has them (others are silently left out).
     pub optional_features: wgpu::Features,
+    /// Limits to ask the device for; `None`: everything the adapter offers. Lower limits make
+    /// a device that behaves as a smaller GPU would (tests of what lodkit does at the limits).
+    pub limits: Option<wgpu::Limits>,
 }
 
 /// A device and queue with the adapter they came from, and what lodkit learned about the device:
@@ -115,7 +118,7 @@ impl GpuContext {
             let device_desc = wgpu::DeviceDescriptor {
                 label: Some("lodkit headless device"),
                 required_features,
-                required_limits: adapter.limits(),
+                required_limits: options.limits.clone().unwrap_or_else(|| adapter.limits()),
                 ..Default::default()
             };
             let (device, queue) = pollster::block_on(adapter.request_device(&device_desc))

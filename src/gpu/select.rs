@@ -32,19 +32,22 @@
 //! # Ok(()) }
 //! ```
 
+mod chunks;
 mod types;
 
 pub use types::{
-    GpuLodGroup, GpuLodInstance, GpuLodSelectorDescriptor, GpuSelectCamera, GpuSelectEntry,
-    GpuSelectFrame, LevelMesh, SlotRange,
+    GpuLodGroup, GpuLodInstance, GpuLodSelectorDescriptor, GpuSelectCamera, GpuSelectChunk,
+    GpuSelectEntry, GpuSelectFrame, LevelMesh, SlotRange,
 };
+
+use chunks::{Chunk, DRAW_BYTES, ENTRY_BYTES, INSTANCE_BYTES, STATE_BYTES};
 
 use super::GpuContext;
 use super::error::{GpuError, buffer_size};
 use crate::select::{LodSettings, distance_kind};
 
 /// A view's selection read back (tests and debugging): per instance its state (packed word,
-/// progress bits), per slot its list.
+/// progress bits), per (group, level) slot its list, the chunks' lists joined.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SelectReadback {
     /// (level | target << 8 | phase << 16 | in transition << 17, progress as f32 bits).
@@ -53,11 +56,25 @@ pub struct SelectReadback {
     pub lists: Vec<Vec<GpuSelectEntry>>,
 }
 
+/// The buffers of one chunk of instances shared by every view.
+struct ChunkBuffers {
+    plan: Chunk,
+    instances: wgpu::Buffer,
+    slot_first: wgpu::Buffer,
+    info: wgpu::Buffer,
+}
+
 /// One camera's buffers.
 struct View {
     camera: wgpu::Buffer,
-    states: wgpu::Buffer,
     draws: wgpu::Buffer,
+    /// Per chunk: states, entries and the bind group of its dispatch.
+    chunks: Vec<ViewChunk>,
+}
+
+/// One chunk's buffers of one camera.
+struct ViewChunk {
+    states: wgpu::Buffer,
     entries: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
 }
@@ -69,13 +86,10 @@ pub struct GpuLodSelector {
     slot_meshes: Vec<LevelMesh>,
     pipeline: wgpu::ComputePipeline,
     group_buffer: wgpu::Buffer,
-    instances: Option<wgpu::Buffer>,
-    slot_first: Option<wgpu::Buffer>,
+    chunks: Vec<ChunkBuffers>,
     template: Option<wgpu::Buffer>,
     slots: Vec<SlotRange>,
     instance_count: u32,
-    capacity: u32,
-    entry_capacity: u64,
     views: Vec<View>,
 }
 
@@ -84,8 +98,8 @@ pub struct GpuLodSelector {
 pub struct ViewId(usize);
 
 const WORKGROUP: u32 = 64;
-const ENTRY_BYTES: u64 = std::mem::size_of::<GpuSelectEntry>() as u64;
-const DRAW_BYTES: u64 = 20;
+/// Storage buffers `passes/select.wgsl` binds.
+const STORAGE_BINDINGS: u32 = 6;
 
 /// The pass needs compute shaders, storage buffers and indirect draws.
 fn check_capabilities(gpu: &GpuContext, call: &'static str) -> Result<(), GpuError> {
@@ -106,13 +120,42 @@ fn check_capabilities(gpu: &GpuContext, call: &'static str) -> Result<(), GpuErr
         }
     }
     let limits = gpu.device.limits();
-    if limits.max_storage_buffers_per_shader_stage < 6 {
+    if limits.max_storage_buffers_per_shader_stage < STORAGE_BINDINGS {
         return Err(GpuError::TooLarge {
             call,
             parameter: "storage buffers of passes/select.wgsl",
-            value: 6,
+            value: STORAGE_BINDINGS.into(),
             limit: "max_storage_buffers_per_shader_stage",
             max: limits.max_storage_buffers_per_shader_stage.into(),
+        });
+    }
+    Ok(())
+}
+
+/// What one binding (and one buffer) of the device holds at most, in bytes.
+fn binding_bytes(gpu: &GpuContext) -> u64 {
+    let limits = gpu.device.limits();
+    limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+}
+
+/// A refused instance: what is wrong with it.
+fn check_instance(i: usize, inst: &GpuLodInstance) -> Result<(), GpuError> {
+    let finite = inst.center.iter().all(|c| c.is_finite())
+        && inst.radius.is_finite()
+        && inst.max_scale.is_finite();
+    if !finite || inst.max_scale == 0.0 || inst.radius < 0.0 {
+        return Err(GpuError::Invalid {
+            call: "GpuLodSelector::set_instances",
+            parameter: "instances",
+            value: format!(
+                "instance {i}: center {:?}, radius {}, max_scale {}",
+                inst.center, inst.radius, inst.max_scale
+            ),
+            rule: "must have a finite center, a finite radius >= 0 and a finite, nonzero \
+                   max_scale (a shader is given no infinity or NaN, and a zero scale would \
+                   divide by zero)",
         });
     }
     Ok(())
@@ -197,125 +240,125 @@ impl GpuLodSelector {
                     cache: None,
                 }))
         })?;
-        Ok(Self {
+        let mut selector = Self {
             settings: desc.settings,
             groups,
             slot_meshes,
             pipeline,
             group_buffer,
-            instances: None,
-            slot_first: None,
+            chunks: Vec::new(),
             template: None,
             slots: Vec::new(),
             instance_count: 0,
-            capacity: 0,
-            entry_capacity: 0,
             views: Vec::new(),
-        })
+        };
+        selector.set_instances(gpu, &[])?;
+        Ok(selector)
     }
 
     /// Uploads the instances and lays out the lists (each (group, level) list holds as many
-    /// entries as its group has instances). Every view's state starts over (no history). Buffers
-    /// grow to the next power of two when they are too small, and are kept otherwise. Errors: more
-    /// instances than one dispatch covers, or buffers larger than the device allows.
+    /// entries as its group has instances). Every view's state starts over (no history).
+    ///
+    /// Instances that one storage binding cannot hold with their states and lists
+    /// (`max_storage_buffer_binding_size`, `max_buffer_size`) are split into chunks, each
+    /// selected by a dispatch of its own, each list with one range per chunk
+    /// ([`chunk_count`](Self::chunk_count), [`slots`](Self::slots)); so one selector takes as
+    /// many instances as the device's memory holds. Errors: an instance with a NaN or infinite
+    /// center, radius or scale, or a zero scale ([`GpuError::Invalid`]); more than `u32::MAX`
+    /// instances, or a binding too small for one instance's lists ([`GpuError::TooLarge`]);
+    /// buffers the device cannot allocate ([`GpuError::OutOfMemory`] and the like).
     pub fn set_instances(
         &mut self,
         gpu: &GpuContext,
         instances: &[GpuLodInstance],
     ) -> Result<(), GpuError> {
         const CALL: &str = "GpuLodSelector::set_instances";
+        let count = u32::try_from(instances.len()).map_err(|_| GpuError::TooLarge {
+            call: CALL,
+            parameter: "instances",
+            value: instances.len() as u64,
+            limit: "u32::MAX (instance indices are 32-bit)",
+            max: u64::from(u32::MAX),
+        })?;
+        for (i, inst) in instances.iter().enumerate() {
+            check_instance(i, inst)?;
+        }
         let limits = gpu.device.limits();
-        let max = u64::from(limits.max_compute_workgroups_per_dimension) * u64::from(WORKGROUP);
-        if instances.len() as u64 > max {
-            return Err(GpuError::TooLarge {
+        let align = u64::from(limits.min_storage_buffer_offset_alignment);
+        let max = binding_bytes(gpu);
+        let max_count =
+            chunks::grid_capacity(WORKGROUP, limits.max_compute_workgroups_per_dimension);
+        let slot_count = self.slot_meshes.len() as u32;
+        let plans = chunks::plan(instances, &self.groups, slot_count, align, (max, max_count))
+            .map_err(|e| GpuError::TooLarge {
                 call: CALL,
-                parameter: "instances",
-                value: instances.len() as u64,
-                limit: "max_compute_workgroups_per_dimension x 64",
-                max,
-            });
-        }
-        let align = u64::from(limits.min_storage_buffer_offset_alignment).max(ENTRY_BYTES);
-        let mut per_group = vec![0u32; self.groups.len()];
-        for inst in instances {
-            if let Some(c) = per_group.get_mut(inst.group as usize) {
-                *c += 1;
-            }
-        }
-        let mut slots = Vec::with_capacity(self.slot_meshes.len());
-        let mut entries = 0u64;
-        for (g, group) in self.groups.iter().enumerate() {
-            for level in 0..group.level_count {
-                slots.push(SlotRange {
-                    draw_offset: u64::from(group.first_slot + level) * DRAW_BYTES,
-                    entries_offset: entries,
-                    capacity: per_group[g],
-                });
-                entries += (u64::from(per_group[g]) * ENTRY_BYTES).div_ceil(align) * align;
-            }
-        }
-        let entry_bytes = entries.max(ENTRY_BYTES);
-        let binding_max = limits.max_storage_buffer_binding_size;
-        if entry_bytes > binding_max {
-            return Err(GpuError::TooLarge {
-                call: CALL,
-                parameter: "instance lists (bytes)",
-                value: entry_bytes,
+                parameter: "one instance's entry in every list of its group (bytes)",
+                value: e.needed,
                 limit: "max_storage_buffer_binding_size",
-                max: binding_max,
-            });
-        }
-        buffer_size(gpu, CALL, "instance lists", entry_bytes)?;
-        let count = instances.len() as u32;
-        let grow = count > self.capacity || entry_bytes > self.entry_capacity;
-        if grow {
-            self.capacity = count.max(1).next_power_of_two().max(self.capacity);
-            self.entry_capacity = entry_bytes.next_power_of_two().max(self.entry_capacity);
-            if self.entry_capacity > binding_max {
-                self.entry_capacity = entry_bytes;
-            }
-        }
-        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
-        let inst_bytes = u64::from(self.capacity) * std::mem::size_of::<GpuLodInstance>() as u64;
-        buffer_size(gpu, CALL, "instances", inst_bytes)?;
-        if grow || self.instances.is_none() {
-            self.instances = Some(create(
+                max,
+            })?;
+        let mut buffers = Vec::with_capacity(plans.len());
+        for plan in plans {
+            let range = plan.first as usize..(plan.first + plan.count) as usize;
+            let bytes: &[u8] = bytemuck::cast_slice(&instances[range]);
+            let instance_buffer = create(
                 gpu,
                 CALL,
-                inst_bytes,
-                storage,
+                (bytes.len() as u64).max(INSTANCE_BYTES),
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 "lodkit select instances",
-            )?);
+            )?;
+            gpu.guarded(CALL, || {
+                gpu.queue.write_buffer(&instance_buffer, 0, bytes);
+                Ok(())
+            })?;
+            let firsts: Vec<u32> = plan
+                .slots
+                .iter()
+                .map(|s| (s.entries_offset / ENTRY_BYTES) as u32)
+                .chain(std::iter::once(0)) // a group-less table still binds a word
+                .collect();
+            let slot_first = super::resources::buffer_with_data(
+                gpu,
+                bytemuck::cast_slice(&firsts),
+                wgpu::BufferUsages::STORAGE,
+                "lodkit select slots",
+            )?;
+            let info = GpuSelectChunk {
+                first_instance: plan.first,
+                count: plan.count,
+                draw_base: buffers.len() as u32 * slot_count,
+                pad: 0,
+            };
+            let info = super::resources::buffer_with_data(
+                gpu,
+                bytemuck::bytes_of(&info),
+                wgpu::BufferUsages::UNIFORM,
+                "lodkit select chunk",
+            )?;
+            buffers.push(ChunkBuffers {
+                plan,
+                instances: instance_buffer,
+                slot_first,
+                info,
+            });
         }
-        let template: Vec<u32> = self
-            .slot_meshes
-            .iter()
+        let template: Vec<u32> = (0..buffers.len())
+            .flat_map(|_| self.slot_meshes.iter())
             .flat_map(|m| [m.index_count, 0, m.first_index, m.base_vertex as u32, 0])
             .collect();
-        let firsts: Vec<u32> = slots
-            .iter()
-            .map(|s| (s.entries_offset / ENTRY_BYTES) as u32)
-            .collect();
-        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-        self.template = Some(super::resources::buffer_with_data(
-            gpu,
-            bytemuck::cast_slice(&template),
-            usage,
-            "lodkit select draw template",
-        )?);
-        self.slot_first = Some(super::resources::buffer_with_data(
-            gpu,
-            bytemuck::cast_slice(&firsts),
-            wgpu::BufferUsages::STORAGE,
-            "lodkit select slots",
-        )?);
-        let buffer = self.instances.as_ref().expect("created above");
-        gpu.guarded(CALL, || {
-            gpu.queue
-                .write_buffer(buffer, 0, bytemuck::cast_slice(instances));
-            Ok(())
-        })?;
-        self.slots = slots;
+        self.template = if template.is_empty() {
+            None
+        } else {
+            Some(super::resources::buffer_with_data(
+                gpu,
+                bytemuck::cast_slice(&template),
+                wgpu::BufferUsages::COPY_SRC,
+                "lodkit select draw template",
+            )?)
+        };
+        self.slots = buffers.iter().flat_map(|c| c.plan.slots.clone()).collect();
+        self.chunks = buffers;
         self.instance_count = count;
         for v in 0..self.views.len() {
             self.views[v] = self.make_view(gpu, CALL)?;
@@ -331,20 +374,10 @@ impl GpuLodSelector {
     }
 
     fn make_view(&self, gpu: &GpuContext, call: &'static str) -> Result<View, GpuError> {
-        let capacity = u64::from(self.capacity.max(1));
-        let states_bytes = capacity * 8;
-        buffer_size(gpu, call, "states", states_bytes)?;
-        let new_states = vec![[crate::select::LodState::NEW.packed(), 0u32]; capacity as usize];
         let rw = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
             | wgpu::BufferUsages::COPY_DST;
-        let states = super::resources::buffer_with_data(
-            gpu,
-            bytemuck::cast_slice(&new_states),
-            rw,
-            "lodkit select states",
-        )?;
-        let draw_bytes = (self.slot_meshes.len().max(1) as u64) * DRAW_BYTES;
+        let draw_bytes = (self.slots.len().max(1) as u64) * DRAW_BYTES;
         let draws = create(
             gpu,
             call,
@@ -352,67 +385,69 @@ impl GpuLodSelector {
             rw | wgpu::BufferUsages::INDIRECT,
             "lodkit select draws",
         )?;
-        let entries = create(
-            gpu,
-            call,
-            self.entry_capacity.max(ENTRY_BYTES),
-            rw,
-            "lodkit select entries",
-        )?;
         let camera = super::resources::uniform_buffer(
             gpu,
             std::mem::size_of::<GpuSelectCamera>(),
             "lodkit select camera",
         )?;
-        let dummy;
-        let (instances, slot_first) = match (&self.instances, &self.slot_first) {
-            (Some(i), Some(s)) => (i, s),
-            _ => {
-                dummy = create(
-                    gpu,
-                    call,
-                    64,
-                    wgpu::BufferUsages::STORAGE,
-                    "lodkit select empty",
-                )?;
-                (&dummy, &dummy)
-            }
-        };
-        let buffers = [
-            &camera,
-            &self.group_buffer,
-            instances,
-            slot_first,
-            &states,
-            &draws,
-            &entries,
-        ];
-        let bind_group = gpu.guarded(call, || {
-            let entries: Vec<wgpu::BindGroupEntry> = buffers
-                .iter()
-                .enumerate()
-                .map(|(k, b)| wgpu::BindGroupEntry {
-                    binding: k as u32,
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("lodkit select"),
-                layout: &self.pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            }))
-        })?;
+        let mut chunks = Vec::with_capacity(self.chunks.len());
+        for chunk in &self.chunks {
+            let n = chunk.plan.count.max(1) as usize;
+            buffer_size(gpu, call, "states", n as u64 * STATE_BYTES)?;
+            let new_states = vec![[crate::select::LodState::NEW.packed(), 0u32]; n];
+            let states = super::resources::buffer_with_data(
+                gpu,
+                bytemuck::cast_slice(&new_states),
+                rw,
+                "lodkit select states",
+            )?;
+            let entries = create(
+                gpu,
+                call,
+                chunk.plan.entry_bytes,
+                rw,
+                "lodkit select entries",
+            )?;
+            let buffers = [
+                &camera,
+                &self.group_buffer,
+                &chunk.instances,
+                &chunk.slot_first,
+                &states,
+                &draws,
+                &entries,
+                &chunk.info,
+            ];
+            let bind_group = gpu.guarded(call, || {
+                let entries: Vec<wgpu::BindGroupEntry> = buffers
+                    .iter()
+                    .enumerate()
+                    .map(|(k, b)| wgpu::BindGroupEntry {
+                        binding: k as u32,
+                        resource: b.as_entire_binding(),
+                    })
+                    .collect();
+                Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("lodkit select"),
+                    layout: &self.pipeline.get_bind_group_layout(0),
+                    entries: &entries,
+                }))
+            })?;
+            chunks.push(ViewChunk {
+                states,
+                entries,
+                bind_group,
+            });
+        }
         Ok(View {
             camera,
-            states,
             draws,
-            entries,
-            bind_group,
+            chunks,
         })
     }
 
     /// Records one view's selection for `frame` into `encoder`: the camera upload, the reset of
-    /// the counts (a copy of the draw template) and one dispatch. Nothing is read back.
+    /// the counts (a copy of the draw template) and one dispatch per chunk. Nothing is read back.
     pub fn record(
         &self,
         gpu: &GpuContext,
@@ -440,7 +475,9 @@ impl GpuLodSelector {
         let uniform = GpuSelectCamera {
             planes,
             position: camera.position.to_array(),
-            factor,
+            // An infinite bias is its own distance kind, which reads no factor: the shader is
+            // given 0 rather than an infinity.
+            factor: if factor.is_finite() { factor } else { 0.0 },
             distance_kind: kind,
             mode,
             step,
@@ -450,6 +487,7 @@ impl GpuLodSelector {
             frame_sequential: frame.frame_sequential as u32,
             cull: frame.view_proj.is_some() as u32,
         };
+        let max_dim = gpu.device.limits().max_compute_workgroups_per_dimension;
         gpu.guarded(CALL, || {
             gpu.queue
                 .write_buffer(&v.camera, 0, bytemuck::bytes_of(&uniform));
@@ -468,8 +506,14 @@ impl GpuLodSelector {
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &v.bind_group, &[]);
-                pass.dispatch_workgroups(self.instance_count.div_ceil(WORKGROUP), 1, 1);
+                for (chunk, vc) in self.chunks.iter().zip(&v.chunks) {
+                    if chunk.plan.count == 0 {
+                        continue;
+                    }
+                    let (x, y) = chunks::grid(chunk.plan.count, WORKGROUP, max_dim);
+                    pass.set_bind_group(0, &vc.bind_group, &[]);
+                    pass.dispatch_workgroups(x, y, 1);
+                }
             }
             Ok(())
         })
@@ -487,37 +531,45 @@ impl GpuLodSelector {
         })
     }
 
-    /// The (group, level) lists in slot order (group by group, level by level).
+    /// Every list: per chunk, the (group, level) slots in order (group by group, level by
+    /// level). With one chunk, one range per slot.
     pub fn slots(&self) -> &[SlotRange] {
         &self.slots
     }
 
-    /// The slot of `level` of `group`, if both exist.
-    pub fn slot(&self, group: usize, level: usize) -> Option<SlotRange> {
+    /// The range of `level` of `group` in `chunk`, if all three exist.
+    pub fn slot(&self, group: usize, level: usize, chunk: u32) -> Option<SlotRange> {
         let g = self.groups.get(group)?;
         if level >= g.level_count as usize {
             return None;
         }
-        self.slots.get(g.first_slot as usize + level).copied()
+        let plan = &self.chunks.get(chunk as usize)?.plan;
+        plan.slots.get(g.first_slot as usize + level).copied()
     }
 
-    /// The view's indirect arguments: one `DrawIndexedIndirectArgs` (20 bytes) per slot, whose
-    /// `instance_count` the last dispatch wrote. Draw slot s with
-    /// `draw_indexed_indirect(buffer, slot.draw_offset)`.
+    /// How many chunks the instances are split into (1 unless one storage binding cannot hold
+    /// them; see [`set_instances`](Self::set_instances)).
+    pub fn chunk_count(&self) -> u32 {
+        self.chunks.len() as u32
+    }
+
+    /// The view's indirect arguments: one `DrawIndexedIndirectArgs` (20 bytes) per list (per
+    /// chunk and slot), whose `instance_count` the last dispatch wrote. Draw a list with
+    /// `draw_indexed_indirect(buffer, range.draw_offset)`.
     pub fn draws_buffer(&self, view: ViewId) -> Option<&wgpu::Buffer> {
         Some(&self.views.get(view.0)?.draws)
     }
 
-    /// The view's lists of [`GpuSelectEntry`]; bind slot s at `slot.entries_offset` (a dynamic
-    /// storage offset) so that `instance_index` indexes its list.
-    pub fn entries_buffer(&self, view: ViewId) -> Option<&wgpu::Buffer> {
-        Some(&self.views.get(view.0)?.entries)
+    /// The view's list entries ([`GpuSelectEntry`]) of `chunk`; bind a list at
+    /// `range.entries_offset` (a dynamic storage offset) so that `instance_index` indexes it.
+    pub fn entries_buffer(&self, view: ViewId, chunk: u32) -> Option<&wgpu::Buffer> {
+        Some(&self.views.get(view.0)?.chunks.get(chunk as usize)?.entries)
     }
 
-    /// The view's state buffer (8 bytes per instance: packed level | target << 8 | phase bits,
-    /// progress).
-    pub fn states_buffer(&self, view: ViewId) -> Option<&wgpu::Buffer> {
-        Some(&self.views.get(view.0)?.states)
+    /// The view's states of `chunk`'s instances (8 bytes per instance: packed level | target <<
+    /// 8 | phase bits, progress), from the chunk's first instance on.
+    pub fn states_buffer(&self, view: ViewId, chunk: u32) -> Option<&wgpu::Buffer> {
+        Some(&self.views.get(view.0)?.chunks.get(chunk as usize)?.states)
     }
 
     /// Instances set.
@@ -526,7 +578,7 @@ impl GpuLodSelector {
     }
 
     /// Reads a view's states and lists back (tests and debugging, not the frame loop): the
-    /// states (packed word, progress) of every instance, and each slot's entries.
+    /// states (packed word, progress) of every instance, and each slot's entries over all chunks.
     pub fn read_back(&self, gpu: &GpuContext, view: ViewId) -> Result<SelectReadback, GpuError> {
         const CALL: &str = "GpuLodSelector::read_back";
         let v = self.view(CALL, view)?;
@@ -534,22 +586,24 @@ impl GpuLodSelector {
             let encoder = gpu.device.create_command_encoder(&Default::default());
             super::readback::read_buffer(gpu, encoder, buffer, size)
         };
-        let states_bytes = read(&v.states, u64::from(self.instance_count.max(1)) * 8)?;
-        let mut states: Vec<[u32; 2]> = bytemuck::pod_collect_to_vec(&states_bytes);
-        states.truncate(self.instance_count as usize);
         let draws: Vec<u32> = bytemuck::pod_collect_to_vec(&read(&v.draws, v.draws.size())?);
-        let entries: Vec<GpuSelectEntry> =
-            bytemuck::pod_collect_to_vec(&read(&v.entries, v.entries.size())?);
-        let lists = self
-            .slots
-            .iter()
-            .enumerate()
-            .map(|(s, slot)| {
-                let first = (slot.entries_offset / ENTRY_BYTES) as usize;
-                let n = (draws[s * 5 + 1] as usize).min(slot.capacity as usize);
-                entries[first..first + n].to_vec()
-            })
-            .collect();
+        let mut states = Vec::with_capacity(self.instance_count as usize);
+        let mut lists = vec![Vec::new(); self.slot_meshes.len()];
+        for (chunk, vc) in self.chunks.iter().zip(&v.chunks) {
+            if chunk.plan.count == 0 {
+                continue;
+            }
+            let bytes = read(&vc.states, u64::from(chunk.plan.count) * STATE_BYTES)?;
+            states.extend(bytemuck::pod_collect_to_vec::<u8, [u32; 2]>(&bytes));
+            let entries: Vec<GpuSelectEntry> =
+                bytemuck::pod_collect_to_vec(&read(&vc.entries, vc.entries.size())?);
+            for range in &chunk.plan.slots {
+                let first = (range.entries_offset / ENTRY_BYTES) as usize;
+                let d = (range.draw_offset / DRAW_BYTES) as usize;
+                let n = (draws[d * 5 + 1] as usize).min(range.capacity as usize);
+                lists[range.slot as usize].extend_from_slice(&entries[first..first + n]);
+            }
+        }
         Ok(SelectReadback { states, lists })
     }
 }

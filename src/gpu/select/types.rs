@@ -43,7 +43,7 @@ pub struct GpuLodGroup {
     pub levels: [[f32; 4]; SELECT_MAX_LEVELS],
     /// Levels in use.
     pub level_count: u32,
-    /// Max draw distance (+inf for none).
+    /// Max draw distance (`f32::MAX` for none: no infinity reaches the shader).
     pub max_distance: f32,
     /// max_distance - hysteresis.
     pub fade_from: f32,
@@ -73,7 +73,7 @@ pub struct GpuSelectCamera {
     pub step: f32,
     /// Frame index.
     pub frame: u32,
-    /// Instances to select.
+    /// Instances to select, in all chunks.
     pub instance_count: u32,
     /// Groups in the table.
     pub group_count: u32,
@@ -81,6 +81,21 @@ pub struct GpuSelectCamera {
     pub frame_sequential: u32,
     /// 1: frustum culling.
     pub cull: u32,
+}
+
+/// Rust mirror of `SelectChunk` in `passes/select.wgsl` (16 bytes): the instances one dispatch
+/// selects.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct GpuSelectChunk {
+    /// Index of the chunk's first instance (what its list entries add to their local index).
+    pub first_instance: u32,
+    /// Instances in the chunk.
+    pub count: u32,
+    /// Index of the chunk's first `DrawIndexedIndirectArgs` in the draws buffer.
+    pub draw_base: u32,
+    /// Padding.
+    pub pad: u32,
 }
 
 /// Rust mirror of `SelectEntry` in `passes/select.wgsl`: one instance in a (group, level) list.
@@ -149,14 +164,24 @@ impl GpuSelectFrame {
     }
 }
 
-/// Where one (group, level) list lives in a view's buffers.
+/// Where one (group, level) list of one chunk of instances lives in a view's buffers.
+///
+/// Instances are split into chunks when one storage binding cannot hold them all (see
+/// [`GpuLodSelector::chunk_count`](super::GpuLodSelector::chunk_count)); most scenes have one
+/// chunk, and then there is one range per (group, level) slot.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SlotRange {
-    /// Byte offset of its `DrawIndexedIndirectArgs` in [`GpuLodSelector::draws_buffer`].
+    /// The chunk of instances whose list this is: bind
+    /// [`GpuLodSelector::entries_buffer`](super::GpuLodSelector::entries_buffer)`(view, chunk)`.
+    pub chunk: u32,
+    /// The (group, level) slot: group g's level k is slot `first_slot(g) + k`, in group order.
+    pub slot: u32,
+    /// Byte offset of its `DrawIndexedIndirectArgs` in
+    /// [`GpuLodSelector::draws_buffer`](super::GpuLodSelector::draws_buffer).
     pub draw_offset: u64,
-    /// Byte offset of its first entry in [`GpuLodSelector::entries_buffer`] (aligned for a
-    /// dynamic storage offset).
+    /// Byte offset of its first entry in its chunk's entries buffer (aligned for a dynamic
+    /// storage offset).
     pub entries_offset: u64,
-    /// Entries it can hold (the group's instance count).
+    /// Entries it can hold (the group's instance count in the chunk).
     pub capacity: u32,
 }
