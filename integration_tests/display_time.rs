@@ -21,7 +21,10 @@ use lodkit::visibility::{
     visibility_threshold_complementary,
 };
 
-use crate::harness::{Probe, floats, run_with, say, words};
+use crate::harness::{Probe, Word, assert_twin, floats, run_with, say, twin_mismatch, words};
+
+/// Output words of the visibility-flags probe: two flags, two thresholds.
+const KINDS: [Word; 4] = [Word::Exact, Word::Exact, Word::Float(0.0), Word::Float(0.0)];
 
 const GLSL: SourceLanguage = SourceLanguage::Glsl(naga::ShaderStage::Compute);
 
@@ -92,7 +95,41 @@ fn visibility_flags_twins_match_with_a_real_texture() {
             urgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
-        assert_eq!(got, want, "{language:?} visibility flags");
+        // The flags are integers: exact. The thresholds are a clamp, `1 - p` and a negation,
+        // each correctly rounded in WGSL as in Rust: equal, with +0 and -0 equal (a zero's sign
+        // is not kept by every driver, and `visibility_shown` gives it no meaning).
+        assert_twin(
+            &got,
+            &want,
+            &KINDS,
+            &format!("{language:?} visibility flags"),
+        );
+        // The failure class seen on a real GPU, reproduced here: a twin whose zeros carry the
+        // other sign (what a driver that drops or keeps the sign gives) still matches, while a
+        // twin with a sign flipped on a nonzero threshold does not.
+        let flip = |w: &[u32], zeros: bool| -> Vec<u32> {
+            w.chunks(4)
+                .flat_map(|c| {
+                    let f = |x: u32| {
+                        let v = f32::from_bits(x);
+                        if (v == 0.0) == zeros {
+                            (-v).to_bits()
+                        } else {
+                            x
+                        }
+                    };
+                    [c[0], c[1], f(c[2]), f(c[3])]
+                })
+                .collect()
+        };
+        assert!(
+            twin_mismatch(&got, &flip(&want, true), &KINDS).is_none(),
+            "{language:?}: a zero of the other sign must match"
+        );
+        assert!(
+            twin_mismatch(&got, &flip(&want, false), &KINDS).is_some(),
+            "{language:?}: a nonzero threshold of the other sign must not match"
+        );
     }
     // Hand-derived: every flag combination occurs, and the complementary thresholds split the
     // texels between the two LODs.
@@ -222,7 +259,15 @@ fn lod_buffer_flags_and_combine_shown_twins_match() {
             urgba: &[],
         };
         let got = run_with(gpu, &probe, &inputs, language, &[]);
-        assert_eq!(got, want, "{language:?} lod buffer flags and combine_shown");
+        // Words and flags exact; the color is a sample or 0.5 x (a + b), correctly rounded on
+        // both sides: equal, +0 and -0 alike.
+        let kinds = [[Word::Exact; 5].as_slice(), &[Word::Float(0.0); 4]].concat();
+        assert_twin(
+            &got,
+            &want,
+            &kinds,
+            &format!("{language:?} lod buffer flags and combine_shown"),
+        );
     }
     // Hand-derived: ids up to 2^30 - 1 survive, the flags sit above them, id 0 is always shown,
     // and a shown sample wins over a hidden one whatever the depths.

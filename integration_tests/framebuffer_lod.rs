@@ -2,7 +2,7 @@
 //! the Rust twin on hand-built 2x2 neighbourhoods.
 
 use glam::{Vec2, Vec3, Vec4};
-use lodkit::bilateral::{bilateral_tent, bilateral_upsample};
+use lodkit::bilateral::{bilateral_tent, bilateral_upsample, gpu_sigma};
 use lodkit::shaders::SourceLanguage;
 
 use crate::harness::{Probe, assert_close, floats, run_with, words};
@@ -109,7 +109,8 @@ fn inputs(cases: &[Case]) -> Vec<u32> {
             c.normals.iter().for_each(|n| v.extend(n.to_array()));
             v.push(c.depth);
             v.extend(c.normal.to_array());
-            v.extend([c.sigma_z, c.sigma_n]);
+            // A shader is given no infinity: +inf goes in as the finite sigma that does the same.
+            v.extend([gpu_sigma(c.sigma_z), gpu_sigma(c.sigma_n)]);
             words(&v)
         })
         .collect()

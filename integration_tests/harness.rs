@@ -327,6 +327,82 @@ pub fn floats(words: &[u32]) -> Vec<f32> {
     words.iter().map(|w| f32::from_bits(*w)).collect()
 }
 
+/// WGSL's stated accuracy for f32 ("Floating Point Accuracy" in the WGSL spec), in ULP: how far a
+/// conformant GPU may be from the correctly rounded result, which is what the Rust twins compute
+/// (Rust rounds every operation correctly and fuses nothing). Tolerances of the twin tests are
+/// derived from these and from each function's conditioning, beside each test.
+pub mod accuracy {
+    /// One ULP relative to a normal value's magnitude: ulp(x) <= 2^-23 |x|.
+    pub const ULP: f32 = f32::EPSILON;
+    /// `x + y`, `x - y`, `x * y`, `abs`, `min`, `max`, `clamp`, `select`, negation: correctly
+    /// rounded (at most 0.5 ULP, the CPU's own rounding; a GPU may also fuse a multiply and an
+    /// add, which differs from the CPU by at most that much per operation).
+    pub const CORRECTLY_ROUNDED: f32 = 0.5;
+    /// `x / y` for |y| in [2^-126, 2^126]: 2.5 ULP.
+    pub const DIV: f32 = 2.5;
+    /// `sqrt` inherits `1.0 / inverseSqrt(x)`: inverseSqrt's 2 ULP, then the division's 2.5.
+    pub const SQRT: f32 = 4.5;
+}
+
+/// How one output word of a probe is held to its Rust twin's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Word {
+    /// An integer, a flag or packed bits: equal.
+    Exact,
+    /// A float within this absolute tolerance. +0 and -0 are equal (Vulkan keeps a zero's sign
+    /// only under `SignedZeroInfNanPreserve`, which naga does not ask for; WGSL and GL promise
+    /// nothing either), and a NaN matches nothing.
+    Float(f32),
+}
+
+/// Whether float `got` is within `tol` of `want`: +0 and -0 equal, a NaN never.
+pub fn float_matches(got: f32, want: f32, tol: f32) -> bool {
+    got == want || (got - want).abs() <= tol
+}
+
+/// Where `got` first differs from the twin's `want` (flattened cases of `kinds.len()` words,
+/// each word held as its kind says), described; `None` when every word matches.
+pub fn twin_mismatch(got: &[u32], want: &[u32], kinds: &[Word]) -> Option<String> {
+    if got.len() != want.len() {
+        return Some(format!("{} words, the twin {}", got.len(), want.len()));
+    }
+    let n = kinds.len();
+    for (case, (g, w)) in got.chunks(n).zip(want.chunks(n)).enumerate() {
+        for (k, kind) in kinds.iter().enumerate() {
+            let ok = match kind {
+                Word::Exact => g[k] == w[k],
+                Word::Float(tol) => float_matches(f32::from_bits(g[k]), f32::from_bits(w[k]), *tol),
+            };
+            if !ok {
+                let show = |v: &[u32]| {
+                    v.iter()
+                        .zip(kinds)
+                        .map(|(x, kind)| match kind {
+                            Word::Exact => format!("{x:#x}"),
+                            Word::Float(_) => format!("{:?}", f32::from_bits(*x)),
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                return Some(format!(
+                    "case {case} word {k} ({kind:?}): GPU [{}] vs Rust twin [{}]",
+                    show(g),
+                    show(w)
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// Asserts that `got` matches the twin's `want` word by word as `kinds` says (see
+/// [`twin_mismatch`]).
+pub fn assert_twin(got: &[u32], want: &[u32], kinds: &[Word], what: &str) {
+    if let Some(problem) = twin_mismatch(got, want, kinds) {
+        panic!("{what}: {problem}");
+    }
+}
+
 /// Asserts `got` matches `want` within `tol` relative to max(1, |want|), naming the first case
 /// that does not.
 pub fn assert_close(got: &[f32], want: &[f32], tol: f32, what: &str) {

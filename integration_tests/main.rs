@@ -15,6 +15,7 @@ mod frame_sequential;
 mod frame_sequential_render;
 mod framebuffer_lod;
 mod gpu_select;
+mod gpu_select_chunks;
 mod gpu_select_path;
 mod gpu_twins;
 mod harness;

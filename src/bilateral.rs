@@ -8,12 +8,33 @@ use crate::normal_distance::foreshortened_normal;
 /// Sum of weights below which [`bilateral_upsample`] falls back to the sample closest in depth.
 pub const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
 
-/// Gaussian range filter exp(-d^2 / (2 sigma^2)); 1 when sigma is +inf.
+/// A sigma that turns its range term off in the shaders (`BILATERAL_SIGMA_OFF` of
+/// `lodkit::bilateral`): every difference over it squares to 0, so the weight is 1. The Rust
+/// twins take +inf as well; a shader must not be given an infinity (WGSL, and SPIR-V without
+/// float-control modes, promise nothing for one), so hosts write this instead
+/// ([`gpu_sigma`]).
+pub const BILATERAL_SIGMA_OFF: f32 = 1e30;
+
+/// The sigma to hand a shader for `sigma`: [`BILATERAL_SIGMA_OFF`] for +inf (or anything above
+/// it), `sigma` otherwise.
 ///
 /// ```
-/// # use lodkit::bilateral::bilateral_range;
+/// # use lodkit::bilateral::{gpu_sigma, BILATERAL_SIGMA_OFF};
+/// assert_eq!(gpu_sigma(f32::INFINITY), BILATERAL_SIGMA_OFF);
+/// assert_eq!(gpu_sigma(0.25), 0.25);
+/// ```
+pub fn gpu_sigma(sigma: f32) -> f32 {
+    sigma.min(BILATERAL_SIGMA_OFF)
+}
+
+/// Gaussian range filter exp(-d^2 / (2 sigma^2)); 1 when sigma is +inf or
+/// [`BILATERAL_SIGMA_OFF`].
+///
+/// ```
+/// # use lodkit::bilateral::{bilateral_range, BILATERAL_SIGMA_OFF};
 /// assert_eq!(bilateral_range(0.0, 0.5), 1.0);
 /// assert_eq!(bilateral_range(3.0, f32::INFINITY), 1.0);
+/// assert_eq!(bilateral_range(1e5, BILATERAL_SIGMA_OFF), 1.0);
 /// assert!((bilateral_range(1.0, 1.0) - (-0.5f32).exp()).abs() < 1e-7);
 /// ```
 pub fn bilateral_range(difference: f32, sigma: f32) -> f32 {

@@ -54,12 +54,15 @@ pub fn gbuffer_normal(geometry: Vec4) -> Vec3 {
 
 /// `v` as two IEEE half floats in one word, x in the low 16 bits, exactly as the shaders write
 /// it: rounded to nearest (ties away from zero), magnitudes clamped to [`GBUFFER_HALF_MAX`], those
-/// below 2^-14 (the smallest normal half) written as signed zero. Inputs must be finite.
+/// below 2^-14 (the smallest normal half) written as +0: the sign of a zero is not kept, since a
+/// GPU need not keep it (Vulkan keeps it only under `SignedZeroInfNanPreserve`) and the word
+/// must be the same on every driver. Inputs must be finite.
 ///
 /// ```
 /// # use lodkit::gbuffer::*;
 /// # use glam::Vec2;
 /// assert_eq!(gbuffer_pack_half2(Vec2::new(1.0, -2.0)), 0xc000_3c00);
+/// assert_eq!(gbuffer_pack_half2(Vec2::new(-0.0, -1e-9)), 0);
 /// assert_eq!(gbuffer_unpack_half2(gbuffer_pack_half2(Vec2::new(0.1, 1e6))), Vec2::new(0.099975586, 65504.0));
 /// ```
 pub fn gbuffer_pack_half2(v: Vec2) -> u32 {
@@ -67,11 +70,10 @@ pub fn gbuffer_pack_half2(v: Vec2) -> u32 {
         let a = x.abs().min(GBUFFER_HALF_MAX);
         // Scaling by 2^-112 moves the exponent to the half's bias: the half is then the float's
         // bits shifted right by 13, after adding half of the dropped last place.
-        let magnitude = if a < f32::from_bits(0x3880_0000) {
-            0 // below 2^-14
-        } else {
-            ((a * f32::from_bits(0x0780_0000)).to_bits() + 0x1000) >> 13
-        };
+        if a < f32::from_bits(0x3880_0000) {
+            return 0; // below 2^-14: +0, whatever the sign (a GPU need not keep a zero's sign)
+        }
+        let magnitude = ((a * f32::from_bits(0x0780_0000)).to_bits() + 0x1000) >> 13;
         magnitude | ((x.to_bits() >> 16) & 0x8000)
     };
     half(v.x) | (half(v.y) << 16)
@@ -127,13 +129,18 @@ mod tests {
     use super::*;
 
     /// Every half the packer can write comes back exactly, and every float lands on the nearest
-    /// half (ties away from zero) or, below 2^-14, on zero: checked against f64 arithmetic.
+    /// half (ties away from zero) or, below 2^-14, on +0: checked against f64 arithmetic.
     #[test]
     fn halves_round_to_nearest() {
         for h in (0u32..0x7c00).chain(0x8000..0xfc00) {
             let f = gbuffer_unpack_half2(h).x;
             if (h >> 10) & 0x1f == 0 && h & 0x3ff != 0 {
                 continue; // subnormal halves are never written
+            }
+            if h == 0x8000 {
+                // -0 is never written: a zero packs without its sign.
+                assert_eq!(gbuffer_pack_half2(Vec2::new(f, 0.0)), 0, "-0 packs as +0");
+                continue;
             }
             assert_eq!(
                 gbuffer_pack_half2(Vec2::new(f, 0.0)) & 0xffff,
@@ -152,6 +159,7 @@ mod tests {
             assert_eq!((got.x, got.y), (want, -want), "{x}");
             x *= 1.0137;
         }
-        assert_eq!(gbuffer_pack_half2(Vec2::new(6.0e-5, -1e-30)), 0x8000_0000);
+        // Below 2^-14 both are +0, the negative one too.
+        assert_eq!(gbuffer_pack_half2(Vec2::new(6.0e-5, -1e-30)), 0);
     }
 }

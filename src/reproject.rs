@@ -64,10 +64,13 @@ pub fn reproject_from_base(base: Vec4, depth: f32, new_to_old: &Mat4) -> Vec3 {
 /// assert!((got - want).abs().max_element() < 1e-4);
 /// ```
 pub fn reproject_refine(base: Vec4, depth: f32, old_depth: f32, new_to_old: &Mat4) -> Vec3 {
+    // Solved for z = num / den; whether it is solved is read from num and den, not from the
+    // quotient, as the shaders must (a GPU need not make a division by zero infinite or NaN).
     let c = new_to_old.z_axis;
-    let z = (old_depth * base.w - base.z) / (c.z - old_depth * c.w);
-    let solved = z.abs() <= 3.0e38;
-    reproject_from_base(base, if solved { z } else { depth }, new_to_old)
+    let num = old_depth * base.w - base.z;
+    let den = c.z - old_depth * c.w;
+    let solved = den.abs() >= f32::MIN_POSITIVE && num.abs() <= 3.0e38 * den.abs().min(1.0);
+    reproject_from_base(base, if solved { num / den } else { depth }, new_to_old)
 }
 
 /// Whether `uv` lies inside the older buffer ([0, 1] on both axes).

@@ -1,15 +1,17 @@
 //! GPU cost of the frame-sequential combine pass against a plain fullscreen pass that reads the
 //! same seven textures (color, id and depth of both buffers, the object motion) and writes one:
 //! the pass's own overhead.
-//! Wall time per pass including submit and wait, so read the ratio, not the absolute figures,
-//! on a software GPU. `lodkit demo` measures the same ratio for its report. Then its floors: the
+//! GPU timestamps around a run of recordings where the device has them, else the wall time of
+//! the run's submission and wait (each line names its clock); on a software GPU read the ratio,
+//! not the absolute figures. `lodkit demo` measures the same ratio for its report. Then its floors: the
 //! 8 main-path loads alone, and those with the 4 loads of its id-mismatch branch all made. Last,
 //! the combine of the same frames in buffers without object motion (`combine_at`) against a copy
 //! of its six textures.
 //!
 //! `cargo bench -p lodkit-cli --bench combine [-- SIZE PAIRS]` (default 512 x 512, 200 pairs)
 
-use lodkit_cli::demo::{combine_timing::combine_vs_copy, open_gpu};
+use lodkit_cli::demo::clock::Timer;
+use lodkit_cli::demo::{RECORDINGS, combine_timing::combine_vs_copy, open_gpu};
 
 fn main() {
     let args: Vec<u32> = std::env::args().filter_map(|a| a.parse().ok()).collect();
@@ -23,12 +25,18 @@ fn main() {
         }
     };
     println!("adapter: {}", gpu.adapter_summary());
-    match combine_vs_copy(&gpu, size, pairs) {
+    let ratios = Timer::new(&gpu, RECORDINGS).and_then(|t| combine_vs_copy(&gpu, &t, size, pairs));
+    match ratios {
         Ok(ratios) => {
             for r in ratios {
                 println!(
-                    "{size}x{size}, {pairs} interleaved pairs: {} {:.3} ms, {} {:.3} ms, median ratio {:.3}",
-                    r.pass, r.pass_ms, r.baseline, r.baseline_ms, r.ratio
+                    "{size}x{size}, {pairs} interleaved pairs ({}): {} {:.3} ms, {} {:.3} ms, median ratio {:.3}",
+                    r.clock.label(),
+                    r.pass,
+                    r.pass_ms,
+                    r.baseline,
+                    r.baseline_ms,
+                    r.ratio
                 );
             }
         }

@@ -420,8 +420,9 @@ impl UpsamplePass {
             let params = UpsampleParams {
                 low_viewport: [vw as f32, vh as f32],
                 full_size: [w as f32, h as f32],
-                sigma_z,
-                sigma_n,
+                // +inf (no range term) goes to the shader as a finite sigma that does the same.
+                sigma_z: crate::bilateral::gpu_sigma(sigma_z),
+                sigma_n: crate::bilateral::gpu_sigma(sigma_n),
                 pad: [0.0; 2],
             };
             gpu.queue

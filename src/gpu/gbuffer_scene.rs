@@ -171,6 +171,24 @@ impl GBufferRenderer {
         clear: wgpu::Color,
         far_view_depth: f32,
     ) -> Result<(), GpuError> {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let draw = (view, proj, items, clear, far_view_depth);
+        self.record(gpu, &mut encoder, target, r, draw)?;
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// [`render`](Self::render) recorded into `encoder` (its uniforms written to the queue, so
+    /// every recording until the submission draws the last ones written): `draw` is (view,
+    /// projection, items, clear color, far view depth).
+    pub fn record(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &LowResBuffer,
+        r: f32,
+        (view, proj, items, clear, far_view_depth): (Mat4, Mat4, &[GDrawItem], wgpu::Color, f32),
+    ) -> Result<(), GpuError> {
         const CALL: &str = "GBufferRenderer::render";
         same_color_format(CALL, "target", target.color_format(), self.color_format)?;
         self.draws.check_count(CALL, items.len())?;
@@ -192,17 +210,13 @@ impl GBufferRenderer {
                 })
                 .collect();
             self.draws.write(gpu, &uniforms)?;
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = target.begin_pass(&mut encoder, r, clear, far_view_depth);
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &self.camera_group, &[]);
-                for (i, item) in items.iter().enumerate() {
-                    pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
-                    item.mesh.draw(&mut pass);
-                }
+            let mut pass = target.begin_pass(encoder, r, clear, far_view_depth);
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.camera_group, &[]);
+            for (i, item) in items.iter().enumerate() {
+                pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
+                item.mesh.draw(&mut pass);
             }
-            gpu.queue.submit([encoder.finish()]);
             Ok(())
         })
     }
@@ -294,6 +308,22 @@ impl EdgeScene {
         r: f32,
         term: ShadingTerm,
     ) -> Result<(), GpuError> {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.record_term(gpu, &mut encoder, target, r, term)?;
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// [`render_term`](Self::render_term) recorded into `encoder` (to time it with GPU
+    /// timestamps, or to record it with other passes).
+    pub fn record_term(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &LowResBuffer,
+        r: f32,
+        term: ShadingTerm,
+    ) -> Result<(), GpuError> {
         let view = glam::camera::rh::view::look_at_mat4(
             Vec3::new(0.5, 1.2, 6.0),
             Vec3::new(0.0, 0.0, -1.0),
@@ -356,15 +386,7 @@ impl EdgeScene {
             ShadingTerm::Lighting => (&renderers[1], wgpu::Color::WHITE),
             ShadingTerm::Albedo => (&renderers[2], clear),
         };
-        renderer.render(
-            gpu,
-            target,
-            r,
-            view,
-            proj,
-            &items,
-            clear,
-            Self::FAR_VIEW_DEPTH,
-        )
+        let draw = (view, proj, &items[..], clear, Self::FAR_VIEW_DEPTH);
+        renderer.record(gpu, encoder, target, r, draw)
     }
 }

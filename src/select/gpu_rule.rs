@@ -74,7 +74,8 @@ pub struct SelectGroupData {
     pub levels: [[f32; 4]; SELECT_MAX_LEVELS],
     /// Levels in use.
     pub level_count: u32,
-    /// Max draw distance (+inf for none).
+    /// Max draw distance; `f32::MAX` for none (above [`SELECT_FAR`], which the GPU rule reads as
+    /// none: a shader is never given an infinity, which WGSL promises nothing for).
     pub max_distance: f32,
     /// max_distance - hysteresis.
     pub fade_from: f32,
@@ -97,7 +98,7 @@ impl LodGroup {
             let (lo, hi) = if i == 0 { (0.0, 0.0) } else { *band };
             table[i] = [level.distance, lo, hi, 0.0];
         }
-        let max = self.max_distance().unwrap_or(f32::INFINITY);
+        let max = self.max_distance().unwrap_or(f32::MAX);
         Some(SelectGroupData {
             levels: table,
             level_count: levels.len() as u32,

@@ -12,6 +12,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::DemoError;
+use super::clock::Timer;
 use super::frame_cost::Frame;
 use super::plots::{Chart, Series, line_chart};
 use super::report::Table;
@@ -84,7 +85,10 @@ impl ClosedLoop {
 
 /// Runs lodkit's controller, the paper's and the step heuristic on the edge scene at `size`.
 pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedLoop, DemoError> {
-    let (frame, mut scene) = Frame::new(gpu, size)?;
+    // One frame per timed run, as an engine times its frames: GPU timestamps where the device
+    // has them.
+    let timer = Timer::new(gpu, 1)?;
+    let (frame, mut scene) = Frame::new(gpu, &timer, size)?;
     let frame = |scene: &EdgeScene, r: f32| frame.whole(scene, r, 0).map(|ms| ms as f32);
     let times = |scene: &EdgeScene, r: f32| -> Result<Vec<f32>, GpuError> {
         let mut t = (0..CALIBRATION)

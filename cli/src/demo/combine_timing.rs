@@ -4,8 +4,9 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+use super::clock::{Record, Timer, interleaved};
 use super::reads::{Reads, Texels};
-use super::timing::{FORMAT, PassRatio, draw_fullscreen, interleaved, plain_pass_with};
+use super::timing::{FORMAT, PassRatio, plain_pass_with, record_fullscreen};
 use lodkit::gpu::frame_sequential::{CombinePass, LOD_DEPTH_FORMAT, LodBuffers};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::{one_group_layout, texture_2d, textures_and_uniform};
@@ -89,6 +90,7 @@ const COPY6: &str = buffer_reads!(still);
 /// (`combine_at`, `LODKIT_COMBINE_STILL`) against a plain pass reading its six textures.
 pub fn combine_vs_copy(
     gpu: &GpuContext,
+    timer: &Timer,
     size: u32,
     pairs: usize,
 ) -> Result<[PassRatio; 4], GpuError> {
@@ -162,24 +164,24 @@ pub fn combine_vs_copy(
     // LodBuffers::new has the motion target.
     textures.extend(buffers.motion());
     let group = || textures_and_uniform(gpu, &layout, &textures, None, "copy7");
-    let run = |buffers: &LodBuffers| {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        combine.encode(gpu, &mut encoder, buffers, 1, m, &target_view)?;
-        gpu.queue.submit([encoder.finish()]);
-        gpu.wait_idle()
+    let run = |encoder: &mut wgpu::CommandEncoder, buffers: &LodBuffers| {
+        combine.encode(gpu, encoder, buffers, 1, m, &target_view)
     };
-    let run_combine = || run(&buffers);
-    let run_still = || run(&still);
+    let run_combine = |e: &mut wgpu::CommandEncoder| run(e, &buffers);
+    let run_still = |e: &mut wgpu::CommandEncoder| run(e, &still);
     let (layout6, pipeline_layout6) =
         one_group_layout(gpu, &CombinePass::buffer_layout_entries(0), "copy6");
     let copy6 = plain_pass_with(gpu, COPY6, "copy6.wgsl", Some(&pipeline_layout6))?;
     let still_textures = [1, 0].map(|i| [still.color(i), still.id(i), still.depth(i)]);
     let still_group =
         || textures_and_uniform(gpu, &layout6, still_textures.as_flattened(), None, "copy6");
-    let run_copy6 = || draw_fullscreen(gpu, &copy6, &still_group, None, &target_view);
-    let run_copy = || draw_fullscreen(gpu, &copy7, &group, None, &target_view);
-    let run_loads = || draw_fullscreen(gpu, &loads8, &group, None, &target_view);
-    let run_loads12 = || draw_fullscreen(gpu, &loads12, &group, None, &target_view);
+    let fullscreen = |e: &mut wgpu::CommandEncoder, pipeline, group: &dyn Fn() -> _| {
+        record_fullscreen(gpu, e, pipeline, group, None, &target_view)
+    };
+    let run_copy6 = |e: &mut wgpu::CommandEncoder| fullscreen(e, &copy6, &still_group);
+    let run_copy = |e: &mut wgpu::CommandEncoder| fullscreen(e, &copy7, &group);
+    let run_loads = |e: &mut wgpu::CommandEncoder| fullscreen(e, &loads8, &group);
+    let run_loads12 = |e: &mut wgpu::CommandEncoder| fullscreen(e, &loads12, &group);
     // Counted from the shaders: the copy reads color, id and depth of each buffer and the object
     // motion; the combine the same, the older depth at its first estimate, and under branches
     // the older ids of its search.
@@ -202,20 +204,20 @@ pub fn combine_vs_copy(
     combine_formats.push(("object_motion", MOTION_FORMAT, Texels::One));
     let against_copy7 = (
         "plain copy of the same 7 textures",
-        &run_copy as &dyn Fn() -> Result<(), GpuError>,
+        &run_copy as Record<'_>,
         Reads::of_source(COPY7, "copy7.wgsl", &copy_formats)?,
     );
     let against_copy6 = (
         "plain copy of the same 6 textures",
-        &run_copy6 as &dyn Fn() -> Result<(), GpuError>,
+        &run_copy6 as Record<'_>,
         Reads::of_source(COPY6, "copy6.wgsl", &copy6_formats)?,
     );
-    type Baseline<'a> = (&'a str, &'a dyn Fn() -> Result<(), GpuError>, Reads);
+    type Baseline<'a> = (&'a str, Record<'a>, Reads);
     let time = |pass: &str,
                 reads: Reads,
-                run: &dyn Fn() -> Result<(), GpuError>,
+                run: Record<'_>,
                 (baseline, run_baseline, baseline_reads): &Baseline| {
-        let (pass_ms, baseline_ms, ratio) = interleaved(run, *run_baseline, pairs)?;
+        let (pass_ms, baseline_ms, ratio) = interleaved(gpu, timer, run, *run_baseline, pairs)?;
         Ok::<_, GpuError>(PassRatio {
             pass: pass.to_owned(),
             baseline: (*baseline).to_owned(),
@@ -224,6 +226,8 @@ pub fn combine_vs_copy(
             baseline_ms,
             ratio,
             pairs,
+            clock: timer.clock(),
+            recordings: timer.recordings(),
             pass_reads: reads,
             baseline_reads: *baseline_reads,
         })

@@ -10,15 +10,19 @@
 //! upsample multiplies by that albedo (the composite, inside the pass). Each route also runs from
 //! a packed L (`lodkit::gbuffer`'s packed texel: 4 low-resolution loads per pixel instead of 8;
 //! in the fine-grained route the upsample is folded into the composite).
+//!
+//! Every time is read from the [`Clock`] the figure names: GPU timestamps around a run of
+//! recordings where the device has them, the wall clock around a submission and its wait
+//! otherwise.
 
 use std::path::Path;
 
 use serde::Serialize;
 
 use super::DemoError;
+use super::clock::{Clock, Timer, median};
 use super::plots::{BarChart, Chart, Series, line_chart, stacked_bars};
 use super::report::Table;
-use super::timing::{median, wall_ms};
 use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
@@ -77,6 +81,10 @@ impl SweepRow {
 pub struct FrameCost {
     /// Image size.
     pub size: (u32, u32),
+    /// The clock every time was read from.
+    pub clock: Clock,
+    /// Recordings per timed run.
+    pub recordings: usize,
     /// Timing rounds per figure (medians).
     pub rounds: usize,
     /// The breakdown at [`BREAKDOWN_WORK`].
@@ -103,19 +111,12 @@ impl FrameCost {
     }
 }
 
-/// Runs `f` and waits for the GPU; its wall time in ms.
-fn timed(gpu: &GpuContext, f: impl Fn() -> Result<(), GpuError>) -> Result<f64, GpuError> {
-    wall_ms(&|| {
-        f()?;
-        gpu.wait_idle()
-    })
-}
-
 /// The resources of a framebuffer-LOD frame of the edge scene (the scene is passed to each
 /// call, since its shading work is the knob the measurements turn): the low-resolution buffer,
 /// the full-resolution prepass, the upsample pass and the target; each pass timed on request.
 pub(super) struct Frame<'a> {
     gpu: &'a GpuContext,
+    timer: &'a Timer,
     /// L, unpacked and packed.
     low: [LowResBuffer; 2],
     prepass: LowResBuffer,
@@ -130,6 +131,7 @@ impl<'a> Frame<'a> {
     /// The resources at `size`, RGBA8, and the edge scene for that aspect.
     pub(super) fn new(
         gpu: &'a GpuContext,
+        timer: &'a Timer,
         size: (u32, u32),
     ) -> Result<(Self, EdgeScene), GpuError> {
         let ((w, h), format) = (size, wgpu::TextureFormat::Rgba8Unorm);
@@ -137,6 +139,7 @@ impl<'a> Frame<'a> {
         let scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
         let frame = Self {
             gpu,
+            timer,
             low: [
                 LowResBuffer::new(gpu, w, h, format)?,
                 LowResBuffer::packed(gpu, w, h)?,
@@ -155,6 +158,11 @@ impl<'a> Frame<'a> {
         Ok((frame, scene))
     }
 
+    /// The time of `record` on the timer's clock, ms.
+    fn timed(&self, record: super::clock::Record<'_>) -> Result<f64, GpuError> {
+        self.timer.time(self.gpu, record)
+    }
+
     /// The low-resolution shading at `r` into L (`p`: 0 unpacked, 1 packed).
     fn shade(
         &self,
@@ -163,46 +171,45 @@ impl<'a> Frame<'a> {
         term: ShadingTerm,
         p: usize,
     ) -> Result<f64, GpuError> {
-        timed(self.gpu, || {
-            scene.render_term(self.gpu, &self.low[p], r, term)
-        })
+        self.timed(&|e| scene.record_term(self.gpu, e, &self.low[p], r, term))
     }
 
     fn prepass(&self, scene: &EdgeScene) -> Result<f64, GpuError> {
         let albedo = ShadingTerm::Albedo;
-        timed(self.gpu, || {
-            scene.render_term(self.gpu, &self.prepass, 1.0, albedo)
-        })
+        self.timed(&|e| scene.record_term(self.gpu, e, &self.prepass, 1.0, albedo))
     }
 
     /// Records the upsample of L `p` at `r`; `term` is what L holds (the lighting alone:
     /// fine-grained).
-    fn record_upsample(&self, r: f32, term: ShadingTerm, p: usize) -> Result<(), GpuError> {
+    fn record_upsample(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        r: f32,
+        term: ShadingTerm,
+        p: usize,
+    ) -> Result<(), GpuError> {
         let gpu = self.gpu;
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let (low, g, view) = (&self.low[p], self.prepass.geometry(), &self.view);
         let (sz, sn) = (SIGMA_Z, SIGMA_N);
         if term == ShadingTerm::Lighting {
             let albedo = self.prepass.color();
-            self.fine[p].encode_fine_grained(gpu, &mut encoder, low, r, g, albedo, sz, sn, view)?;
+            self.fine[p].encode_fine_grained(gpu, encoder, low, r, g, albedo, sz, sn, view)
         } else {
-            self.upsample[p].encode(gpu, &mut encoder, low, r, g, sz, sn, view)?;
+            self.upsample[p].encode(gpu, encoder, low, r, g, sz, sn, view)
         }
-        gpu.queue.submit([encoder.finish()]);
-        Ok(())
     }
 
     fn upsample(&self, r: f32, term: ShadingTerm, p: usize) -> Result<f64, GpuError> {
-        timed(self.gpu, || self.record_upsample(r, term, p))
+        self.timed(&|e| self.record_upsample(e, r, term, p))
     }
 
-    /// A whole frame at `r` from L `p` (0 unpacked, 1 packed), waited for once at its end; its
-    /// wall time in ms.
+    /// A whole frame at `r` from L `p` (0 unpacked, 1 packed): its three passes recorded one
+    /// after the other; its time in ms.
     pub(super) fn whole(&self, scene: &EdgeScene, r: f32, p: usize) -> Result<f64, GpuError> {
-        timed(self.gpu, || {
-            scene.render_term(self.gpu, &self.prepass, 1.0, ShadingTerm::Albedo)?;
-            scene.render_term(self.gpu, &self.low[p], r, ShadingTerm::Full)?;
-            self.record_upsample(r, ShadingTerm::Full, p)
+        self.timed(&|e| {
+            scene.record_term(self.gpu, e, &self.prepass, 1.0, ShadingTerm::Albedo)?;
+            scene.record_term(self.gpu, e, &self.low[p], r, ShadingTerm::Full)?;
+            self.record_upsample(e, r, ShadingTerm::Full, p)
         })
     }
 
@@ -225,11 +232,12 @@ impl<'a> Frame<'a> {
 /// Measures the breakdown and the sweep on the edge scene at `size`, medians of `rounds`.
 pub fn measure_frame_cost(
     gpu: &GpuContext,
+    timer: &Timer,
     size: (u32, u32),
     rounds: usize,
 ) -> Result<FrameCost, DemoError> {
     let rounds = rounds.max(3);
-    let (frame, mut scene) = Frame::new(gpu, size)?;
+    let (frame, mut scene) = Frame::new(gpu, timer, size)?;
     // Pass by pass, rounds interleaved over the configurations; round 0 warms up.
     scene.set_shading_work(BREAKDOWN_WORK);
     let full = ("full resolution", 1.0, ShadingTerm::Full, 0);
@@ -288,6 +296,8 @@ pub fn measure_frame_cost(
     }
     Ok(FrameCost {
         size,
+        clock: timer.clock(),
+        recordings: timer.recordings(),
         rounds,
         breakdown,
         sweep,

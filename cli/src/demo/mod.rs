@@ -10,6 +10,7 @@
 //! # Ok::<(), lodkit_cli::demo::DemoError>(())
 //! ```
 
+pub mod clock;
 pub mod closed_loop;
 pub mod combine_timing;
 pub mod cpu;
@@ -162,6 +163,10 @@ pub fn save(image: &image::RgbaImage, path: &Path) -> Result<(), DemoError> {
 pub struct DemoReport {
     /// Adapter name, backend, driver.
     pub adapter: String,
+    /// The driver and its version, as the adapter reports them.
+    pub driver: String,
+    /// The clock the timed figures were read from (GPU timestamps where the device has them).
+    pub clock: clock::Clock,
     /// Backend (Vulkan, Gl, ...).
     pub backend: String,
     /// Device type (Cpu = software rasterizer).
@@ -199,6 +204,10 @@ pub struct DemoReport {
     /// Wall time of the whole run, seconds.
     pub seconds: f64,
 }
+
+/// Recordings of a pass per timed run: the run shares one encoder and one submission, so the
+/// submission's fixed cost is spread over them (and, on GPU timestamps, not counted at all).
+pub const RECORDINGS: usize = 8;
 
 /// The most memory the frames of one run may take.
 pub const MAX_FRAME_MEMORY_MIB: u64 = 2048;
@@ -252,10 +261,10 @@ pub fn utc_date(secs: u64) -> String {
 }
 
 /// Opens the GPU the demo runs on: the first adapter of `LODKIT_BACKEND` or Vulkan then GL,
-/// with pipeline statistics when the adapter has them.
+/// with pipeline statistics and timestamps inside encoders when the adapter has them.
 pub fn open_gpu() -> Result<GpuContext, DemoError> {
     let options = GpuOptions {
-        optional_features: wgpu::Features::PIPELINE_STATISTICS_QUERY,
+        optional_features: wgpu::Features::PIPELINE_STATISTICS_QUERY | clock::TIMESTAMP_FEATURES,
         ..Default::default()
     };
     GpuContext::new_headless(&options).map_err(|e| match e {
@@ -325,28 +334,26 @@ pub fn run_on(
         bar.inc(1);
     };
     let rounds = (options.timing_pairs / 4).max(3);
-    let upsampling = upsampling::measure_upsampling(gpu, options.size, rounds, out, &mut tick)?;
+    let timer = clock::Timer::new(gpu, RECORDINGS)?;
+    let upsampling =
+        upsampling::measure_upsampling(gpu, &timer, options.size, rounds, out, &mut tick)?;
     bar.set_message("framebuffer LOD: frame cost and shading sweep");
-    let frame_cost = frame_cost::measure_frame_cost(gpu, options.fb_size, rounds)?;
+    let frame_cost = frame_cost::measure_frame_cost(gpu, &timer, options.fb_size, rounds)?;
     bar.inc(1);
     bar.set_message("framebuffer LOD: controllers on the real frame");
     let closed_loop = closed_loop::measure_closed_loop(gpu, options.fb_size)?;
     bar.inc(1);
     bar.set_message("pass time ratios");
+    let pairs = options.timing_pairs;
+    let combine_size = options.size.0.min(1024);
     let mut pass_ratios =
-        combine_timing::combine_vs_copy(gpu, options.size.0.min(1024), options.timing_pairs)?
-            .to_vec();
+        combine_timing::combine_vs_copy(gpu, &timer, combine_size, pairs)?.to_vec();
+    let fb_size = options.fb_size;
     pass_ratios.extend(timing::upsample_vs_bilinear(
-        gpu,
-        options.fb_size,
-        2.0,
-        options.timing_pairs,
+        gpu, &timer, fb_size, 2.0, pairs,
     )?);
     pass_ratios.extend(packed_timing::packed_upsample_vs_bilinear(
-        gpu,
-        options.fb_size,
-        2.0,
-        options.timing_pairs,
+        gpu, &timer, fb_size, 2.0, pairs,
     )?);
     bar.inc(1);
     bar.set_message("controllers and host-side figures");
@@ -354,7 +361,7 @@ pub fn run_on(
     let cpu = cpu::cpu_figures(15)?;
     bar.inc(1);
     bar.set_message("GPU LOD selection against select_batch");
-    let selection = selection::measure(gpu, 5)?;
+    let selection = selection::measure(gpu, &timer, 5)?;
     bar.inc(1);
     let info = gpu.adapter.get_info();
     let now = std::time::SystemTime::now()
@@ -362,6 +369,10 @@ pub fn run_on(
         .map_or(0, |d| d.as_secs());
     let mut report = DemoReport {
         adapter: gpu.adapter_summary(),
+        driver: format!("{} {}", info.driver, info.driver_info)
+            .trim()
+            .to_owned(),
+        clock: timer.clock(),
         backend: format!("{:?}", info.backend),
         device_type: format!("{:?}", info.device_type),
         date: utc_date(now),

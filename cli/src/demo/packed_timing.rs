@@ -3,8 +3,9 @@
 //! floor of any packed eq. 1), and the fold-in upsample inside a composite pass against the same
 //! composite with a bilinear sample. Same host work on both sides ([`super::timing::HOST_WORK`]).
 
+use super::clock::{Record, Timer, interleaved};
 use super::reads::{Reads, Texels};
-use super::timing::{BILINEAR, FORMAT, PassRatio, draw_fullscreen, interleaved, plain_pass};
+use super::timing::{BILINEAR, FORMAT, PassRatio, plain_pass, record_fullscreen};
 use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
@@ -54,6 +55,7 @@ struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 /// composite with a bilinear sample.
 pub fn packed_upsample_vs_bilinear(
     gpu: &GpuContext,
+    timer: &Timer,
     size: (u32, u32),
     r: f32,
     pairs: usize,
@@ -70,16 +72,13 @@ pub fn packed_upsample_vs_bilinear(
     let view = texture_2d(gpu, size, FORMAT, usage, "target")?.create_view(&Default::default());
     let upsample = UpsamplePass::packed(gpu, FORMAT)?;
     let fold_in = UpsamplePass::packed_fine_grained(gpu, FORMAT)?;
-    let run_pass = |fine: bool| {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let run_pass = |encoder: &mut wgpu::CommandEncoder, fine: bool| {
         let (g, a, (sz, sn)) = (full.geometry(), full.color(), (SIGMA_Z, SIGMA_N));
         if fine {
-            fold_in.encode_fine_grained(gpu, &mut encoder, &packed, r, g, a, sz, sn, &view)?;
+            fold_in.encode_fine_grained(gpu, encoder, &packed, r, g, a, sz, sn, &view)
         } else {
-            upsample.encode(gpu, &mut encoder, &packed, r, g, sz, sn, &view)?;
+            upsample.encode(gpu, encoder, &packed, r, g, sz, sn, &view)
         }
-        gpu.queue.submit([encoder.finish()]);
-        gpu.wait_idle()
     };
     let (vw, vh) = low.viewport(r);
     let s = [vw as f32 / w as f32, vh as f32 / h as f32, 0.0, 0.0];
@@ -119,15 +118,33 @@ pub fn packed_upsample_vs_bilinear(
         }))
     };
     let uniform = Some((&scale, scale_bytes));
-    let run_bilinear =
-        || draw_fullscreen(gpu, &bilinear, &|| group(&bilinear, false), uniform, &view);
-    let run_composite =
-        || draw_fullscreen(gpu, &composite, &|| group(&composite, true), uniform, &view);
+    let run_bilinear = |e: &mut wgpu::CommandEncoder| {
+        record_fullscreen(
+            gpu,
+            e,
+            &bilinear,
+            &|| group(&bilinear, false),
+            uniform,
+            &view,
+        )
+    };
+    let run_composite = |e: &mut wgpu::CommandEncoder| {
+        record_fullscreen(
+            gpu,
+            e,
+            &composite,
+            &|| group(&composite, true),
+            uniform,
+            &view,
+        )
+    };
     let loads = plain_pass(gpu, LOADS5, "loads5.wgsl")?;
     let layout = loads.get_bind_group_layout(0);
     let textures = [packed.color(), full.geometry()];
     let loads_group = || textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads5");
-    let run_loads = || draw_fullscreen(gpu, &loads, &loads_group, uniform, &view);
+    let run_loads = |e: &mut wgpu::CommandEncoder| {
+        record_fullscreen(gpu, e, &loads, &loads_group, uniform, &view)
+    };
     // Counted from the shaders.
     let packed_bound = [
         ("low", PACKED_FORMAT, Texels::One),
@@ -152,11 +169,11 @@ pub fn packed_upsample_vs_bilinear(
     )?;
     let time = |pass: String,
                 reads: Reads,
-                run: &dyn Fn() -> Result<(), GpuError>,
+                run: Record<'_>,
                 baseline: &str,
                 baseline_reads: Reads,
-                run_baseline: &dyn Fn() -> Result<(), GpuError>| {
-        let (pass_ms, baseline_ms, ratio) = interleaved(run, run_baseline, pairs)?;
+                run_baseline: Record<'_>| {
+        let (pass_ms, baseline_ms, ratio) = interleaved(gpu, timer, run, run_baseline, pairs)?;
         Ok::<_, GpuError>(PassRatio {
             pass,
             baseline: baseline.to_owned(),
@@ -165,6 +182,8 @@ pub fn packed_upsample_vs_bilinear(
             baseline_ms,
             ratio,
             pairs,
+            clock: timer.clock(),
+            recordings: timer.recordings(),
             pass_reads: reads,
             baseline_reads,
         })
@@ -174,7 +193,7 @@ pub fn packed_upsample_vs_bilinear(
         time(
             format!("bilateral upsample, packed L (r = {r})"),
             upsample_reads,
-            &|| run_pass(false),
+            &|e| run_pass(e, false),
             bilinear_name,
             bilinear_reads,
             &run_bilinear,
@@ -190,7 +209,7 @@ pub fn packed_upsample_vs_bilinear(
         time(
             format!("fold-in upsample in the composite, packed L (r = {r})"),
             fold_in_reads,
-            &|| run_pass(true),
+            &|e| run_pass(e, true),
             "the same composite, bilinear upsample",
             composite_reads,
             &run_composite,

@@ -2,14 +2,14 @@
 //! interleaved pairs so machine noise hits both alike: the bilateral upsample against a
 //! hardware-filtered bilinear fetch (the combine's timings are in
 //! [`combine_timing`](super::combine_timing), the packed upsample's in
-//! [`packed_timing`](super::packed_timing)). Wall
-//! time per pass including submit and wait: read the ratio on a software GPU, not the
-//! milliseconds.
-
-use std::time::Instant;
+//! [`packed_timing`](super::packed_timing)). Each figure is read from the
+//! [`Clock`](super::clock::Clock) it names: GPU timestamps around a run of recordings where the
+//! device has them, so the submission's fixed cost sits on neither side of a ratio; the wall
+//! clock otherwise.
 
 use serde::Serialize;
 
+use super::clock::{Clock, Timer, interleaved};
 use super::reads::{Reads, Texels};
 use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
@@ -30,58 +30,25 @@ pub struct PassRatio {
     pub baseline: String,
     /// Image size.
     pub size: (u32, u32),
-    /// Median wall time of the pass, ms.
+    /// Median time of one recording of the pass, ms.
     pub pass_ms: f64,
-    /// Median wall time of the baseline, ms.
+    /// Median time of one recording of the baseline, ms.
     pub baseline_ms: f64,
     /// Median of the per-pair ratios.
     pub ratio: f64,
     /// Pairs timed.
     pub pairs: usize,
+    /// The clock the times were read from.
+    pub clock: Clock,
+    /// Recordings per timed run.
+    pub recordings: usize,
     /// Texture reads per output pixel of the pass, counted from its shader.
     pub pass_reads: Reads,
     /// Texture reads per output pixel of the baseline.
     pub baseline_reads: Reads,
 }
 
-/// Median: the middle value, or the mean of the two middle values for an even count; NaN when
-/// empty (lodkit's, shared with the Bevy examples).
-pub use lodkit::metrics::median;
-
-/// Wall time of `f` in milliseconds.
-pub fn wall_ms(f: &dyn Fn() -> Result<(), GpuError>) -> Result<f64, GpuError> {
-    let t = Instant::now();
-    f()?;
-    Ok(t.elapsed().as_secs_f64() * 1e3)
-}
-
-/// Times `a` and `b` (each must wait for the GPU itself) in `pairs` interleaved pairs after a
-/// few warm-up rounds, alternating which goes first. Returns the medians of a, b and a/b.
-pub fn interleaved(
-    a: &dyn Fn() -> Result<(), GpuError>,
-    b: &dyn Fn() -> Result<(), GpuError>,
-    pairs: usize,
-) -> Result<(f64, f64, f64), GpuError> {
-    let time = wall_ms;
-    for _ in 0..5 {
-        a()?;
-        b()?;
-    }
-    let (mut ta, mut tb, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
-    for i in 0..pairs.max(1) {
-        let (x, y) = if i % 2 == 0 {
-            let x = time(a)?;
-            (x, time(b)?)
-        } else {
-            let y = time(b)?;
-            (time(a)?, y)
-        };
-        ta.push(x);
-        tb.push(y);
-        ratio.push(x / y);
-    }
-    Ok((median(&ta), median(&tb), median(&ratio)))
-}
+pub use super::clock::median;
 
 /// A fullscreen pipeline (`vs_main`, `fs_main`, RGBA8 target) from WGSL `source` that may
 /// import lodkit modules; `name` labels it and names the file in errors.
@@ -146,41 +113,41 @@ struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 }
 ";
 
-/// A baseline pass timed as lodkit's passes run: its bind group built and its uniform (if any)
-/// written per call inside the same error scopes ([`GpuContext::guarded`]), then submit and
-/// wait. The lodkit pass and its baseline so do the same host work per call.
-pub(super) fn draw_fullscreen(
+/// Records a baseline pass as lodkit's passes record: its bind group built and its uniform (if
+/// any) written per recording inside the same error scopes ([`GpuContext::guarded`]).
+pub(super) fn record_fullscreen(
     gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
     pipeline: &wgpu::RenderPipeline,
     group: &dyn Fn() -> Result<wgpu::BindGroup, GpuError>,
     uniform: Option<(&wgpu::Buffer, &[u8])>,
     target: &wgpu::TextureView,
 ) -> Result<(), GpuError> {
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
     gpu.guarded("baseline", || {
         if let Some((buffer, bytes)) = uniform {
             gpu.queue.write_buffer(buffer, 0, bytes);
         }
         let group = group()?;
-        let mut pass = begin_color_pass(&mut encoder, target, wgpu::Color::BLACK, "baseline");
+        let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "baseline");
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &group, &[]);
         pass.draw(0..3, 0..1);
         Ok(())
-    })?;
-    gpu.queue.submit([encoder.finish()]);
-    gpu.wait_idle()
+    })
 }
 
-/// What the timed pass and its baseline each do on the host per call.
-pub const HOST_WORK: &str = "each call builds its bind group, writes its uniform (where it has \
-    one), records inside wgpu error scopes, submits and waits";
+/// What the timed pass and its baseline each do per recording, and what the clock counts.
+pub const HOST_WORK: &str = "each recording builds its bind group and writes its uniform (where \
+    it has one) inside wgpu error scopes; a run of recordings shares one encoder and one \
+    submission, and GPU timestamps around the run count the GPU's time alone (the wall clock, \
+    where there are none, also counts the submission and the wait)";
 
 /// The bilateral upsample pass against a hardware-filtered bilinear pass over the same low-res
 /// color, on the edge scene at resize factor `r`; then, against the same baseline, a pass that
 /// only makes eq. 1's nine texel loads (no arithmetic): the floor of any per-pixel eq. 1.
 pub fn upsample_vs_bilinear(
     gpu: &GpuContext,
+    timer: &Timer,
     size: (u32, u32),
     r: f32,
     pairs: usize,
@@ -231,36 +198,30 @@ pub fn upsample_vs_bilinear(
             ],
         }))
     };
-    let run_bilateral = || {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let run_bilateral = |encoder: &mut wgpu::CommandEncoder| {
         upsample.encode(
             gpu,
-            &mut encoder,
+            encoder,
             &low,
             r,
             full.geometry(),
             SIGMA_Z,
             SIGMA_N,
             &view,
-        )?;
-        gpu.queue.submit([encoder.finish()]);
-        gpu.wait_idle()
+        )
     };
     let scale_bytes: &[u8] = bytemuck::cast_slice(&s);
-    let run_bilinear =
-        || draw_fullscreen(gpu, &bilinear, &group, Some((&scale, scale_bytes)), &view);
+    let run_bilinear = |encoder: &mut wgpu::CommandEncoder| {
+        let uniform = Some((&scale, scale_bytes));
+        record_fullscreen(gpu, encoder, &bilinear, &group, uniform, &view)
+    };
     let loads = plain_pass(gpu, LOADS9, "loads9.wgsl")?;
     let textures = [low.color(), low.geometry(), full.geometry()];
     let layout = loads.get_bind_group_layout(0);
     let loads_group = || textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads9");
-    let run_loads = || {
-        draw_fullscreen(
-            gpu,
-            &loads,
-            &loads_group,
-            Some((&scale, scale_bytes)),
-            &view,
-        )
+    let run_loads = |encoder: &mut wgpu::CommandEncoder| {
+        let uniform = Some((&scale, scale_bytes));
+        record_fullscreen(gpu, encoder, &loads, &loads_group, uniform, &view)
     };
     // Counted from the shaders: eq. 1 reads the pixel's own geometry and the 2x2 cell's colors
     // and geometry; the bilinear pass one filtered sample (4 texels).
@@ -276,8 +237,8 @@ pub fn upsample_vs_bilinear(
         "bilinear.wgsl",
         &[("low_color", FORMAT, Texels::Linear)],
     )?;
-    let time = |pass: String, reads: Reads, run: &dyn Fn() -> Result<(), GpuError>| {
-        let (pass_ms, baseline_ms, ratio) = interleaved(run, &run_bilinear, pairs)?;
+    let time = |pass: String, reads: Reads, run: super::clock::Record<'_>| {
+        let (pass_ms, baseline_ms, ratio) = interleaved(gpu, timer, run, &run_bilinear, pairs)?;
         Ok::<_, GpuError>(PassRatio {
             pass,
             baseline: "bilinear upsample (hardware filter)".to_owned(),
@@ -286,6 +247,8 @@ pub fn upsample_vs_bilinear(
             baseline_ms,
             ratio,
             pairs,
+            clock: timer.clock(),
+            recordings: timer.recordings(),
             pass_reads: reads,
             baseline_reads: bilinear_reads,
         })

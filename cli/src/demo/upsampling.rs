@@ -8,7 +8,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::DemoError;
-use super::timing::{median, wall_ms};
+use super::clock::{Timer, median};
 use lodkit::framebuffer_lod::{
     FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
     RlsController, StepController, psnr_rgba8, simulate, ssim_rgba8, step_response,
@@ -80,6 +80,7 @@ fn heat(image: &[u8], reference: &[u8]) -> Vec<u8> {
 /// times whole frames over `rounds` rounds.
 pub fn measure_upsampling(
     gpu: &GpuContext,
+    timer: &Timer,
     size: (u32, u32),
     rounds: usize,
     out: &Path,
@@ -109,20 +110,28 @@ pub fn measure_upsampling(
     let target = texture_2d(gpu, size, format, usage, "upsampled")?;
     let view = target.create_view(&Default::default());
     // `p` picks the layout of L: 0 color + geometry, 1 packed.
-    let upsample_with = |p: usize, r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        upsample[p].encode(gpu, &mut encoder, &lows[p], r, geometry, sz, sn, &view)?;
-        gpu.queue.submit([encoder.finish()]);
-        Ok::<(), GpuError>(())
+    let record_upsample = |e: &mut wgpu::CommandEncoder,
+                           p: usize,
+                           r: f32,
+                           geometry: &wgpu::Texture,
+                           (sz, sn): (f32, f32)| {
+        upsample[p].encode(gpu, e, &lows[p], r, geometry, sz, sn, &view)
     };
     // Fine-grained: the upsampled lighting times the full-resolution albedo, in the upsample.
-    let fine_with = |p: usize, r: f32| {
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let record_fine = |e: &mut wgpu::CommandEncoder, p: usize, r: f32| {
         let (g, a, (sz, sn)) = (albedo.geometry(), albedo.color(), (SIGMA_Z, SIGMA_N));
-        fine_pass[p].encode_fine_grained(gpu, &mut encoder, &lows[p], r, g, a, sz, sn, &view)?;
+        fine_pass[p].encode_fine_grained(gpu, e, &lows[p], r, g, a, sz, sn, &view)
+    };
+    let submit = |record: &dyn Fn(&mut wgpu::CommandEncoder) -> Result<(), GpuError>| {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        record(&mut encoder)?;
         gpu.queue.submit([encoder.finish()]);
         Ok::<(), GpuError>(())
     };
+    let upsample_with = |p: usize, r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
+        submit(&|e| record_upsample(e, p, r, geometry, (sz, sn)))
+    };
+    let fine_with = |p: usize, r: f32| submit(&|e| record_fine(e, p, r));
     let mut rows = Vec::new();
     for r in RESIZE_FACTORS {
         let mut images = Vec::new();
@@ -171,28 +180,24 @@ pub fn measure_upsampling(
     // route (full-res albedo, which writes the geometry too, + low-res lighting + the upsample
     // that multiplies them: the frame whose image is measured above); each from both layouts.
     let prepass = LowResBuffer::new(gpu, w, h, format)?;
-    let time = |f: &dyn Fn() -> Result<(), GpuError>| {
-        wall_ms(&|| {
-            f()?;
-            gpu.wait_idle()
-        })
-    };
+    let time = |f: &dyn Fn(&mut wgpu::CommandEncoder) -> Result<(), GpuError>| timer.time(gpu, f);
     let mut base = Vec::new();
     let mut times = vec![vec![Vec::new(); ROUTES.len()]; RESIZE_FACTORS.len()];
+    let (full_term, albedo_term) = (ShadingTerm::Full, ShadingTerm::Albedo);
     for round in 0..rounds + 2 {
-        let t0 = time(&|| scene.render(gpu, &full, 1.0))?;
+        let t0 = time(&|e| scene.record_term(gpu, e, &full, 1.0, full_term))?;
         let mut ts = Vec::new();
         for &r in &RESIZE_FACTORS {
             for (p, low) in lows.iter().enumerate() {
-                ts.push(time(&|| {
-                    scene.render_term(gpu, &prepass, 1.0, ShadingTerm::Albedo)?;
-                    scene.render(gpu, low, r)?;
-                    upsample_with(p, r, prepass.geometry(), SIGMA_Z, SIGMA_N)
+                ts.push(time(&|e| {
+                    scene.record_term(gpu, e, &prepass, 1.0, albedo_term)?;
+                    scene.record_term(gpu, e, low, r, full_term)?;
+                    record_upsample(e, p, r, prepass.geometry(), (SIGMA_Z, SIGMA_N))
                 })?);
-                ts.push(time(&|| {
-                    scene.render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)?;
-                    scene.render_term(gpu, low, r, ShadingTerm::Lighting)?;
-                    fine_with(p, r)
+                ts.push(time(&|e| {
+                    scene.record_term(gpu, e, &albedo, 1.0, albedo_term)?;
+                    scene.record_term(gpu, e, low, r, ShadingTerm::Lighting)?;
+                    record_fine(e, p, r)
                 })?);
             }
         }

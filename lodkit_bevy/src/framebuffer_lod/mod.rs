@@ -211,7 +211,8 @@ pub enum FramebufferLodUpsample {
         /// Sigma on the foreshortened normal distance (lodkit::normal_distance; default 0.5).
         normal_sigma: f32,
     },
-    /// Plain bilinear upsampling (the same pass with infinite sigmas): what a renderer does
+    /// Plain bilinear upsampling (the same pass with sigmas that turn the range terms off,
+    /// `lodkit::bilateral::BILATERAL_SIGMA_OFF`): what a renderer does
     /// without geometry awareness; here for comparison.
     Bilinear,
 }
@@ -226,14 +227,18 @@ impl Default for FramebufferLodUpsample {
 }
 
 impl FramebufferLodUpsample {
-    /// The (depth, normal) sigmas the upsample pass uses; infinite for bilinear.
+    /// The (depth, normal) sigmas the upsample pass uses; `BILATERAL_SIGMA_OFF` for bilinear (a
+    /// finite value: a shader must not be given an infinity).
     pub fn sigmas(&self) -> (f32, f32) {
         match *self {
             Self::Bilateral {
                 depth_sigma,
                 normal_sigma,
             } => (depth_sigma, normal_sigma),
-            Self::Bilinear => (f32::INFINITY, f32::INFINITY),
+            Self::Bilinear => (
+                lodkit::bilateral::BILATERAL_SIGMA_OFF,
+                lodkit::bilateral::BILATERAL_SIGMA_OFF,
+            ),
         }
     }
 }

@@ -6,6 +6,8 @@
 //
 // Exports:
 //   LODKIT_BILATERAL_MIN_WEIGHT: float   fallback threshold on the sum of weights (1e-4)
+//   LODKIT_BILATERAL_SIGMA_OFF: float   a sigma that turns its range term off (1e30; a shader
+//       must not be given +inf)
 //   lodkit_bilateral_range(difference, sigma) -> float
 //   lodkit_bilateral_tent(f) -> vec4
 //   lodkit_bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> float
@@ -36,7 +38,10 @@
 /// Sum of weights below which eq. 1 falls back to the sample closest in depth.
 const float LODKIT_BILATERAL_MIN_WEIGHT = 1e-4;
 
-/// Gaussian range filter exp(-difference^2 / (2 sigma^2)); 1 when sigma is +inf.
+/// A sigma that turns its range term off (finite: a shader must not be given +inf).
+const float LODKIT_BILATERAL_SIGMA_OFF = 1e30;
+
+/// Gaussian range filter exp(-difference^2 / (2 sigma^2)); 1 when sigma is LODKIT_BILATERAL_SIGMA_OFF.
 float lodkit_bilateral_range(float difference, float sigma) {
     float s = difference / sigma;
     return exp(-0.5 * s * s);

@@ -56,10 +56,11 @@ const float LODKIT_GBUFFER_HALF_MAX = 65504.0;
 /// `v` as two halves in one word (x in the low 16 bits); see the header for the rounding.
 uint lodkit_gbuffer_pack_half2(vec2 v) {
     vec2 a = min(abs(v), vec2(LODKIT_GBUFFER_HALF_MAX));
-    // Scaling by 2^-112 moves the exponent to the half's bias.
+    // Scaling by 2^-112 moves the exponent to the half's bias; below 2^-14 the product would be a
+    // denormal (which a GPU may flush) and is not read. A zero is written without its sign.
     uvec2 bits = (floatBitsToUint(a * 1.92592994e-34) + uvec2(0x1000u)) >> uvec2(13u);
-    uvec2 magnitude = mix(bits, uvec2(0u), lessThan(a, vec2(6.10351562e-5)));
-    uvec2 h = magnitude | ((floatBitsToUint(v) >> uvec2(16u)) & uvec2(0x8000u));
+    uvec2 sign_bits = (floatBitsToUint(v) >> uvec2(16u)) & uvec2(0x8000u);
+    uvec2 h = mix(uvec2(0u), bits | sign_bits, greaterThanEqual(a, vec2(6.10351562e-5)));
     return h.x | (h.y << 16u);
 }
 

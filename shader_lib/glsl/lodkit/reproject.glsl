@@ -43,10 +43,12 @@ bool lodkit_in_viewport(vec2 uv) {
 /// Reprojects the point on this pixel's ray whose old clip depth is `old_depth` (the first
 /// estimate, `depth`, where there is none).
 vec3 lodkit_reproject_refine(vec4 base, float depth, float old_depth, mat4 new_to_old) {
+    // Solved or not is read from num and den, never from the quotient (see the WGSL form).
     vec4 c = new_to_old[2];
-    float z = (old_depth * base.w - base.z) / (c.z - old_depth * c.w);
-    bool solved = abs(z) <= 3.0e38;
-    return lodkit_reproject_from_base(base, solved ? z : depth, new_to_old);
+    float num = old_depth * base.w - base.z;
+    float den = c.z - old_depth * c.w;
+    bool solved = abs(den) >= 1.17549435e-38 && abs(num) <= 3.0e38 * min(abs(den), 1.0);
+    return lodkit_reproject_from_base(base, solved ? num / den : depth, new_to_old);
 }
 
 #endif // LODKIT_REPROJECT_GLSL

@@ -14,7 +14,8 @@
 //
 // Exports:
 //   BILATERAL_MIN_WEIGHT: f32   fallback threshold on the sum of weights (1e-4)
-//   bilateral_range(difference, sigma) -> f32   exp(-d^2 / (2 sigma^2)); 1 for sigma = +inf
+//   BILATERAL_SIGMA_OFF: f32   a sigma that turns its range term off (1e30, finite)
+//   bilateral_range(difference, sigma) -> f32   exp(-d^2 / (2 sigma^2)); 1 for BILATERAL_SIGMA_OFF
 //   bilateral_tent(f) -> vec4<f32>   bilinear weights of the 2x2 samples at fraction f
 //   bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> f32   one term of eq. 1
 //   bilateral_upsample(f, values, depths, normals, depth, normal, sigma_z, sigma_n) -> vec4<f32>
@@ -49,7 +50,11 @@
 /// Sum of weights below which eq. 1 falls back to the sample closest in depth.
 const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
 
-/// Gaussian range filter exp(-difference^2 / (2 sigma^2)); 1 when sigma is +inf.
+/// A sigma that turns its range term off: every difference over it squares to 0 (or a denormal,
+/// which is as good), so the weight is 1. Finite, unlike +inf, which no shader must be given.
+const BILATERAL_SIGMA_OFF: f32 = 1e30;
+
+/// Gaussian range filter exp(-difference^2 / (2 sigma^2)); 1 when sigma is BILATERAL_SIGMA_OFF.
 fn bilateral_range(difference: f32, sigma: f32) -> f32 {
     let s = difference / sigma;
     return exp(-0.5 * s * s);
@@ -82,7 +87,7 @@ fn bilateral_upsample_projected(
     sigma_z: f32,
     sigma_n: f32,
 ) -> vec4<f32> {
-    // Differences scaled by 1 / sigma (0 for sigma = +inf: no range term).
+    // Differences scaled by 1 / sigma (about 0 for BILATERAL_SIGMA_OFF: no range term).
     let inv_z = 1.0 / sigma_z;
     let inv_n = 1.0 / sigma_n;
     let dz = depths - depth;

@@ -13,7 +13,7 @@
 // foreshortening map (nx / nz, ny / nz) as two halves: what eq. 1 compares, so the upsampler
 // divides nothing. Halves are written by lodkit's own conversion (no float16 capability needed):
 // round to nearest (ties away from zero), magnitudes clamped to 65504, those below 2^-14 (the
-// smallest normal half) written as zero. The paper's variant (a 16-bit depth and an 8+8-bit
+// smallest normal half) written as +0. The paper's variant (a 16-bit depth and an 8+8-bit
 // normal in one rgba16 target) loses the normal's z sign and depth precision; lodkit does not
 // offer it.
 //
@@ -61,15 +61,17 @@ fn gbuffer_normal(geometry: vec4<f32>) -> vec3<f32> {
 const GBUFFER_HALF_MAX: f32 = 65504.0;
 
 /// `v` as two IEEE half floats in one word, x in the low 16 bits: rounded to nearest (ties away
-/// from zero), magnitudes clamped to GBUFFER_HALF_MAX, those below 2^-14 written as (signed) zero.
-/// Inputs must be finite.
+/// from zero), magnitudes clamped to GBUFFER_HALF_MAX, those below 2^-14 written as +0 (a zero's
+/// sign is not kept: GPUs need not keep it, so the word must not depend on it). Inputs must be
+/// finite.
 fn gbuffer_pack_half2(v: vec2<f32>) -> u32 {
     let a = min(abs(v), vec2<f32>(GBUFFER_HALF_MAX));
     // Scaling by 2^-112 moves the exponent to the half's bias: the half is then the float's bits
-    // shifted right by 13, after adding half of the dropped last place.
+    // shifted right by 13, after adding half of the dropped last place. Below 2^-14 the product
+    // would be a denormal (which a GPU may flush): those magnitudes are not read.
     let bits = (bitcast<vec2<u32>>(a * 1.92592994e-34) + vec2<u32>(0x1000u)) >> vec2<u32>(13u);
-    let magnitude = select(bits, vec2<u32>(0u), a < vec2<f32>(6.10351562e-5));
-    let h = magnitude | ((bitcast<vec2<u32>>(v) >> vec2<u32>(16u)) & vec2<u32>(0x8000u));
+    let sign = (bitcast<vec2<u32>>(v) >> vec2<u32>(16u)) & vec2<u32>(0x8000u);
+    let h = select(vec2<u32>(0u), bits | sign, a >= vec2<f32>(6.10351562e-5));
     return h.x | (h.y << 16u);
 }
 

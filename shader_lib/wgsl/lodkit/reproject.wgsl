@@ -54,9 +54,12 @@ fn in_viewport(uv: vec2<f32>) -> bool {
 /// pixel shows another surface (a stipple hole, an edge). Where no point of the ray has that old
 /// depth, the reprojection of `depth` itself.
 fn reproject_refine(base: vec4<f32>, depth: f32, old_depth: f32, new_to_old: mat4x4<f32>) -> vec3<f32> {
-    // old.z / old.w = old_depth along base + z * column 2, solved for z.
+    // old.z / old.w = old_depth along base + z * column 2, solved for z = num / den. Whether it
+    // is solved is read from num and den, never from the quotient: a GPU need not give a
+    // division by zero (or by a flushed denormal) an infinity or a NaN to test for.
     let c = new_to_old[2];
-    let z = (old_depth * base.w - base.z) / (c.z - old_depth * c.w);
-    let solved = abs(z) <= 3.0e38;
-    return reproject_from_base(base, select(depth, z, solved), new_to_old);
+    let num = old_depth * base.w - base.z;
+    let den = c.z - old_depth * c.w;
+    let solved = abs(den) >= 1.17549435e-38 && abs(num) <= 3.0e38 * min(abs(den), 1.0);
+    return reproject_from_base(base, select(depth, num / den, solved), new_to_old);
 }

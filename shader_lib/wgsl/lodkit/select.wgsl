@@ -65,7 +65,7 @@ struct SelectGroup {
     levels: array<vec4<f32>, 8>,
     /// Levels in use, 1 ..= SELECT_MAX_LEVELS.
     level_count: u32,
-    /// Max draw distance (+inf for none).
+    /// Max draw distance; above SELECT_FAR for none (the host writes 3.4e38: no infinity).
     max_distance: f32,
     /// max_distance - hysteresis: where the fade-out begins.
     fade_from: f32,
@@ -134,14 +134,15 @@ fn select_distance(center: vec3<f32>, camera_position: vec3<f32>, factor: f32, m
 /// dt / duration for time-driven transitions (0 when dt is not positive). The same rule, float
 /// for float, as LodGroup::select.
 fn select_level(distance: f32, group: SelectGroup, mode: u32, step: f32, state: SelectState) -> SelectOutcome {
-    // NaN counts as SELECT_FAR (found from its bits: compilers may fold `d != d`), negative
-    // as 0.
+    // Negative counts as 0. A NaN distance (a NaN position or scale) counts as SELECT_FAR where
+    // the GPU keeps the NaN (found from its bits: compilers may fold `d != d`); WGSL promises
+    // nothing for NaN or infinity, so the host refuses such instances and this is only a guard.
     var d = max(distance, 0.0);
     if ((bitcast<u32>(distance) & 0x7fffffffu) > 0x7f800000u) {
         d = SELECT_FAR;
     }
     let n = min(group.level_count, SELECT_MAX_LEVELS);
-    // A max distance above SELECT_FAR is +inf: none.
+    // A max distance above SELECT_FAR is none.
     if (group.max_distance <= SELECT_FAR && d >= group.max_distance) {
         return SelectOutcome(Selection(n - 1u, SELECT_NONE, 0.0, 0.0, false), SelectState(SELECT_STATE_NEW, 0.0));
     }
