@@ -58,7 +58,9 @@ uint lodkit_gbuffer_pack_half2(vec2 v) {
     vec2 a = min(abs(v), vec2(LODKIT_GBUFFER_HALF_MAX));
     // Scaling by 2^-112 moves the exponent to the half's bias.
     uvec2 bits = (floatBitsToUint(a * 1.92592994e-34) + uvec2(0x1000u)) >> uvec2(13u);
-    uvec2 magnitude = mix(bits, uvec2(0u), lessThan(a, vec2(6.10351562e-5)));
+    // Per component: mix() over integer vectors needs GLSL 4.50 or GLSL ES 3.10.
+    const float tiny = 6.10351562e-5;
+    uvec2 magnitude = uvec2(a.x < tiny ? 0u : bits.x, a.y < tiny ? 0u : bits.y);
     uvec2 h = magnitude | ((floatBitsToUint(v) >> uvec2(16u)) & uvec2(0x8000u));
     return h.x | (h.y << 16u);
 }

@@ -68,7 +68,11 @@ fn gbuffer_pack_half2(v: vec2<f32>) -> u32 {
     // Scaling by 2^-112 moves the exponent to the half's bias: the half is then the float's bits
     // shifted right by 13, after adding half of the dropped last place.
     let bits = (bitcast<vec2<u32>>(a * 1.92592994e-34) + vec2<u32>(0x1000u)) >> vec2<u32>(13u);
-    let magnitude = select(bits, vec2<u32>(0u), a < vec2<f32>(6.10351562e-5));
+    // One select per component: naga writes a select with a vector condition as
+    // mix(a, b, bvec), which GLSL before 4.50 and GLSL ES 3.00 (GL 3.3, GLES 3.0, WebGL2) only
+    // have for float vectors; a scalar condition becomes `?:`, which every version has.
+    let tiny = 6.10351562e-5;
+    let magnitude = vec2<u32>(select(bits.x, 0u, a.x < tiny), select(bits.y, 0u, a.y < tiny));
     let h = magnitude | ((bitcast<vec2<u32>>(v) >> vec2<u32>(16u)) & vec2<u32>(0x8000u));
     return h.x | (h.y << 16u);
 }
