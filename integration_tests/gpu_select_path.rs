@@ -284,7 +284,7 @@ fn run_path(gpu: &GpuContext, mode: TransitionMode, frame_sequential: bool) -> u
 
 #[test]
 fn gpu_selection_equals_select_batch_along_a_camera_path() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     for (mode, fs) in [
         (TransitionMode::Distance, false),
         (TransitionMode::Time { seconds: 0.4 }, true),
@@ -303,7 +303,7 @@ fn gpu_selection_equals_select_batch_along_a_camera_path() {
 /// as `select_batch` does from fresh states.
 #[test]
 fn selector_grows_and_starts_over() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     let groups = groups();
     let settings = LodSettings {
         hysteresis: 4.0,
