@@ -150,7 +150,7 @@ fn visibility_flags_twins_match_with_a_real_texture() {
 
 #[test]
 fn lod_buffer_flags_and_combine_shown_twins_match() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let sample = |c: f32, id, depth| LodSample {
         color: Vec4::new(c, 1.0 - c, 0.25, 1.0),
         id,

@@ -78,7 +78,7 @@ const COMBINE_GLSL: &str = "lodkit_LodSample newer = lodkit_LodSample(vec4(inp_f
 
 #[test]
 fn combine_samples_twins_match_on_hand_derived_cases() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let cases = combine_cases();
     let inputs = combine_inputs(&cases);
     for (convention, defs) in [
@@ -224,7 +224,7 @@ fn reproject_cases() -> Vec<(Mat4, Vec2, f32)> {
 
 #[test]
 fn reproject_twins_match_including_reversed_z_sky_and_outside() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let cases = reproject_cases();
     // The refinement looks for the surface at new depth 0.97 on the same ray, given its old depth.
     let old_depth = |m: &Mat4, uv: Vec2| reproject(uv, 0.97, m).z;

@@ -140,7 +140,7 @@ const GLSL: &str = "vec2 f = vec2(inp_f(0u), inp_f(1u));
 
 #[test]
 fn bilateral_upsample_twins_match_on_hand_built_neighbourhoods() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let cases = cases();
     let want: Vec<f32> = cases
         .iter()

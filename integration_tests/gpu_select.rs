@@ -191,7 +191,7 @@ fn probe(header: &'static str, body: &'static str) -> Probe<'static> {
 
 #[test]
 fn select_level_wgsl_and_wesl_match_rust_twin() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let cases = cases();
     let inputs: Vec<u32> = cases.iter().flat_map(|c| c.inputs.clone()).collect();
     let p = probe(
@@ -203,7 +203,7 @@ fn select_level_wgsl_and_wesl_match_rust_twin() {
 
 #[test]
 fn select_level_glsl_matches_rust_twin() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let cases = cases();
     let inputs: Vec<u32> = cases.iter().flat_map(|c| c.inputs.clone()).collect();
     let p = probe("#include \"lodkit/select.glsl\"", GLSL_BODY);
@@ -218,7 +218,7 @@ fn select_level_glsl_matches_rust_twin() {
 /// margin, outside.
 #[test]
 fn select_sphere_visible_matches_rust_twin() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let proj = glam::camera::rh::proj::directx::perspective(1.0, 1.5, 0.5, 200.0);
     let view = glam::camera::rh::view::look_at_mat4(
         glam::Vec3::new(3.0, 2.0, 10.0),
@@ -362,7 +362,7 @@ fn selector_rejects_bad_groups_meshes_and_views() {
     use lodkit::gpu::select::{
         GpuLodSelector, GpuLodSelectorDescriptor, GpuSelectFrame, LevelMesh,
     };
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     let nine = LodGroup::from_distances(&[0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]).unwrap();
     let two = LodGroup::from_distances(&[0.0, 10.0]).unwrap();
     let desc = |groups, meshes| GpuLodSelectorDescriptor {

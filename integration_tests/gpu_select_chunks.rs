@@ -187,7 +187,7 @@ fn select_and_compare(gpu: &GpuContext, insts: &[GpuLodInstance], frames: u32) -
 /// 64 KiB bindings, so 12,000 instances need several chunks and a 2-D grid in each.
 #[test]
 fn a_device_with_small_limits_selects_in_chunks_on_a_2d_grid() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     let mut limits = gpu.adapter.limits();
     limits.max_compute_workgroups_per_dimension = 4;
     limits.max_storage_buffer_binding_size = 64 << 10;
@@ -230,7 +230,7 @@ fn a_device_with_small_limits_selects_in_chunks_on_a_2d_grid() {
 /// `select_batch`.
 #[test]
 fn more_instances_than_one_dispatch_row_select_as_select_batch_does() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     let insts = instances(4_200_000);
     let got = select_and_compare(gpu, &insts, 2);
     assert_eq!(got.states.len(), 4_200_000);

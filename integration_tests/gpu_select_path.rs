@@ -437,7 +437,7 @@ fn run_path(
 
 #[test]
 fn gpu_selection_equals_select_batch_along_a_camera_path() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     for (mode, fs) in [
         (TransitionMode::Distance, false),
         (TransitionMode::Time { seconds: 0.4 }, true),
@@ -460,7 +460,7 @@ fn gpu_selection_equals_select_batch_along_a_camera_path() {
 /// nor too loose to see a wrong distance.
 #[test]
 fn selection_tolerance_holds_a_perturbed_twin_and_rejects_a_wrong_one() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     let bound = DISTANCE_ULPS * accuracy::ULP;
     for perturb in [bound, -bound] {
         let run = run_path(gpu, TransitionMode::Distance, false, perturb);
@@ -480,7 +480,7 @@ fn selection_tolerance_holds_a_perturbed_twin_and_rejects_a_wrong_one() {
 /// as `select_batch` does from fresh states.
 #[test]
 fn selector_grows_and_starts_over() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(compute);
     let groups = groups();
     let settings = LodSettings {
         hysteresis: 4.0,

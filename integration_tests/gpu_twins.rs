@@ -72,7 +72,7 @@ fn normal_inputs(pairs: &[(Vec3, Vec3)]) -> Vec<u32> {
 
 #[test]
 fn foreshortened_normal_distance_wgsl_matches_rust_twin() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let pairs = normal_pairs();
     let probe = normal_probe("foreshortened_normal_distance(a, b)");
     let got = floats(&run_wgsl(gpu, &probe, &normal_inputs(&pairs)));
@@ -90,7 +90,7 @@ fn foreshortened_normal_distance_wgsl_matches_rust_twin() {
 
 #[test]
 fn foreshortened_normal_distance_glsl_matches_rust_twin() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let pairs = normal_pairs();
     let probe = Probe {
         header: "#include \"lodkit/normal_distance.glsl\"",
@@ -134,7 +134,7 @@ fn fullscreen_want() -> Vec<f32> {
 
 #[test]
 fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let inputs = [0u32, 1, 2];
     let wgsl = Probe {
         header: "#import lodkit::fullscreen::fullscreen_vertex",
@@ -174,7 +174,7 @@ fn fullscreen_vertex_wgsl_and_glsl_match_rust_twin() {
 #[test]
 fn probe_detects_a_wrong_twin() {
     // The harness must be able to fail: a deliberately different expression does not match.
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let pairs = normal_pairs();
     let probe = normal_probe("distance(a, b)");
     let got = floats(&run_wgsl(gpu, &probe, &normal_inputs(&pairs)));
@@ -336,7 +336,7 @@ fn silhouette_cases() -> Vec<[f32; 6]> {
 fn silhouette_wgsl_and_glsl_match_rust_twins() {
     use glam::Vec2;
     use lodkit::silhouette::{silhouette_crossing, silhouette_distance};
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let cases = silhouette_cases();
     let inputs = words(&cases.concat());
     let wgsl = Probe {

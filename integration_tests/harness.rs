@@ -1,5 +1,6 @@
 //! The GPU test harness: one shared headless device, and a probe that runs a shader function over
-//! a table of inputs (one compute invocation per case) and reads the results back.
+//! a table of inputs (one compute invocation per case, or one fragment per case where compute
+//! shaders do not work: `fragment_probe.rs`) and reads the results back.
 //!
 //! The shared GPU and the skip rules live in `support.rs` (shared with the CLI's tests).
 
@@ -8,6 +9,28 @@ pub use crate::support::{say, strict, test_name};
 use lodkit::gpu::GpuContext;
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary, SourceLanguage};
 use wgpu::util::DeviceExt;
+
+use crate::fragment_probe::{self, Grid};
+
+/// How a probe runs its cases.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Route {
+    /// One compute invocation per case, outputs in a storage buffer.
+    Compute,
+    /// One fragment per case, inputs from a texture, outputs in integer render targets.
+    Fragment,
+}
+
+impl Route {
+    /// Compute where the device's compute shaders work, fragments elsewhere.
+    pub fn of(gpu: &GpuContext) -> Self {
+        if gpu.capabilities().compute_shaders() {
+            Self::Compute
+        } else {
+            Self::Fragment
+        }
+    }
+}
 
 /// Runs `program` (which must not fail to spawn) or, if it is missing, fails under
 /// `LODKIT_REQUIRE_GPU=1` and skips loudly otherwise. Returns `None` when skipped.
@@ -153,10 +176,11 @@ pub fn run_glsl(gpu: &GpuContext, probe: &Probe, cases: &[u32]) -> Vec<u32> {
     run_with(gpu, probe, cases, glsl, &[])
 }
 
-/// Runs the probe in `language` with the boolean shader defs `defs` switched on. A WGSL probe
-/// runs twice: composed from the naga_oil modules, and converted to WESL
-/// (`naga_oil_to_wesl`) and linked by wesl-rs against the WESL package; both must give the same
-/// words, so every table a test holds against a Rust twin also holds for the WESL form.
+/// Runs the probe in `language` with the boolean shader defs `defs` switched on, on the device's
+/// route ([`Route::of`]). A WGSL probe runs twice: composed from the naga_oil modules, and
+/// converted to WESL (`naga_oil_to_wesl`) and linked by wesl-rs against the WESL package; both
+/// must give the same words, so every table a test holds against a Rust twin also holds for the
+/// WESL form. (A GLSL probe's stage follows the route whatever `language` names.)
 pub fn run_with(
     gpu: &GpuContext,
     probe: &Probe,
@@ -164,19 +188,55 @@ pub fn run_with(
     language: SourceLanguage,
     defs: &[&str],
 ) -> Vec<u32> {
-    let source = match language {
-        SourceLanguage::Glsl(_) => glsl_probe(probe),
-        _ => wgsl_probe(probe),
+    run_on(gpu, Route::of(gpu), probe, cases, language, defs)
+}
+
+/// [`run_with`] on the given route.
+pub fn run_on(
+    gpu: &GpuContext,
+    route: Route,
+    probe: &Probe,
+    cases: &[u32],
+    language: SourceLanguage,
+    defs: &[&str],
+) -> Vec<u32> {
+    assert_eq!(
+        cases.len() % probe.inputs,
+        0,
+        "inputs are not a whole number of cases"
+    );
+    let grid = Grid::new(gpu, probe, cases.len() / probe.inputs);
+    let (source, language) = match (language, route) {
+        (SourceLanguage::Glsl(_), Route::Compute) => (
+            glsl_probe(probe),
+            SourceLanguage::Glsl(naga::ShaderStage::Compute),
+        ),
+        (SourceLanguage::Glsl(_), Route::Fragment) => (
+            fragment_probe::glsl(probe, grid),
+            SourceLanguage::Glsl(naga::ShaderStage::Fragment),
+        ),
+        (_, Route::Compute) => (wgsl_probe(probe), language),
+        (_, Route::Fragment) => (fragment_probe::wgsl(probe, grid), language),
     };
     let shader_defs: lodkit::shaders::ShaderDefs = defs
         .iter()
         .map(|d| (d.to_string(), lodkit::shaders::ShaderDefValue::Bool(true)))
         .collect();
-    let words = run(gpu, probe, cases, &source, language, shader_defs.clone());
+    let run = |source: &str, language| {
+        let module = probe_module(gpu, source, language, shader_defs.clone());
+        match route {
+            Route::Compute => run_compute(gpu, probe, grid.n, cases, &module),
+            Route::Fragment => {
+                let textures = probe_textures(gpu, probe);
+                fragment_probe::run(gpu, probe, grid, cases, &module, &textures)
+            }
+        }
+    };
+    let words = run(&source, language);
     if language == SourceLanguage::Wgsl {
         let wesl = lodkit::shaders::naga_oil_to_wesl(&source, "", "")
             .unwrap_or_else(|e| panic!("the probe has no WESL form: {e}\n{source}"));
-        let wesl_words = run(gpu, probe, cases, &wesl, SourceLanguage::Wesl, shader_defs);
+        let wesl_words = run(&wesl, SourceLanguage::Wesl);
         assert!(
             wesl_words == words,
             "the WESL modules compute other results than the naga_oil modules (defs {defs:?})\n{wesl}"
@@ -185,20 +245,13 @@ pub fn run_with(
     words
 }
 
-fn run(
+/// The probe's shader module, composed with lodkit's library.
+fn probe_module(
     gpu: &GpuContext,
-    probe: &Probe,
-    cases: &[u32],
     source: &str,
     language: SourceLanguage,
     shader_defs: lodkit::shaders::ShaderDefs,
-) -> Vec<u32> {
-    assert_eq!(
-        cases.len() % probe.inputs,
-        0,
-        "inputs are not a whole number of cases"
-    );
-    let n = cases.len() / probe.inputs;
+) -> wgpu::ShaderModule {
     let mut library = ShaderLibrary::new().expect("library");
     let composed = library
         .compose(&ComposeDescriptor {
@@ -208,45 +261,21 @@ fn run(
             shader_defs,
         })
         .unwrap_or_else(|e| panic!("probe does not compose:\n{}\n{source}", render(&e)));
+    gpu.shader_module("probe", &composed)
+        .unwrap_or_else(|e| panic!("probe module: {e}\n{source}"))
+}
+
+/// The probe's own textures as (binding, view): `probe_tex` at 2, float ones from 4 (at most
+/// 8), unsigned ones from 12.
+fn probe_textures(gpu: &GpuContext, probe: &Probe) -> Vec<(u32, wgpu::TextureView)> {
     let device = &gpu.device;
-    let module = gpu.shader_module("probe", &composed).expect("probe module");
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("probe"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("probe in"),
-        contents: bytemuck::cast_slice(cases),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (n * probe.outputs * 4) as u64;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("probe out"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let mut entries = vec![
-        wgpu::BindGroupEntry {
-            binding: 0,
-            resource: input.as_entire_binding(),
-        },
-        wgpu::BindGroupEntry {
-            binding: 1,
-            resource: output.as_entire_binding(),
-        },
-    ];
-    let view = probe.texture.map(|(size, texels)| {
+    let mut out = Vec::new();
+    if let Some((size, texels)) = probe.texture {
         let texture = lodkit::gpu::resources::r32float_texture(gpu, size, texels, "probe texture")
             .expect("probe texture");
-        texture.create_view(&Default::default())
-    });
+        out.push((2, texture.create_view(&Default::default())));
+    }
     let texture = |(w, h): (u32, u32), format, bytes: &[u8]| {
-        use wgpu::util::DeviceExt;
         device
             .create_texture_with_data(
                 &gpu.queue,
@@ -269,29 +298,67 @@ fn run(
             )
             .create_view(&Default::default())
     };
-    let float_views = probe.rgba.iter().map(|(w, h, texels)| {
+    for (k, (w, h, texels)) in probe.rgba.iter().enumerate() {
         let flat: Vec<f32> = texels.iter().flat_map(|v| v.to_array()).collect();
         let format = wgpu::TextureFormat::Rgba32Float;
-        texture((*w, *h), format, bytemuck::cast_slice(&flat))
-    });
-    let uint_views = probe.urgba.iter().map(|(w, h, texels)| {
-        let format = wgpu::TextureFormat::Rgba32Uint;
-        texture((*w, *h), format, bytemuck::cast_slice(texels))
-    });
-    // Float textures from binding 4 (at most 8), unsigned ones from binding 12.
-    let views: [(u32, Vec<wgpu::TextureView>); 2] =
-        [(4, float_views.collect()), (12, uint_views.collect())];
-    for (first, list) in &views {
-        for (k, v) in list.iter().enumerate() {
-            entries.push(wgpu::BindGroupEntry {
-                binding: first + k as u32,
-                resource: wgpu::BindingResource::TextureView(v),
-            });
-        }
+        out.push((
+            4 + k as u32,
+            texture((*w, *h), format, bytemuck::cast_slice(&flat)),
+        ));
     }
-    if let Some(view) = &view {
+    for (k, (w, h, texels)) in probe.urgba.iter().enumerate() {
+        let format = wgpu::TextureFormat::Rgba32Uint;
+        out.push((
+            12 + k as u32,
+            texture((*w, *h), format, bytemuck::cast_slice(texels)),
+        ));
+    }
+    out
+}
+
+/// Dispatches the compute probe `module` over `n` cases and returns the output words.
+fn run_compute(
+    gpu: &GpuContext,
+    probe: &Probe,
+    n: usize,
+    cases: &[u32],
+    module: &wgpu::ShaderModule,
+) -> Vec<u32> {
+    let device = &gpu.device;
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("probe"),
+        layout: None,
+        module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("probe in"),
+        contents: bytemuck::cast_slice(cases),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let size = (n * probe.outputs * 4) as u64;
+    let output = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("probe out"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let textures = probe_textures(gpu, probe);
+    let mut entries = vec![
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: input.as_entire_binding(),
+        },
+        wgpu::BindGroupEntry {
+            binding: 1,
+            resource: output.as_entire_binding(),
+        },
+    ];
+    for (binding, view) in &textures {
         entries.push(wgpu::BindGroupEntry {
-            binding: 2,
+            binding: *binding,
             resource: wgpu::BindingResource::TextureView(view),
         });
     }

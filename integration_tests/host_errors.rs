@@ -26,7 +26,7 @@ const RGBA8: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// A device of this test's own (see the module comment).
 fn own_gpu() -> Option<GpuContext> {
-    let _shared = crate::support::gpu_or_skip()?;
+    let _shared = crate::support::gpu_for(crate::support::Needs::Passes)?;
     Some(GpuContext::new_headless(&Default::default()).expect("a second device"))
 }
 

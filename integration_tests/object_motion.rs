@@ -18,7 +18,7 @@ use crate::harness::{Probe, floats, run_with, say, words};
 
 #[test]
 fn object_motion_twins_match() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let noise = lodkit::noise::white_noise(13 * 40, 21);
     let proj = glam::camera::rh::proj::directx::perspective(0.9, 1.5, 0.1, 50.0);
     let eye =

@@ -65,7 +65,7 @@ fn probe<'a>(
 
 #[test]
 fn half_packing_twins_match_bit_for_bit() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let values = half_inputs();
     let inputs = words(&values);
     let want: Vec<u32> = values
@@ -175,7 +175,7 @@ fn fixture() -> Fixture {
 
 #[test]
 fn packed_texel_twins_match_word_for_word_and_within_a_half_step() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let f = fixture();
     let inputs: Vec<u32> = (0..f.colors.len())
         .flat_map(|i| {

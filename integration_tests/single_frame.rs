@@ -102,7 +102,7 @@ const SCREEN_DOOR_WGSL: &str = "let t = inp_f(0u); let y = f32(inp_u(1u)) + 0.5;
 
 #[test]
 fn screen_door_twins_are_complementary_on_the_gpu() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let (ts, cases) = screen_door_cases();
     let wgsl = SCREEN_DOOR_PROBE;
     let glsl = Probe {
@@ -151,7 +151,7 @@ fn screen_door_twins_are_complementary_on_the_gpu() {
 
 #[test]
 fn unpopping_twins_match_on_the_gpu() {
-    let gpu = lodkit_test_gpu!();
+    let gpu = lodkit_test_gpu!(device);
     let ts: Vec<f32> = (-4..=68)
         .map(|k| k as f32 / 64.0)
         .chain([0.5, 0.4999999, 0.5000001])

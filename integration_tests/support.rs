@@ -4,7 +4,9 @@
 //! GPU tests start with `lodkit_test_gpu!()`. Without an adapter they fail when
 //! `LODKIT_REQUIRE_GPU=1`, and otherwise return early after writing a SKIPPED line straight to
 //! stderr (past the test harness's capture), so a skip is never silent. Browser checks follow the
-//! same rule with `LODKIT_REQUIRE_BROWSER=1`.
+//! same rule with `LODKIT_REQUIRE_BROWSER=1`. A device that lacks a capability the test needs
+//! ([`Needs`]: lodkit's passes, or compute shaders) skips the test with a line that names the
+//! capability, whatever `LODKIT_REQUIRE_GPU` says: such a device is no failure of the test.
 
 #![allow(dead_code, unused_macros)] // each test crate uses its own part
 
@@ -208,10 +210,62 @@ pub fn gpu_or_skip() -> Option<&'static GpuContext> {
     }
 }
 
-/// The shared GPU, or return from the test (see [`gpu_or_skip`]).
+/// What a GPU test needs of the device besides an adapter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Needs {
+    /// Nothing more: probes without textures of their own, tests that look at the device's
+    /// capabilities themselves.
+    Device,
+    /// lodkit's passes: pipelines with several textures and uniform buffers
+    /// (`GpuCapabilities::binding_layout`).
+    Passes,
+    /// Compute shaders for the thing under test itself (GPU selection).
+    Compute,
+}
+
+/// Why `gpu` cannot run a test that needs `needs`; `None` when it can.
+pub fn lacks(gpu: &GpuContext, needs: Needs) -> Option<String> {
+    let caps = gpu.capabilities();
+    let missing = match needs {
+        Needs::Device => None,
+        Needs::Passes => (!caps.binding_layout).then_some("SHADER_BINDING_LAYOUT"),
+        Needs::Compute => (!caps.compute_shaders()).then_some("COMPUTE_SHADERS"),
+    }?;
+    Some(format!("the device lacks {missing} ({caps})"))
+}
+
+/// The shared GPU when it has what the test needs; otherwise `None` after saying the calling test
+/// was skipped and why (a missing adapter is a failure under `LODKIT_REQUIRE_GPU=1`).
+pub fn gpu_for(needs: Needs) -> Option<&'static GpuContext> {
+    let gpu = gpu_or_skip()?;
+    match lacks(gpu, needs) {
+        None => Some(gpu),
+        Some(why) => {
+            say(&format!("SKIPPED {}: {why}", test_name()));
+            None
+        }
+    }
+}
+
+/// The shared GPU, or return from the test (see [`gpu_for`]): `lodkit_test_gpu!()` for a test
+/// that renders through lodkit's passes, `lodkit_test_gpu!(device)` for one that needs only a
+/// device (a probe without textures of its own), `lodkit_test_gpu!(compute)` for one that needs
+/// compute shaders.
 macro_rules! lodkit_test_gpu {
     () => {
-        match $crate::support::gpu_or_skip() {
+        lodkit_test_gpu!(passes)
+    };
+    (passes) => {
+        lodkit_test_gpu!(@ $crate::support::Needs::Passes)
+    };
+    (device) => {
+        lodkit_test_gpu!(@ $crate::support::Needs::Device)
+    };
+    (compute) => {
+        lodkit_test_gpu!(@ $crate::support::Needs::Compute)
+    };
+    (@ $needs:expr) => {
+        match $crate::support::gpu_for($needs) {
             Some(gpu) => gpu,
             None => return,
         }

@@ -142,7 +142,7 @@ enum Command {
         npm: Option<PathBuf>,
     },
     /// Show the GPU adapter the demo would run on (Vulkan, then GL; `LODKIT_BACKEND=vulkan|gl`
-    /// picks one). Exits 1 when there is none.
+    /// picks one) and what lodkit's passes may use on it. Exits 1 when there is none.
     Adapter,
     /// Render the built-in scenes with every technique, measure them, write images, plots and
     /// an HTML report.
@@ -265,6 +265,7 @@ fn adapter() -> ExitCode {
         Ok(gpu) => {
             let mut out = Output::default();
             out.println(&gpu.adapter_summary());
+            out.println(&format!("capabilities: {}", gpu.capabilities()));
             out.finish(ExitCode::SUCCESS)
         }
         Err(e) => {

@@ -14,7 +14,7 @@ use std::borrow::Cow;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::{Arc, Mutex, PoisonError};
 
-use super::GpuError;
+use super::{GpuCapabilities, GpuError};
 use crate::shaders::Composed;
 
 /// Most errors the uncaptured-error handler keeps (it still counts the rest).
@@ -47,6 +47,8 @@ pub struct GpuContext {
     state: Arc<DeviceState>,
     /// On GL: taken by every lodkit call, so that two never meet in wgpu's timed context lock.
     gate: Option<Mutex<()>>,
+    /// What the device really can do (wgpu's answer, corrected on downlevel GL contexts).
+    capabilities: GpuCapabilities,
 }
 
 /// What the device callbacks recorded.
@@ -93,7 +95,11 @@ impl DeviceState {
 }
 
 impl GpuContext {
-    /// Creates a device without a window, blocking until it is ready.
+    /// Creates a device without a window, blocking until it is ready, with every limit the
+    /// adapter has. On a GL context that claims compute shaders its shading language lacks
+    /// (GL 3.3 with `GL_ARB_compute_shader`, see [`GpuCapabilities`]) the instance leaves out
+    /// wgpu's indirect-call validation, whose compute pipelines would lose the device; lodkit's
+    /// passes then refuse what the context cannot do ([`GpuError::MissingCapability`]).
     pub fn new_headless(options: &GpuOptions) -> Result<Self, GpuError> {
         let backends = if options.backends.is_empty() {
             match std::env::var("LODKIT_BACKEND") {
@@ -104,16 +110,41 @@ impl GpuContext {
             options.backends.clone()
         };
         for &backends in &backends {
-            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-            desc.backends = backends;
-            let instance = wgpu::Instance::new(desc);
-            let request = wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                ..Default::default()
+            let instance_for = |flags: wgpu::InstanceFlags| {
+                let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+                desc.backends = backends;
+                desc.flags = flags;
+                let instance = wgpu::Instance::new(desc);
+                let request = wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::HighPerformance,
+                    ..Default::default()
+                };
+                let adapter = pollster::block_on(instance.request_adapter(&request)).ok()?;
+                Some((instance, adapter))
             };
-            let Ok(adapter) = pollster::block_on(instance.request_adapter(&request)) else {
+            let flags = wgpu::InstanceDescriptor::new_without_display_handle_from_env().flags;
+            let Some((mut instance, mut adapter)) = instance_for(flags) else {
                 continue;
             };
+            // wgpu-core builds compute pipelines for its indirect-call validation when it creates
+            // a device on an adapter that claims compute shaders, and reports their failure as a
+            // lost device ("Parent device is lost"): a GL 3.3 context whose driver lists
+            // GL_ARB_compute_shader (NVIDIA's EGL, Mesa with a version override) claims them
+            // without GLSL 4.30. There the instance goes without that validation.
+            let indirect = wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL;
+            let claims_compute = adapter
+                .get_downlevel_capabilities()
+                .flags
+                .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS);
+            if flags.contains(indirect)
+                && claims_compute
+                && !GpuCapabilities::of_adapter(&adapter).compute_shaders()
+            {
+                let Some(found) = instance_for(flags - indirect) else {
+                    continue;
+                };
+                (instance, adapter) = found;
+            }
             let required_features = adapter.features() & options.optional_features;
             let device_desc = wgpu::DeviceDescriptor {
                 label: Some("lodkit headless device"),
@@ -162,6 +193,7 @@ impl GpuContext {
             };
             recorder.record_lost(format!("{reason:?}"), message);
         });
+        let capabilities = GpuCapabilities::of_adapter(&adapter);
         Self {
             instance,
             adapter,
@@ -169,7 +201,16 @@ impl GpuContext {
             queue,
             state,
             gate: gl.then(|| Mutex::new(())),
+            capabilities,
         }
+    }
+
+    /// What the device really can do: wgpu's downlevel flags, less what the context's shading
+    /// language cannot do on a downlevel GL context, and whether a pipeline may bind more than
+    /// one texture and one uniform buffer (see [`GpuCapabilities`]). lodkit's capability checks
+    /// read this, never the adapter's own flags.
+    pub fn capabilities(&self) -> &GpuCapabilities {
+        &self.capabilities
     }
 
     /// Runs `f` (work on this context's device) while no lodkit call runs on it. On wgpu's GL
@@ -296,12 +337,18 @@ impl GpuContext {
     }
 
     /// A shader module from a composed lodkit module (no re-parsing: naga IR goes straight in).
+    /// [`GpuError::MissingCapability`] when a pipeline built from it could not run correctly on
+    /// this device ([`GpuCapabilities::check_module`]): compute or storage buffers the device
+    /// lacks, or more textures or uniform buffers than a downlevel GL context can bind.
     pub fn shader_module(
         &self,
         label: &str,
         composed: &Composed,
     ) -> Result<wgpu::ShaderModule, GpuError> {
-        self.guarded("GpuContext::shader_module", || {
+        const CALL: &str = "GpuContext::shader_module";
+        self.capabilities
+            .check_module(CALL, &composed.module, &composed.info)?;
+        self.guarded(CALL, || {
             Ok(self
                 .device
                 .create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -6,6 +6,7 @@
 //! against the device's limits before wgpu sees them, the device work of each call runs inside
 //! error scopes, and a lost device is reported by the next call (docs/errors.md).
 
+mod capabilities;
 mod context;
 pub mod counters;
 mod error;
@@ -20,5 +21,6 @@ pub mod select;
 pub mod transition_scene;
 pub mod unpopping;
 
+pub use capabilities::{GlVersion, GpuCapabilities};
 pub use context::{GpuContext, GpuOptions};
 pub use error::GpuError;

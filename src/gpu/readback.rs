@@ -177,12 +177,7 @@ pub fn read_depth32(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32
         });
     }
     let copies = wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES;
-    let bytes = if gpu
-        .adapter
-        .get_downlevel_capabilities()
-        .flags
-        .contains(copies)
-    {
+    let bytes = if gpu.capabilities().downlevel.contains(copies) {
         read_texture(gpu, texture, 4)?
     } else {
         let usage = texture.usage();

@@ -103,7 +103,7 @@ const STORAGE_BINDINGS: u32 = 6;
 
 /// The pass needs compute shaders, storage buffers and indirect draws.
 fn check_capabilities(gpu: &GpuContext, call: &'static str) -> Result<(), GpuError> {
-    let flags = gpu.adapter.get_downlevel_capabilities().flags;
+    let flags = gpu.capabilities().downlevel;
     for (flag, name) in [
         (wgpu::DownlevelFlags::COMPUTE_SHADERS, "COMPUTE_SHADERS"),
         (

@@ -60,7 +60,9 @@ uint lodkit_gbuffer_pack_half2(vec2 v) {
     // denormal (which a GPU may flush) and is not read. A zero is written without its sign.
     uvec2 bits = (floatBitsToUint(a * 1.92592994e-34) + uvec2(0x1000u)) >> uvec2(13u);
     uvec2 sign_bits = (floatBitsToUint(v) >> uvec2(16u)) & uvec2(0x8000u);
-    uvec2 h = mix(uvec2(0u), bits | sign_bits, greaterThanEqual(a, vec2(6.10351562e-5)));
+    // Per component: mix() over integer vectors needs GLSL 4.50 or GLSL ES 3.10.
+    const float tiny = 6.10351562e-5;
+    uvec2 h = uvec2(a.x >= tiny ? bits.x | sign_bits.x : 0u, a.y >= tiny ? bits.y | sign_bits.y : 0u);
     return h.x | (h.y << 16u);
 }
 

@@ -71,7 +71,14 @@ fn gbuffer_pack_half2(v: vec2<f32>) -> u32 {
     // would be a denormal (which a GPU may flush): those magnitudes are not read.
     let bits = (bitcast<vec2<u32>>(a * 1.92592994e-34) + vec2<u32>(0x1000u)) >> vec2<u32>(13u);
     let sign = (bitcast<vec2<u32>>(v) >> vec2<u32>(16u)) & vec2<u32>(0x8000u);
-    let h = select(vec2<u32>(0u), bits | sign, a >= vec2<f32>(6.10351562e-5));
+    // One select per component: naga writes a select with a vector condition as
+    // mix(a, b, bvec), which GLSL before 4.50 and GLSL ES 3.00 (GL 3.3, GLES 3.0, WebGL2) only
+    // have for float vectors; a scalar condition becomes `?:`, which every version has.
+    let tiny = 6.10351562e-5;
+    let h = vec2<u32>(
+        select(0u, bits.x | sign.x, a.x >= tiny),
+        select(0u, bits.y | sign.y, a.y >= tiny),
+    );
     return h.x | (h.y << 16u);
 }
 
