@@ -149,7 +149,13 @@ pub fn test_name() -> String {
 pub fn gpu() -> Result<&'static GpuContext, String> {
     static GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
     let gpu = GPU.get_or_init(|| {
-        let gpu = GpuContext::new_headless(&GpuOptions::default()).map_err(|e| e.to_string());
+        // Timestamps inside encoders where the adapter has them: the demo's timers read them.
+        let options = GpuOptions {
+            optional_features: wgpu::Features::TIMESTAMP_QUERY
+                | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS,
+            ..Default::default()
+        };
+        let gpu = GpuContext::new_headless(&options).map_err(|e| e.to_string());
         if let Ok(g) = &gpu {
             say(&format!("lodkit GPU tests run on: {}", g.adapter_summary()));
         }

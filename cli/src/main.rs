@@ -170,6 +170,21 @@ enum Command {
         #[arg(long, value_name = "WxH", default_value = "1280x720", value_parser = parse_size)]
         fb_size: (u32, u32),
     },
+    /// Take the figures that need a real GPU, on GPU timestamps where it has them: pass ratios
+    /// at 1920x1080 and 3840x2160, the framebuffer-LOD frame-cost sweep, GPU selection from
+    /// 10^4 to 10^7 instances; writes gpu-report.json and gpu-report.md
+    /// (`scripts/gpu-report.sh` also runs the GPU test binaries).
+    GpuReport {
+        /// Output folder.
+        #[arg(long, default_value = "lodkit-gpu-report")]
+        out: PathBuf,
+        /// Small sizes and counts: a check of the command on a software GPU.
+        #[arg(long)]
+        quick: bool,
+        /// Interleaved pairs per pass ratio.
+        #[arg(long, default_value_t = 9)]
+        pairs: usize,
+    },
     /// Compose a shader and write it through one of naga's back ends (`--to wesl`: convert a
     /// naga_oil WGSL file to WESL instead).
     Export {
@@ -260,6 +275,35 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
     out.finish(code)
 }
 
+fn gpu_report(
+    out_dir: &Path,
+    options: &lodkit_cli::demo::gpu_report::GpuReportOptions,
+) -> ExitCode {
+    use lodkit_cli::demo::gpu_report;
+    let mut out = Output::default();
+    let run = lodkit_cli::demo::open_gpu().and_then(|gpu| {
+        out.println(&format!("lodkit gpu-report on {}", gpu.adapter_summary()));
+        let report = gpu_report::measure(&gpu, options)?;
+        gpu_report::write(&report, out_dir)?;
+        Ok(report)
+    });
+    let code = match run {
+        Ok(report) => {
+            out.println(&gpu_report::markdown(&report));
+            out.println(&format!(
+                "wrote {}",
+                out_dir.join("gpu-report.md").display()
+            ));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            output::eprintln(&format!("error: {e}"));
+            ExitCode::from(1)
+        }
+    };
+    out.finish(code)
+}
+
 fn adapter() -> ExitCode {
     match lodkit_cli::demo::open_gpu() {
         Ok(gpu) => {
@@ -279,6 +323,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
         Command::Adapter => adapter(),
+        Command::GpuReport { out, quick, pairs } => gpu_report(
+            &out,
+            &lodkit_cli::demo::gpu_report::GpuReportOptions { quick, pairs },
+        ),
         // clap requires exactly one of the two.
         Command::Wesl { out, npm } => match npm {
             Some(dir) => library::write_wesl(&dir, true),

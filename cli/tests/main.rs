@@ -13,6 +13,7 @@ mod demo;
 mod docs_figures;
 mod engine_tree;
 mod fast_path;
+mod gpu_report;
 mod impostor;
 mod npm_package;
 mod permutations;

@@ -16,6 +16,7 @@ pub mod combine_timing;
 pub mod cpu;
 pub mod doc_pictures;
 pub mod frame_cost;
+pub mod gpu_report;
 pub mod impostor;
 pub mod packed_timing;
 pub mod plots;
@@ -361,7 +362,7 @@ pub fn run_on(
     let cpu = cpu::cpu_figures(15)?;
     bar.inc(1);
     bar.set_message("GPU LOD selection against select_batch");
-    let selection = selection::measure(gpu, &timer, 5)?;
+    let selection = selection::measure(gpu, &timer, 5, &selection::SIZES)?;
     bar.inc(1);
     let info = gpu.adapter.get_info();
     let now = std::time::SystemTime::now()

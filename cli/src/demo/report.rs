@@ -291,7 +291,7 @@ fn speed_table(report: &DemoReport) -> Table {
     }
 }
 
-fn ratio_table(report: &DemoReport) -> Table {
+pub(super) fn ratio_table(ratios: &[super::timing::PassRatio]) -> Table {
     Table {
         header: &[
             "pass",
@@ -304,8 +304,7 @@ fn ratio_table(report: &DemoReport) -> Table {
             "clock",
             "fetches / texels / bytes per pixel, pass vs baseline",
         ],
-        rows: report
-            .pass_ratios
+        rows: ratios
             .iter()
             .map(|p| {
                 vec![
@@ -430,7 +429,7 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     b.push_str("\n## Cost of a transition\n\nTriangles submitted and fragments counted over the transition's frames, static camera. Frame-sequential adds the combine pass over the screen rectangles of the objects in transition (one fragment per pixel of the rectangles, included; the rest of the frame is a copy). The last column compares the frames before and after the transition, with no object in transition.\n");
     b.push_str(&transition_tables(report, true));
     b.push_str(&format!("\n## Pass time ratios\n\nEach pass against the plainest pass with the same memory traffic, timed in interleaved pairs; the figure is the median of the per-pair ratios, on the clock each row names. Host work is the same on both sides: {}. Fetches, texels and bytes per pixel are counted from each shader (`lodkit check --stats`), weighed by the formats bound.\n\n", super::timing::HOST_WORK));
-    b.push_str(&ratio_table(report).markdown());
+    b.push_str(&ratio_table(&report.pass_ratios).markdown());
     b.push_str("\n## Framebuffer LOD: whole-frame speed-up\n\n");
     let _ = writeln!(
         b,
@@ -561,7 +560,7 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
     }
     h.push_str(&super::report_fb::html(report));
     h.push_str("<h2>Pass time ratios</h2>\n");
-    h.push_str(&ratio_table(report).html());
+    h.push_str(&ratio_table(&report.pass_ratios).html());
     h.push_str("<h2>Host side (CPU)</h2>\n");
     h.push_str(&cpu_table(report).html());
     let sel = &report.selection;

@@ -65,8 +65,13 @@ pub struct SelectionReport {
     pub bandwidth_bound: (f64, f64),
 }
 
-/// Measures the selectors with `frames` timed frames per size.
-pub fn measure(gpu: &GpuContext, timer: &Timer, frames: u32) -> Result<SelectionReport, DemoError> {
+/// Measures the selectors with `frames` timed frames per instance count of `sizes`.
+pub fn measure(
+    gpu: &GpuContext,
+    timer: &Timer,
+    frames: u32,
+    sizes: &[usize],
+) -> Result<SelectionReport, DemoError> {
     let internal = |e: &dyn std::fmt::Display| DemoError::Internal(format!("selection: {e}"));
     let groups = [
         LodGroup::from_distances(&[0.0, 10.0, 30.0])
@@ -88,7 +93,7 @@ pub fn measure(gpu: &GpuContext, timer: &Timer, frames: u32) -> Result<Selection
         (LodCamera::new(eye, proj), proj * look)
     };
     let mut rows = Vec::new();
-    for n in SIZES {
+    for &n in sizes {
         let side = (n as f32).sqrt().ceil() as usize;
         let instances: Vec<GpuLodInstance> = (0..n)
             .map(|i| {
