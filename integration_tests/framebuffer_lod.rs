@@ -291,6 +291,55 @@ mod controller {
         assert!(worst_overshoot <= 0.10, "overshoot {worst_overshoot}");
     }
 
+    /// A GPU that slows down (a laptop clocking down, a data-center part idling between the
+    /// slow frames of a debug build): the whole frame, K and C alike, takes 2x longer over 200
+    /// frames, with 3 % noise. r must follow it up, and the frame time must come back within 10 %
+    /// of the target and stay there, while the speed drifts and after it stops.
+    #[test]
+    fn online_controller_follows_a_gpu_whose_speed_drifts_2x_over_200_frames() {
+        let (k, c) = (40.0f32, 3.0f32);
+        let speed = |f: usize| 1.0 + (f.saturating_sub(50).min(200) as f32) / 200.0;
+        let expected = |f: usize, r: f32| speed(f) * (k / (r * r) + c);
+        for seed in 0..20u64 {
+            let mut controller = RlsController::new(TARGET, ResizeLimits::default());
+            let mut noise = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+            let mut uniform = || {
+                noise ^= noise << 13;
+                noise ^= noise >> 7;
+                noise ^= noise << 17;
+                (noise >> 40) as f32 / (1u64 << 24) as f32
+            };
+            let mut worst_after_settling = 0.0f32;
+            let mut r_at = Vec::new();
+            for f in 0..400 {
+                let r = controller.r();
+                let t = expected(f, r);
+                r_at.push(r);
+                if f >= 30 {
+                    worst_after_settling = worst_after_settling.max((t - TARGET).abs() / TARGET);
+                }
+                controller.update(t * (1.0 + 0.03 * (2.0 * uniform() - 1.0)));
+            }
+            // r followed: from the speed-1 solution to the speed-2 one.
+            let solve = |s: f32| (k / (TARGET / s - c)).sqrt();
+            assert!(
+                (r_at[49] - solve(1.0)).abs() < 0.1,
+                "seed {seed}: r {} before the drift",
+                r_at[49]
+            );
+            assert!(
+                (r_at[399] - solve(2.0)).abs() < 0.1,
+                "seed {seed}: r {} after it",
+                r_at[399]
+            );
+            // The frame time stayed within the band all along once settled.
+            assert!(
+                worst_after_settling <= 0.10,
+                "seed {seed}: the frame time strayed {worst_after_settling:.3} from the target"
+            );
+        }
+    }
+
     #[test]
     fn the_papers_controller_overshoots_when_its_calibration_is_stale() {
         // The comparison the online estimator is for: K calibrated before the workload doubled.

@@ -53,6 +53,7 @@ struct Totals {
     ghosts: usize,
     min_coverage: Option<f64>,
     fragments: [f64; PARTS],
+    gpu_ms: [f64; PARTS],
 }
 
 fn io(message: String) -> Failure {
@@ -124,6 +125,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             for (t, f) in total.fragments.iter_mut().zip(fragments) {
                 *t += f;
             }
+            let gpu_ms = run.transition_gpu_ms(latency);
+            for (t, ms) in total.gpu_ms.iter_mut().zip(gpu_ms) {
+                *t += ms;
+            }
             println!(
                 "{name:30} {path:6}: pop {p:.3}, flicker {:.2} ({} reversals), see-through {seen} \
                  px, ghosts {ghosted} px, fragments {:.0} (prepass {:.0}, opaque {:.0}, older depth \
@@ -135,6 +140,15 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 fragments[1],
                 fragments[2],
                 fragments[3],
+            );
+            println!(
+                "{name:30} {path:6}: GPU time {:.3} ms (prepass {:.3}, opaque {:.3}, older depth \
+                 {:.3}, combine {:.3})",
+                gpu_ms.iter().sum::<f64>(),
+                gpu_ms[0],
+                gpu_ms[1],
+                gpu_ms[2],
+                gpu_ms[3],
             );
             report.insert(format!("pop_{name}_{path}"), p.into());
             report.insert(format!("flicker_{name}_{path}"), f.ratio().into());
@@ -193,22 +207,35 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         for (pass, f) in Pass::ALL.iter().zip(total.fragments) {
             report.insert(format!("fragments_{name}_{}", pass.name()), f.into());
         }
+        // GPU time over the frames in transition, from Bevy's render diagnostics (timestamp
+        // queries): what the fragment counts cost on this GPU.
+        report.insert(
+            format!("gpu_ms_{name}"),
+            total.gpu_ms.iter().sum::<f64>().into(),
+        );
+        for (pass, ms) in Pass::ALL.iter().zip(total.gpu_ms) {
+            report.insert(format!("gpu_ms_{name}_{}", pass.name()), ms.into());
+        }
     }
-    for (key, ours, theirs) in [
-        ("fragments_ratio", "frame_sequential", "bevy_crossfade"),
-        (
-            "fragments_ratio_with_prepass",
-            "frame_sequential_with_prepass",
-            "bevy_crossfade_with_prepass",
-        ),
-    ] {
-        let get = |k: &str| {
-            report
-                .get(&format!("fragments_{k}"))
-                .and_then(Value::as_f64)
-        };
-        if let (Some(a), Some(b)) = (get(ours), get(theirs)) {
-            report.insert(key.into(), (a / b.max(1.0)).into());
+    for measure in ["fragments", "gpu_ms"] {
+        for (suffix, ours, theirs) in [
+            ("", "frame_sequential", "bevy_crossfade"),
+            (
+                "_with_prepass",
+                "frame_sequential_with_prepass",
+                "bevy_crossfade_with_prepass",
+            ),
+        ] {
+            let get = |k: &str| {
+                report
+                    .get(&format!("{measure}_{k}"))
+                    .and_then(Value::as_f64)
+            };
+            if let (Some(a), Some(b)) = (get(ours), get(theirs))
+                && b > 0.0
+            {
+                report.insert(format!("{measure}_ratio{suffix}"), (a / b).into());
+            }
         }
     }
     report.insert("frames_per_run".into(), FRAMES.into());

@@ -86,6 +86,9 @@ pub struct Run {
     /// Per update: fragment-shader invocations of each [`Pass`] (in `Pass::ALL` order) reported
     /// that update (Bevy's render diagnostics arrive `latency` updates after their frame).
     pub fragments: Vec<[f64; PARTS]>,
+    /// Per update: GPU milliseconds of each [`Pass`] reported that update (Bevy's render
+    /// diagnostics `elapsed_gpu`, from timestamp queries; empty where the device has none).
+    pub gpu_ms: Vec<[f64; PARTS]>,
     /// Per frame: whether a group was in its transition band.
     pub in_transition: Vec<bool>,
     /// Per frame: the CPU time (microseconds) the plugin spent on silhouettes, and the
@@ -96,23 +99,36 @@ pub struct Run {
 impl Run {
     /// Fragments of each pass over the frames in transition, with the diagnostics `latency`.
     pub fn transition_fragments(&self, latency: usize) -> [f64; PARTS] {
-        let mut sum = [0.0; PARTS];
-        for (f, _) in self.in_transition.iter().enumerate().filter(|(_, t)| **t) {
-            if let Some(counts) = self.fragments.get(f + latency) {
-                for (s, c) in sum.iter_mut().zip(counts) {
-                    *s += c;
-                }
-            }
-        }
-        sum
+        transition_sum(&self.in_transition, &self.fragments, latency)
+    }
+
+    /// GPU milliseconds of each pass over the frames in transition (`latency` as above).
+    pub fn transition_gpu_ms(&self, latency: usize) -> [f64; PARTS] {
+        transition_sum(&self.in_transition, &self.gpu_ms, latency)
     }
 }
+
+/// The sum of per-update `values` over the frames in transition, read `latency` updates later.
+fn transition_sum(in_transition: &[bool], values: &[[f64; PARTS]], latency: usize) -> [f64; PARTS] {
+    let mut sum = [0.0; PARTS];
+    for (f, _) in in_transition.iter().enumerate().filter(|(_, t)| **t) {
+        if let Some(counts) = values.get(f + latency) {
+            for (s, c) in sum.iter_mut().zip(counts) {
+                *s += c;
+            }
+        }
+    }
+    sum
+}
+
+impl Run {}
 
 pub struct Harness {
     app: App,
     target: Handle<Image>,
-    /// The last measurement time seen per pass (a pass that did not run adds nothing).
-    seen: Vec<Option<Instant>>,
+    /// The last measurement time seen per pass and diagnostic (fragments, GPU time): a pass
+    /// that did not run adds nothing.
+    seen: Vec<[Option<Instant>; 2]>,
 }
 
 impl Harness {
@@ -134,7 +150,7 @@ impl Harness {
         Self {
             app,
             target,
-            seen: vec![None; PASSES.len()],
+            seen: vec![[None; 2]; PASSES.len()],
         }
     }
 
@@ -142,26 +158,37 @@ impl Harness {
         &self.app
     }
 
-    /// Fragment invocations per [`Pass`] reported since the last call.
-    fn fragments(&mut self) -> [f64; PARTS] {
+    /// Fragment invocations and GPU milliseconds per [`Pass`] reported since the last call.
+    fn diagnostics(&mut self) -> [[f64; PARTS]; 2] {
         let store = self.app.world().resource::<DiagnosticsStore>();
-        let mut sum = [0.0; PARTS];
+        let mut sum = [[0.0; PARTS]; 2];
         for ((pass, part), seen) in PASSES.iter().zip(&mut self.seen) {
-            let path = DiagnosticPath::new(format!("render/{pass}/fragment_shader_invocations"));
-            let Some(m) = store.get(&path).and_then(|d| d.measurement()) else {
-                continue;
-            };
-            if *seen != Some(m.time) {
-                *seen = Some(m.time);
-                sum[Pass::ALL.iter().position(|p| p == part).unwrap_or(0)] += m.value;
+            let k = Pass::ALL.iter().position(|p| p == part).unwrap_or(0);
+            for (d, name) in ["fragment_shader_invocations", "elapsed_gpu"]
+                .iter()
+                .enumerate()
+            {
+                let path = DiagnosticPath::new(format!("render/{pass}/{name}"));
+                let Some(m) = store.get(&path).and_then(|d| d.measurement()) else {
+                    continue;
+                };
+                if seen[d] != Some(m.time) {
+                    seen[d] = Some(m.time);
+                    sum[d][k] += m.value;
+                }
             }
         }
         sum
     }
 
-    fn step(&mut self) -> [f64; PARTS] {
+    /// One update; the fragments and GPU time reported in it.
+    fn step_timed(&mut self) -> [[f64; PARTS]; 2] {
         step(&mut self.app);
-        self.fragments()
+        self.diagnostics()
+    }
+
+    fn step(&mut self) -> [f64; PARTS] {
+        self.step_timed()[0]
     }
 
     /// The camera of a run: what every run has (target, clear color, no MSAA, no tonemapping
@@ -236,6 +263,7 @@ impl Harness {
         let mut run = Run {
             frames: Vec::new(),
             fragments: Vec::new(),
+            gpu_ms: Vec::new(),
             in_transition: Vec::new(),
             silhouettes: Vec::new(),
         };
@@ -255,8 +283,9 @@ impl Harness {
                 }
             }
             run.in_transition.push(banded);
-            let fragments = self.step();
+            let [fragments, gpu_ms] = self.step_timed();
             run.fragments.push(fragments);
+            run.gpu_ms.push(gpu_ms);
             let stats = self.app.world().resource::<FrameSequentialStats>();
             run.silhouettes.push((
                 stats.silhouette_time.as_secs_f64() * 1e6,
@@ -267,8 +296,9 @@ impl Harness {
             if self.app.world().resource::<Inbox>().0.len() >= FRAMES {
                 break;
             }
-            let fragments = self.step();
+            let [fragments, gpu_ms] = self.step_timed();
             run.fragments.push(fragments);
+            run.gpu_ms.push(gpu_ms);
         }
         let world = self.app.world_mut();
         world.despawn(readback);
