@@ -220,6 +220,7 @@ pub struct LodChainLevel {
     error: f32,
     simplifier: Simplifier,
     simplifier_error: f32,
+    time: std::time::Duration,
 }
 
 impl LodChainLevel {
@@ -260,6 +261,10 @@ impl LodChainLevel {
     /// (a quadric estimate, not a bound; for comparison only).
     pub fn simplifier_error(&self) -> f32 {
         self.simplifier_error
+    }
+    /// Time taken to make this level: simplifying, measuring its bound and compacting it.
+    pub fn time(&self) -> std::time::Duration {
+        self.time
     }
 }
 

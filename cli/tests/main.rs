@@ -14,6 +14,7 @@ mod docs_figures;
 mod engine_tree;
 mod fast_path;
 mod impostor;
+mod lod;
 mod npm_package;
 mod permutations;
 mod pipes;

@@ -72,6 +72,7 @@ pub(super) fn build(
     let mut current = mesh.indices.to_vec();
     let mut sloppy = false;
     for i in 1..descriptor.levels {
+        let started = std::time::Instant::now();
         let target = ((triangles as f64) * f64::from(descriptor.ratio).powi(i as i32))
             .round()
             .max(1.0) as usize;
@@ -119,13 +120,9 @@ pub(super) fn build(
             break;
         }
         let error = level_bound(positions, mesh.indices, &original, &indices, tolerance);
-        levels.push(make_level(
-            mesh,
-            &indices,
-            error,
-            simplifier,
-            result_error * scale,
-        ));
+        let mut level = make_level(mesh, &indices, error, simplifier, result_error * scale);
+        level.time = started.elapsed();
+        levels.push(level);
         current = indices;
     }
     if levels.len() == 1 && descriptor.levels > 1 && descriptor.small_mesh == SmallMesh::Error {
@@ -186,6 +183,7 @@ fn make_level(
         error,
         simplifier,
         simplifier_error,
+        time: std::time::Duration::ZERO,
     }
 }
 

@@ -174,21 +174,39 @@ pub(crate) fn directed_bound(
     for (&v, s) in used.iter().zip(&samples) {
         at_vertex[v as usize] = Some(*s);
     }
-    let lb = samples.iter().map(|s| s.distance).fold(0.0, f64::max);
     let triangles: Vec<[u32; 3]> = indices
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
         .collect();
-    let bounds = parallel_map(&triangles, |t| {
+    // f at every centroid too: with the vertices, a lower bound close to the supremum before
+    // any piece is refined (refining against a small early `lb` would split pieces far finer
+    // than the tolerance of the final result needs).
+    let centres = parallel_map(&triangles, |t| {
+        target.nearest((p(t[0]) + p(t[1]) + p(t[2])) / 3.0)
+    });
+    let lb = samples
+        .iter()
+        .chain(&centres)
+        .map(|s| s.distance)
+        .fold(0.0, f64::max);
+    let work: Vec<([u32; 3], Sample)> = triangles.into_iter().zip(centres).collect();
+    let bounds = parallel_map(&work, |(t, centre)| {
         let mut lb = lb;
         let corners = t.map(|v| at_vertex[v as usize].expect("every used vertex was sampled"));
-        refine(target, corners, 0, &mut lb, tolerance)
+        refine(target, corners, Some(*centre), 0, &mut lb, tolerance)
     });
     bounds.into_iter().fold(lb, f64::max)
 }
 
 /// The bound over the triangle piece with corners `c`.
-fn refine(target: &Surface, c: [Sample; 3], depth: u32, lb: &mut f64, tolerance: Tolerance) -> f64 {
+fn refine<'a>(
+    target: &'a Surface,
+    c: [Sample<'a>; 3],
+    centre: Option<Sample<'a>>,
+    depth: u32,
+    lb: &mut f64,
+    tolerance: Tolerance,
+) -> f64 {
     let p = c.map(|s| s.at);
     let longest = (p[1] - p[0])
         .length_squared()
@@ -197,7 +215,7 @@ fn refine(target: &Surface, c: [Sample; 3], depth: u32, lb: &mut f64, tolerance:
         .sqrt();
     let lipschitz = c[0].distance.max(c[1].distance).max(c[2].distance) + longest / 3f64.sqrt();
     // The centroid's nearest triangle is often the one whose prism holds the whole piece.
-    let centre = target.nearest((p[0] + p[1] + p[2]) / 3.0);
+    let centre = centre.unwrap_or_else(|| target.nearest((p[0] + p[1] + p[2]) / 3.0));
     *lb = lb.max(centre.distance);
     let convex = c
         .iter()
@@ -220,7 +238,7 @@ fn refine(target: &Surface, c: [Sample; 3], depth: u32, lb: &mut f64, tolerance:
         .into_iter()
         .map(|piece| {
             let corners = piece.map(|x| corner(target, &c, x, lb));
-            refine(target, corners, depth + 1, lb, tolerance)
+            refine(target, corners, None, depth + 1, lb, tolerance)
         })
         .fold(0.0, f64::max)
 }
