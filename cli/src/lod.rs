@@ -233,9 +233,9 @@ fn plan(
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for c in chains {
         for p in c.levels()[0].positions() {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
+            for ((l, h), x) in lo.iter_mut().zip(&mut hi).zip(p) {
+                *l = l.min(*x);
+                *h = h.max(*x);
             }
         }
     }

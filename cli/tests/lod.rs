@@ -40,9 +40,9 @@ fn write_gltf(dir: &Path, name: &str, f: &Fixture, edit: impl FnOnce(&mut serde_
     let (lo, hi) = f.positions.iter().fold(
         ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
         |(mut lo, mut hi), p| {
-            for k in 0..3 {
-                lo[k] = lo[k].min(p[k]);
-                hi[k] = hi[k].max(p[k]);
+            for ((l, h), x) in lo.iter_mut().zip(&mut hi).zip(p) {
+                *l = l.min(*x);
+                *h = h.max(*x);
             }
             (lo, hi)
         },

@@ -269,7 +269,7 @@ fn check_descriptor(d: &LodChainDescriptor) -> Result<(), LodChainError> {
 
 fn check_mesh(mesh: &MeshData) -> Result<(), LodChainError> {
     let n = mesh.positions.len();
-    if mesh.indices.len() % 3 != 0 {
+    if !mesh.indices.len().is_multiple_of(3) {
         return Err(LodChainError::PartialTriangle(mesh.indices.len()));
     }
     if mesh.indices.is_empty() {

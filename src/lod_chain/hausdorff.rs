@@ -8,7 +8,8 @@
 //!   which is used), so `sup_Q f <= max f(corners) + r`.
 //! - **Convex**: for any one triangle `t` of the target, `f(x) <= d(x, t)`, and `d(., t)` is convex
 //!   (the distance to a convex set), so over the triangle `Q` its maximum is at a corner:
-//!   `sup_Q f <= max d(corner, t)`. The candidates `t` are the triangles nearest to `Q`'s corners.
+//!   `sup_Q f <= max d(corner, t)`. The candidates `t` are the triangles nearest to `Q`'s
+//!   corners and centroid.
 //!
 //! [`directed_bound`] evaluates `f` at every vertex of the source (the largest value found, `lb`,
 //! is a lower bound of the supremum), then refines each triangle: a piece whose smaller bound is
@@ -228,7 +229,7 @@ fn refine<'a>(
         return bound;
     }
     // Plane cuts do not shorten the longest side: every other cut is at the midpoints.
-    let plane = if depth % 2 == 0 {
+    let plane = if depth.is_multiple_of(2) {
         cut_between_neighbours(&c)
     } else {
         None

@@ -76,7 +76,7 @@ impl PixelErrorCamera {
 /// # use lodkit::lod_chain::{PixelErrorCamera, projected_error};
 /// let cam = PixelErrorCamera { fov_y: 90f32.to_radians(), viewport_height: 1000.0, ..Default::default() };
 /// // A point-sized object: k e / D = 500 x 0.01 / 5 = 1 pixel.
-/// assert!((projected_error(0.01, 0.0, 5.0, &cam) - 1.0).abs() < 1e-9);
+/// assert!((projected_error(0.01, 0.0, 5.0, &cam) - 1.0).abs() < 1e-6); // fov_y is an f32
 /// assert!(projected_error(0.01, 1.0, 5.0, &cam) > 1.0); // its near side is closer
 /// ```
 pub fn projected_error(error: f32, radius: f32, distance: f64, camera: &PixelErrorCamera) -> f64 {

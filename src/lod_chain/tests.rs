@@ -5,8 +5,11 @@
 use super::*;
 use glam::DVec3;
 
+/// Positions, indices, normals and UVs of a test mesh.
+type Parts = (Vec<[f32; 3]>, Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>);
+
 /// A sphere, closed and smooth: normals are the positions.
-fn sphere() -> (Vec<[f32; 3]>, Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>) {
+fn sphere() -> Parts {
     let (p, i) = uv_sphere(16, 32);
     let uv = p.iter().map(|q| [q[0], q[1]]).collect();
     (p.clone(), i, p, uv)
@@ -14,10 +17,7 @@ fn sphere() -> (Vec<[f32; 3]>, Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>) {
 
 /// A box whose faces bulge outward, each face its own grid of vertices (flat normal, UVs 0..1):
 /// hard edges and UV seams on every cube edge.
-pub(super) fn bulged_box(
-    n: u32,
-    bulge: f32,
-) -> (Vec<[f32; 3]>, Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>) {
+fn bulged_box(n: u32, bulge: f32) -> Parts {
     let (mut p, mut i, mut nr, mut uv) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for axis in 0..3 {
         for sign in [-1.0f32, 1.0] {
@@ -55,7 +55,7 @@ pub(super) fn bulged_box(
 }
 
 /// An open wavy grid (terrain) over [-1, 1]², with UVs.
-pub(super) fn terrain(n: u32) -> (Vec<[f32; 3]>, Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 2]>) {
+fn terrain(n: u32) -> Parts {
     let (mut p, mut i, mut nr, mut uv) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for y in 0..=n {
         for x in 0..=n {

@@ -177,7 +177,7 @@ fn to_list(mode: Mode, strip: &[u32]) -> Vec<u32> {
     let mut out = Vec::new();
     for k in 2..strip.len() {
         let t = match mode {
-            Mode::TriangleStrip if k % 2 == 0 => [strip[k - 2], strip[k - 1], strip[k]],
+            Mode::TriangleStrip if k.is_multiple_of(2) => [strip[k - 2], strip[k - 1], strip[k]],
             Mode::TriangleStrip => [strip[k - 1], strip[k - 2], strip[k]],
             _ => [strip[0], strip[k - 1], strip[k]],
         };

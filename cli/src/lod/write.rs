@@ -27,7 +27,7 @@ pub struct Output {
 }
 
 fn pad4(bin: &mut Vec<u8>) {
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
 }
@@ -92,9 +92,9 @@ impl Output {
             let mut lo = [f32::INFINITY; N];
             let mut hi = [f32::NEG_INFINITY; N];
             for v in values {
-                for c in 0..N {
-                    lo[c] = lo[c].min(v[c]);
-                    hi[c] = hi[c].max(v[c]);
+                for ((l, h), x) in lo.iter_mut().zip(&mut hi).zip(v) {
+                    *l = l.min(*x);
+                    *h = h.max(*x);
                 }
             }
             (
