@@ -20,9 +20,10 @@ pub struct PixelErrorCamera {
     pub viewport_height: f32,
     /// Largest allowed screen-space deviation from the original, in pixels (default 1).
     pub pixel_error: f32,
-    /// The hysteresis `h` the group will be selected with ([`LodSettings::hysteresis`]
-    /// (crate::select::LodSettings::hysteresis), view-normalized; default 0). A level can be shown
-    /// from `h / 2` nearer than its switch distance, so every distance is pushed out by `h / 2`.
+    /// The hysteresis `h` the group will be selected with
+    /// ([`LodSettings::hysteresis`](crate::select::LodSettings::hysteresis), view-normalized;
+    /// default 0). A level can be shown from `h / 2` nearer than its switch distance, so every
+    /// distance is pushed out by `h / 2`.
     pub hysteresis: f32,
 }
 
