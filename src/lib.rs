@@ -22,6 +22,9 @@
 //! - [`metrics`]: how a transition looks on read-back frames: pop, flicker (change over net
 //!   change, direction reversals), PSNR, medians.
 //! - [`gpu`] (feature `wgpu`): headless devices and ready-made passes.
+//! - `lod_chain` (feature `lod_chain`): levels of detail generated from one mesh by
+//!   meshoptimizer, each with an upper bound of its Hausdorff distance from the original, and
+//!   switch distances for a pixel error.
 //!
 //! ## Features
 //!
@@ -30,6 +33,7 @@
 //! | `compose` | yes | [`shaders::ShaderLibrary`], validation, export, [`shaders::add_to_composer`] | naga 30, naga_oil 0.23 |
 //! | `wesl` | no | `SourceLanguage::Wesl`: link WESL that imports lodkit (wesl-rs), then validate | wesl 0.4.0 (no naga of its own; and `compose`) |
 //! | `wgpu` | no | [`gpu`]: headless devices, buffers, ready-made passes | wgpu 30 (and `compose`) |
+//! | `lod_chain` | no | `lod_chain`: LOD chains from one mesh, error bounds, switch distances for a pixel error | meshopt 0.7 (compiles meshoptimizer's C++: needs a C++ compiler), rstar; no naga |
 //!
 //! With `default-features = false` the crate is the embedded shader sources ([`shaders::modules`])
 //! and the host math: no naga, naga_oil or wgpu in the tree, so an engine on another naga (Bevy
@@ -62,6 +66,9 @@ pub mod visibility;
 
 #[cfg(feature = "wgpu")]
 pub mod gpu;
+
+#[cfg(feature = "lod_chain")]
+pub mod lod_chain;
 
 /// The Rust snippets of `docs/engines.md`, compiled and run as doctests so the guide cannot
 /// drift from the API.

@@ -11,6 +11,7 @@ use std::process::ExitCode;
 mod check;
 mod compose;
 mod library;
+mod lod;
 mod output;
 mod stats;
 
@@ -184,6 +185,43 @@ enum Command {
         /// Interleaved pairs per pass ratio.
         #[arg(long, default_value_t = 9)]
         pairs: usize,
+    },
+    /// Generate a LOD chain for every mesh of a glTF/GLB file (meshoptimizer, each level's error
+    /// bounded) and write it back with `MSFT_lod`: levels as nodes, switch points as
+    /// `MSFT_screencoverage` for the reference camera. Prints a table per mesh.
+    Lod {
+        /// The glTF (.gltf) or GLB (.glb) file.
+        input: PathBuf,
+        /// Output file: .glb, or .gltf with its buffer in <stem>.bin beside it.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Largest screen-space deviation from the original, in pixels of the reference camera.
+        #[arg(long, default_value_t = 1.0)]
+        pixel_error: f32,
+        /// Levels per mesh, LOD0 (the mesh itself) included.
+        #[arg(long, default_value_t = 4)]
+        levels: usize,
+        /// Triangle share of each level relative to the one before.
+        #[arg(long, default_value_t = 0.5)]
+        ratio: f32,
+        /// The reference camera's vertical field of view, degrees.
+        #[arg(long, default_value_t = 60.0)]
+        fov: f32,
+        /// The reference viewport's height, pixels.
+        #[arg(long, default_value_t = 1080.0)]
+        viewport_height: f32,
+        /// The reference viewport's width over height (screen coverages are shares of it).
+        #[arg(long, default_value_t = 16.0 / 9.0)]
+        aspect: f32,
+        /// Keep vertices on open borders in place (chunks of terrain stay stitched).
+        #[arg(long)]
+        lock_border: bool,
+        /// Fail on a mesh too small to simplify instead of keeping it as a single level.
+        #[arg(long)]
+        strict: bool,
+        /// Also write the table as JSON.
+        #[arg(long, value_name = "FILE")]
+        report: Option<PathBuf>,
     },
     /// Compose a shader and write it through one of naga's back ends (`--to wesl`: convert a
     /// naga_oil WGSL file to WESL instead).
@@ -369,6 +407,31 @@ fn main() -> ExitCode {
             permutations: permutations.as_deref(),
             max_sets,
             files: &files,
+        }),
+        Command::Lod {
+            input,
+            output,
+            pixel_error,
+            levels,
+            ratio,
+            fov,
+            viewport_height,
+            aspect,
+            lock_border,
+            strict,
+            report,
+        } => lod::run(&lod::LodArgs {
+            input,
+            output,
+            pixel_error,
+            levels,
+            ratio,
+            fov_y_degrees: fov,
+            viewport_height,
+            aspect,
+            lock_border,
+            keep_small: !strict,
+            report,
         }),
         Command::Export {
             compose,

@@ -15,6 +15,7 @@ mod engine_tree;
 mod fast_path;
 mod gpu_report;
 mod impostor;
+mod lod;
 mod npm_package;
 mod permutations;
 mod pipes;

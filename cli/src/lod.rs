@@ -1,0 +1,314 @@
+//! `lodkit lod`: a LOD chain for every mesh of a glTF / GLB file (`lodkit::lod_chain`), written
+//! back as glTF with `MSFT_lod` (levels as nodes, screen coverages in `MSFT_screencoverage`), a
+//! table per mesh and an optional JSON report.
+
+mod read;
+mod write;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use lodkit::lod_chain::{
+    LodChain, LodChainDescriptor, MeshData, PixelErrorCamera, SmallMesh, hide_distance,
+    switch_distances,
+};
+
+use crate::output::{self, Output};
+
+/// What `lodkit lod` was asked to do.
+pub struct LodArgs {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub pixel_error: f32,
+    pub levels: usize,
+    pub ratio: f32,
+    pub fov_y_degrees: f32,
+    pub viewport_height: f32,
+    pub aspect: f32,
+    pub lock_border: bool,
+    pub keep_small: bool,
+    pub report: Option<PathBuf>,
+}
+
+/// One row of the table and the report.
+#[derive(serde::Serialize)]
+struct LevelRow {
+    level: usize,
+    triangles: usize,
+    /// Upper bound of the Hausdorff distance from LOD0, object units.
+    error: f32,
+    /// View-normalized distance from which the level is used.
+    switch_distance: f32,
+    /// `MSFT_screencoverage` entry: below this share of the screen the next level takes over.
+    screen_coverage: f32,
+    seconds: f64,
+}
+
+#[derive(serde::Serialize)]
+struct MeshReport {
+    mesh: usize,
+    name: String,
+    radius: f32,
+    /// View-normalized distance beyond which the mesh covers less than the pixel error.
+    max_distance: f32,
+    levels: Vec<LevelRow>,
+    warnings: Vec<String>,
+}
+
+#[derive(serde::Serialize)]
+struct Report {
+    input: String,
+    output: String,
+    pixel_error: f32,
+    fov_y_degrees: f32,
+    viewport_height: f32,
+    aspect: f32,
+    meshes: Vec<MeshReport>,
+}
+
+/// Screen share (Babylon.js's `MSFT_screencoverage`: the bounding sphere's projected area over
+/// the viewport's, `π R² |P11|² / (4 aspect D²)`) at view-normalized distance `d`.
+fn coverage(radius: f32, d: f32, aspect: f32) -> f32 {
+    let c = std::f32::consts::PI * radius * radius / (4.0 * aspect * d * d);
+    if c.is_finite() { c.min(1.0) } else { 1.0 }
+}
+
+/// Runs `lodkit lod`. Exit 0 on success, 1 when the file or a mesh in it is unusable, 2 for
+/// I/O errors.
+pub fn run(args: &LodArgs) -> ExitCode {
+    let file = args.input.display().to_string();
+    let fail = |code: u8, message: String| {
+        output::eprintln(&format!("error: {file}: {message}"));
+        ExitCode::from(code)
+    };
+    let camera = PixelErrorCamera {
+        fov_y: args.fov_y_degrees.to_radians(),
+        viewport_height: args.viewport_height,
+        pixel_error: args.pixel_error,
+        hysteresis: 0.0,
+    };
+    if let Err(e) = camera.validate() {
+        return fail(2, e.to_string());
+    }
+    if !is_gltf_name(&args.output) {
+        return fail(
+            2,
+            format!(
+                "-o {}: the output must end in .gltf or .glb",
+                args.output.display()
+            ),
+        );
+    }
+    if !(args.aspect.is_finite() && args.aspect > 0.0) {
+        return fail(2, format!("--aspect {} must be > 0", args.aspect));
+    }
+    let descriptor = LodChainDescriptor {
+        levels: args.levels,
+        ratio: args.ratio,
+        camera,
+        lock_border: args.lock_border,
+        small_mesh: if args.keep_small {
+            SmallMesh::SingleLevel
+        } else {
+            SmallMesh::Error
+        },
+        ..Default::default()
+    };
+    let (document, buffers) = match read::open(&args.input) {
+        Ok(x) => x,
+        Err(e) => return fail(if e.starts_with("cannot read") { 2 } else { 1 }, e),
+    };
+    let mut out = write::Output::new(document.clone(), &buffers);
+    let mut reports = Vec::new();
+    for mesh in document.meshes() {
+        let name = mesh.name().unwrap_or("").to_owned();
+        let label = format!("mesh {} '{name}'", mesh.index());
+        let input = match read::mesh(&mesh, &buffers) {
+            Ok(i) => i,
+            Err(e) => return fail(1, format!("{label}: {e}")),
+        };
+        let mut warnings = input.warnings.clone();
+        let mut chains = Vec::new();
+        for p in &input.primitives {
+            if !p.carried.is_empty() {
+                let names: Vec<&str> = p.carried.iter().map(|(s, _)| s.as_str()).collect();
+                warnings.push(format!(
+                    "primitive {}: {} carried into the levels unweighed (the simplifier weighs only position, NORMAL and TEXCOORD_0)",
+                    p.index,
+                    names.join(", ")
+                ));
+            }
+            let data = MeshData {
+                positions: &p.positions,
+                indices: &p.indices,
+                normals: p.normals.as_deref(),
+                uvs: p.uvs.as_deref(),
+            };
+            match LodChain::build(&data, &descriptor) {
+                Ok(chain) => chains.push(chain),
+                Err(e) => return fail(1, format!("{label} primitive {}: {e}", p.index)),
+            }
+        }
+        let report = match plan(&chains, args, &camera) {
+            Ok(rows) => rows,
+            Err(e) => return fail(1, format!("{label}: {e}")),
+        };
+        for w in &warnings {
+            output::eprintln(&format!("warning: {file}: {label}: {w}"));
+        }
+        let count = report.levels.len();
+        let levels: Vec<Vec<write::LevelPrimitive>> = (0..count)
+            .map(|i| {
+                input
+                    .primitives
+                    .iter()
+                    .zip(&chains)
+                    .map(|(p, chain)| {
+                        let l = &chain.levels()[i.min(chain.levels().len() - 1)];
+                        write::LevelPrimitive {
+                            primitive: p.index,
+                            positions: l.positions(),
+                            normals: l.normals(),
+                            uvs: l.uvs(),
+                            indices: l.indices(),
+                            file_vertices: l
+                                .source_vertices()
+                                .iter()
+                                .map(|&v| p.file_vertex[v as usize])
+                                .collect(),
+                            carried: &p.carried,
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        if count > 1 {
+            let coverages: Vec<f32> = report.levels.iter().map(|r| r.screen_coverage).collect();
+            out.add_levels(mesh.index(), &levels, &coverages);
+        }
+        reports.push(MeshReport {
+            mesh: mesh.index(),
+            name,
+            warnings,
+            ..report
+        });
+    }
+    if let Err(e) = out.write(&args.output) {
+        return fail(2, e);
+    }
+    let mut stdout = Output::default();
+    for r in &reports {
+        stdout.println(&table(r));
+    }
+    stdout.println(&format!("wrote {}", args.output.display()));
+    if let Some(path) = &args.report {
+        let report = Report {
+            input: file.clone(),
+            output: args.output.display().to_string(),
+            pixel_error: args.pixel_error,
+            fov_y_degrees: args.fov_y_degrees,
+            viewport_height: args.viewport_height,
+            aspect: args.aspect,
+            meshes: reports,
+        };
+        let text = serde_json::to_string_pretty(&report).expect("a report is JSON");
+        if let Err(e) = std::fs::write(path, text) {
+            return fail(2, format!("cannot write `{}`: {e}", path.display()));
+        }
+    }
+    stdout.finish(ExitCode::SUCCESS)
+}
+
+/// The mesh's levels: level i is level i of every primitive's chain (its last where it has
+/// fewer), its error the largest of theirs, its distances for the sphere around all of them.
+fn plan(
+    chains: &[LodChain],
+    args: &LodArgs,
+    camera: &PixelErrorCamera,
+) -> Result<MeshReport, String> {
+    let count = chains.iter().map(|c| c.levels().len()).max().unwrap_or(1);
+    // The sphere around every primitive's sphere, centred on their common box's centre (which
+    // is Babylon.js's bounding-sphere centre; its radius, half the box diagonal, is what its
+    // screen coverage uses).
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for c in chains {
+        for p in c.levels()[0].positions() {
+            for ((l, h), x) in lo.iter_mut().zip(&mut hi).zip(p) {
+                *l = l.min(*x);
+                *h = h.max(*x);
+            }
+        }
+    }
+    let centre: [f32; 3] = std::array::from_fn(|k| 0.5 * (lo[k] + hi[k]));
+    let dist = |a: [f32; 3], b: [f32; 3]| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    let radius = chains
+        .iter()
+        .map(|c| {
+            let s = c.bounding_sphere();
+            dist(s.center, centre) + s.radius
+        })
+        .fold(0.0f32, f32::max)
+        .next_up();
+    let box_radius = 0.5 * dist(lo, hi);
+    fn at(c: &LodChain, i: usize) -> &lodkit::lod_chain::LodChainLevel {
+        &c.levels()[i.min(c.levels().len() - 1)]
+    }
+    let errors: Vec<f32> = (0..count)
+        .map(|i| chains.iter().map(|c| at(c, i).error()).fold(0.0, f32::max))
+        .collect();
+    let distances = switch_distances(&errors, radius, camera).map_err(|e| e.to_string())?;
+    let max_distance = hide_distance(radius, camera).map_err(|e| e.to_string())?;
+    let levels = (0..count)
+        .map(|i| {
+            let next = distances.get(i + 1).copied().unwrap_or(max_distance);
+            LevelRow {
+                level: i,
+                triangles: chains.iter().map(|c| at(c, i).triangles()).sum(),
+                error: errors[i],
+                switch_distance: distances[i],
+                screen_coverage: coverage(box_radius, next, args.aspect),
+                seconds: chains
+                    .iter()
+                    .filter(|c| i < c.levels().len())
+                    .map(|c| c.levels()[i].time().as_secs_f64())
+                    .sum(),
+            }
+        })
+        .collect();
+    Ok(MeshReport {
+        mesh: 0,
+        name: String::new(),
+        radius,
+        max_distance,
+        levels,
+        warnings: Vec::new(),
+    })
+}
+
+fn table(r: &MeshReport) -> String {
+    let mut s = format!(
+        "mesh {} '{}': radius {:.4}, hidden beyond {:.3} (view-normalized)\n",
+        r.mesh, r.name, r.radius, r.max_distance
+    );
+    s.push_str("  level  triangles       error  switch distance  coverage     time\n");
+    for l in &r.levels {
+        s.push_str(&format!(
+            "  {:>5}  {:>9}  {:>10.6}  {:>15.4}  {:>8.5}  {:>5.0} ms\n",
+            l.level,
+            l.triangles,
+            l.error,
+            l.switch_distance,
+            l.screen_coverage,
+            l.seconds * 1e3
+        ));
+    }
+    s.trim_end().to_owned()
+}
+
+/// Whether `path` looks like a glTF file name (for the usage check of `-o`).
+fn is_gltf_name(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}

@@ -1,0 +1,337 @@
+//! Reading the triangle primitives of a glTF / GLB file, with every accessor checked against
+//! its buffer before it is read (a short buffer is an error naming the accessor, not a panic).
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use gltf::Semantic;
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
+
+/// One triangle primitive, as a list of vertices and a triangle list.
+pub struct Primitive {
+    /// Index of the primitive in its mesh.
+    pub index: usize,
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Option<Vec<[f32; 3]>>,
+    pub uvs: Option<Vec<[f32; 2]>>,
+    pub indices: Vec<u32>,
+    /// For each vertex, the vertex of the file's accessors it came from (differs when a
+    /// non-indexed primitive was welded).
+    pub file_vertex: Vec<u32>,
+    /// Attributes other than POSITION, NORMAL and TEXCOORD_0 that are carried: (semantic name,
+    /// accessor index).
+    pub carried: Vec<(String, usize)>,
+}
+
+/// A mesh's triangle primitives and what was left out.
+pub struct MeshInput {
+    pub primitives: Vec<Primitive>,
+    /// Primitives that are not triangles (carried unchanged into every level).
+    pub other_primitives: Vec<usize>,
+    pub warnings: Vec<String>,
+}
+
+/// Loads the document and its buffers.
+pub fn open(path: &Path) -> Result<(gltf::Document, Vec<gltf::buffer::Data>), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))?;
+    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| format!("not a valid glTF/GLB: {e}"))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let buffers = gltf::import_buffers(&gltf.document, Some(base), gltf.blob)
+        .map_err(|e| format!("cannot load its buffers: {e}"))?;
+    Ok((gltf.document, buffers))
+}
+
+/// The bytes of element `k` of `accessor` (checked by [`check_accessor`] first).
+pub fn element<'b>(
+    accessor: &gltf::Accessor,
+    buffers: &'b [gltf::buffer::Data],
+    k: usize,
+) -> &'b [u8] {
+    let view = accessor.view().expect("checked");
+    let stride = view.stride().unwrap_or(accessor.size());
+    let start = view.offset() + accessor.offset() + k * stride;
+    &buffers[view.buffer().index()][start..start + accessor.size()]
+}
+
+/// That `accessor` has a view, no sparse part, at least one element and lies inside its view
+/// and its view inside the buffer's data.
+pub fn check_accessor(
+    accessor: &gltf::Accessor,
+    buffers: &[gltf::buffer::Data],
+    what: &str,
+) -> Result<(), String> {
+    let name = format!("{what} (accessor {})", accessor.index());
+    if accessor.sparse().is_some() {
+        return Err(format!(
+            "{name} is sparse, which `lodkit lod` does not read"
+        ));
+    }
+    let Some(view) = accessor.view() else {
+        return Err(format!("{name} has no buffer view"));
+    };
+    if accessor.count() == 0 {
+        return Err(format!("{name} has no elements"));
+    }
+    let data = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
+    if view.offset() + view.length() > data {
+        return Err(format!(
+            "{name}: buffer view {} (bytes {}..{}) reaches past the end of buffer {} ({data} bytes)",
+            view.index(),
+            view.offset(),
+            view.offset() + view.length(),
+            view.buffer().index()
+        ));
+    }
+    let stride = view.stride().unwrap_or(accessor.size());
+    let end = accessor.offset() + stride * (accessor.count() - 1) + accessor.size();
+    if end > view.length() {
+        return Err(format!(
+            "{name}: {} elements need {end} bytes, buffer view {} has {}",
+            accessor.count(),
+            view.index(),
+            view.length()
+        ));
+    }
+    Ok(())
+}
+
+fn floats(
+    accessor: &gltf::Accessor,
+    buffers: &[gltf::buffer::Data],
+    what: &str,
+    dims: Dimensions,
+) -> Result<Vec<Vec<f32>>, String> {
+    check_accessor(accessor, buffers, what)?;
+    if accessor.dimensions() != dims {
+        return Err(format!(
+            "{what} (accessor {}) is {:?}, not {dims:?}",
+            accessor.index(),
+            accessor.dimensions()
+        ));
+    }
+    let n = dims.multiplicity();
+    let read = |b: &[u8], k: usize| -> f32 {
+        match accessor.data_type() {
+            DataType::F32 => f32::from_le_bytes(b[k * 4..k * 4 + 4].try_into().expect("4 bytes")),
+            DataType::U8 if accessor.normalized() => f32::from(b[k]) / 255.0,
+            DataType::U16 if accessor.normalized() => {
+                f32::from(u16::from_le_bytes([b[k * 2], b[k * 2 + 1]])) / 65535.0
+            }
+            _ => f32::NAN,
+        }
+    };
+    let ok = matches!(accessor.data_type(), DataType::F32)
+        || (accessor.normalized() && matches!(accessor.data_type(), DataType::U8 | DataType::U16));
+    if !ok {
+        return Err(format!(
+            "{what} (accessor {}) holds {:?}{}, not floats",
+            accessor.index(),
+            accessor.data_type(),
+            if accessor.normalized() {
+                " (normalized)"
+            } else {
+                ""
+            }
+        ));
+    }
+    Ok((0..accessor.count())
+        .map(|k| {
+            let b = element(accessor, buffers, k);
+            (0..n).map(|c| read(b, c)).collect()
+        })
+        .collect())
+}
+
+fn indices(
+    accessor: &gltf::Accessor,
+    buffers: &[gltf::buffer::Data],
+    what: &str,
+) -> Result<Vec<u32>, String> {
+    check_accessor(accessor, buffers, what)?;
+    let ok = accessor.dimensions() == Dimensions::Scalar
+        && matches!(
+            accessor.data_type(),
+            DataType::U8 | DataType::U16 | DataType::U32
+        );
+    if !ok {
+        return Err(format!(
+            "{what} (accessor {}) is not a scalar of unsigned integers",
+            accessor.index()
+        ));
+    }
+    Ok((0..accessor.count())
+        .map(|k| {
+            let b = element(accessor, buffers, k);
+            match accessor.data_type() {
+                DataType::U8 => u32::from(b[0]),
+                DataType::U16 => u32::from(u16::from_le_bytes([b[0], b[1]])),
+                _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+            }
+        })
+        .collect())
+}
+
+/// A strip or fan as a triangle list (glTF's orders).
+fn to_list(mode: Mode, strip: &[u32]) -> Vec<u32> {
+    let mut out = Vec::new();
+    for k in 2..strip.len() {
+        let t = match mode {
+            Mode::TriangleStrip if k.is_multiple_of(2) => [strip[k - 2], strip[k - 1], strip[k]],
+            Mode::TriangleStrip => [strip[k - 1], strip[k - 2], strip[k]],
+            _ => [strip[0], strip[k - 1], strip[k]],
+        };
+        out.extend(t);
+    }
+    out
+}
+
+/// The triangle primitives of `mesh`.
+pub fn mesh(mesh: &gltf::Mesh, buffers: &[gltf::buffer::Data]) -> Result<MeshInput, String> {
+    let mut input = MeshInput {
+        primitives: Vec::new(),
+        other_primitives: Vec::new(),
+        warnings: Vec::new(),
+    };
+    for (index, prim) in mesh.primitives().enumerate() {
+        let mode = prim.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            input.other_primitives.push(index);
+            continue;
+        }
+        let what = |s: &str| format!("primitive {index} {s}");
+        let position = prim
+            .get(&Semantic::Positions)
+            .ok_or_else(|| format!("primitive {index} has no POSITION"))?;
+        let positions = floats(&position, buffers, &what("POSITION"), Dimensions::Vec3)?;
+        let count = positions.len();
+        let same_count = |a: &gltf::Accessor, name: &str| {
+            if a.count() == count {
+                Ok(())
+            } else {
+                Err(format!(
+                    "primitive {index} {name} has {} elements, POSITION {count}",
+                    a.count()
+                ))
+            }
+        };
+        let mut normals = None;
+        let mut uvs = None;
+        let mut carried = Vec::new();
+        for (semantic, accessor) in prim.attributes() {
+            same_count(&accessor, &semantic.to_string())?;
+            match semantic {
+                Semantic::Positions => {}
+                Semantic::Normals => {
+                    normals = Some(floats(
+                        &accessor,
+                        buffers,
+                        &what("NORMAL"),
+                        Dimensions::Vec3,
+                    )?)
+                }
+                Semantic::TexCoords(0) => {
+                    uvs = Some(floats(
+                        &accessor,
+                        buffers,
+                        &what("TEXCOORD_0"),
+                        Dimensions::Vec2,
+                    )?)
+                }
+                other => {
+                    check_accessor(&accessor, buffers, &what(&other.to_string()))?;
+                    carried.push((other.to_string(), accessor.index()));
+                }
+            }
+        }
+        if prim.morph_targets().len() > 0 {
+            input.warnings.push(format!(
+                "primitive {index}: {} morph targets dropped from the generated levels",
+                prim.morph_targets().len()
+            ));
+        }
+        let (list, welded) = match prim.indices() {
+            Some(a) => {
+                let raw = indices(&a, buffers, &what("indices"))?;
+                (to_list_or_keep(mode, raw), None)
+            }
+            None => {
+                let (order, file_vertex) = weld(prim.attributes().map(|(_, a)| a), buffers);
+                (to_list_or_keep(mode, order), Some(file_vertex))
+            }
+        };
+        let file_vertex: Vec<u32> = welded.unwrap_or_else(|| (0..count as u32).collect());
+        let pick3 = |v: &[Vec<f32>]| -> Vec<[f32; 3]> {
+            file_vertex
+                .iter()
+                .map(|&k| {
+                    let x = &v[k as usize];
+                    [x[0], x[1], x[2]]
+                })
+                .collect()
+        };
+        input.primitives.push(Primitive {
+            index,
+            positions: pick3(&positions),
+            normals: normals.as_deref().map(pick3),
+            uvs: uvs.as_deref().map(|v| {
+                file_vertex
+                    .iter()
+                    .map(|&k| [v[k as usize][0], v[k as usize][1]])
+                    .collect()
+            }),
+            indices: list,
+            file_vertex,
+            carried,
+        });
+    }
+    if input.primitives.is_empty() {
+        return Err(if input.other_primitives.is_empty() {
+            "it has no primitives".to_owned()
+        } else {
+            "it has no triangles (points or lines only)".to_owned()
+        });
+    }
+    if !input.other_primitives.is_empty() {
+        input.warnings.push(format!(
+            "primitives {:?} are points or lines: carried unchanged into every level",
+            input.other_primitives
+        ));
+    }
+    Ok(input)
+}
+
+fn to_list_or_keep(mode: Mode, indices: Vec<u32>) -> Vec<u32> {
+    match mode {
+        Mode::Triangles => indices,
+        _ => to_list(mode, &indices),
+    }
+}
+
+/// A non-indexed primitive indexed: vertices equal in every attribute become one. Returns the
+/// index list into the welded vertices and, per welded vertex, its first file vertex.
+fn weld<'a>(
+    attributes: impl Iterator<Item = gltf::Accessor<'a>>,
+    buffers: &[gltf::buffer::Data],
+) -> (Vec<u32>, Vec<u32>) {
+    let attributes: Vec<gltf::Accessor> = attributes.collect();
+    let count = attributes.first().map_or(0, |a| a.count());
+    let mut seen: HashMap<Vec<u8>, u32> = HashMap::new();
+    let mut file_vertex = Vec::new();
+    let order = (0..count)
+        .map(|k| {
+            let key: Vec<u8> = attributes
+                .iter()
+                .flat_map(|a| element(a, buffers, k).iter().copied())
+                .collect();
+            *seen.entry(key).or_insert_with(|| {
+                file_vertex.push(k as u32);
+                file_vertex.len() as u32 - 1
+            })
+        })
+        .collect();
+    (order, file_vertex)
+}

@@ -1,0 +1,359 @@
+//! `lodkit lod`: a glTF file in, the same file with each mesh's LOD chain out (`MSFT_lod`), read
+//! back by a second reader (the `gltf` crate); bad inputs each get an error naming the file and
+//! the mesh, never a panic.
+
+use std::path::Path;
+
+use serde_json::json;
+
+use crate::cli::run;
+use crate::support::Scratch;
+
+/// A mesh to write: positions, optional indices, optional RGBA8 colors, primitive mode.
+struct Fixture {
+    positions: Vec<[f32; 3]>,
+    indices: Option<Vec<u32>>,
+    colors: bool,
+    mode: u32,
+}
+
+fn sphere(rings: u32, segments: u32) -> Fixture {
+    let (positions, indices) = lodkit::lod_chain::uv_sphere(rings, segments);
+    Fixture {
+        positions,
+        indices: Some(indices),
+        colors: false,
+        mode: 4,
+    }
+}
+
+/// Writes `name`.gltf and `name`.bin into `dir`; `edit` may change the JSON before it is saved.
+fn write_gltf(dir: &Path, name: &str, f: &Fixture, edit: impl FnOnce(&mut serde_json::Value)) {
+    let mut bin: Vec<u8> = f
+        .positions
+        .iter()
+        .flatten()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    let pos_len = bin.len();
+    let mut views = vec![json!({"buffer": 0, "byteOffset": 0, "byteLength": pos_len})];
+    let (lo, hi) = f.positions.iter().fold(
+        ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+        |(mut lo, mut hi), p| {
+            for ((l, h), x) in lo.iter_mut().zip(&mut hi).zip(p) {
+                *l = l.min(*x);
+                *h = h.max(*x);
+            }
+            (lo, hi)
+        },
+    );
+    let mut accessors = vec![json!({
+        "bufferView": 0, "componentType": 5126, "count": f.positions.len(), "type": "VEC3",
+        "min": lo, "max": hi
+    })];
+    let mut attributes = json!({"POSITION": 0});
+    if f.colors {
+        let start = bin.len();
+        for (k, _) in f.positions.iter().enumerate() {
+            bin.extend([(k % 256) as u8, 128, 255, 255]);
+        }
+        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}));
+        accessors.push(json!({
+            "bufferView": views.len() - 1, "componentType": 5121, "normalized": true,
+            "count": f.positions.len(), "type": "VEC4"
+        }));
+        attributes["COLOR_0"] = json!(accessors.len() - 1);
+    }
+    let mut primitive = json!({"attributes": attributes, "mode": f.mode});
+    if let Some(indices) = &f.indices {
+        let start = bin.len();
+        bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+        views.push(json!({"buffer": 0, "byteOffset": start, "byteLength": bin.len() - start}));
+        accessors.push(json!({
+            "bufferView": views.len() - 1, "componentType": 5125, "count": indices.len(),
+            "type": "SCALAR"
+        }));
+        primitive["indices"] = json!(accessors.len() - 1);
+    }
+    let mut doc = json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "name": "thing", "translation": [1.0, 2.0, 3.0]}],
+        "meshes": [{"name": "ball", "primitives": [primitive]}],
+        "buffers": [{"uri": format!("{name}.bin"), "byteLength": bin.len()}],
+        "bufferViews": views,
+        "accessors": accessors,
+    });
+    edit(&mut doc);
+    std::fs::write(dir.join(format!("{name}.bin")), &bin).unwrap();
+    std::fs::write(
+        dir.join(format!("{name}.gltf")),
+        serde_json::to_vec(&doc).unwrap(),
+    )
+    .unwrap();
+}
+
+/// Triangles of the first primitive of `mesh`, read by the gltf crate (LOD0 of a non-indexed
+/// input stays non-indexed).
+fn triangles(mesh: &gltf::Mesh, buffers: &[gltf::buffer::Data]) -> usize {
+    let p = mesh.primitives().next().unwrap();
+    let reader = p.reader(|b| Some(&buffers[b.index()]));
+    match reader.read_indices() {
+        Some(i) => i.into_u32().count() / 3,
+        None => reader.read_positions().unwrap().count() / 3,
+    }
+}
+
+/// Checks the output the way a second reader sees it: LOD0's node carries `MSFT_lod` with the
+/// level nodes in order (fewer triangles each), one decreasing screen coverage per level.
+fn assert_levels_in_order(path: &Path, levels: usize) {
+    let (doc, buffers, _) = gltf::import(path).unwrap();
+    assert!(doc.extensions_used().any(|e| e == "MSFT_lod"));
+    let lod0 = doc.nodes().next().unwrap();
+    let ids: Vec<usize> = lod0.extension_value("MSFT_lod").unwrap()["ids"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap() as usize)
+        .collect();
+    assert_eq!(ids.len(), levels - 1, "{ids:?}");
+    let extras: serde_json::Value =
+        serde_json::from_str(lod0.extras().as_ref().unwrap().get()).unwrap();
+    let coverage: Vec<f64> = extras["MSFT_screencoverage"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(coverage.len(), levels);
+    assert!(coverage.windows(2).all(|w| w[0] >= w[1]), "{coverage:?}");
+    let mut counts = vec![triangles(&lod0.mesh().unwrap(), &buffers)];
+    for &id in &ids {
+        let node = doc.nodes().nth(id).unwrap();
+        assert_eq!(node.transform().matrix(), lod0.transform().matrix());
+        counts.push(triangles(&node.mesh().unwrap(), &buffers));
+    }
+    assert!(counts.windows(2).all(|w| w[0] > w[1]), "{counts:?}");
+}
+
+#[test]
+fn lod_writes_msft_lod_levels_a_second_reader_loads_in_order() {
+    let dir = Scratch::folder();
+    write_gltf(&dir, "s", &sphere(12, 24), |_| {});
+    let (code, stdout, stderr) = run(
+        &dir,
+        &[
+            "lod",
+            "s.gltf",
+            "-o",
+            "out.glb",
+            "--pixel-error",
+            "1",
+            "--levels",
+            "4",
+            "--report",
+            "r.json",
+        ],
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("switch distance"), "{stdout}");
+    assert_levels_in_order(&dir.join("out.glb"), 4);
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("r.json")).unwrap()).unwrap();
+    let levels = report["meshes"][0]["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 4);
+    let d: Vec<f64> = levels
+        .iter()
+        .map(|l| l["switch_distance"].as_f64().unwrap())
+        .collect();
+    assert!(d.windows(2).all(|w| w[0] < w[1]), "{d:?}");
+    // The same through a .gltf with its .bin beside it.
+    let (code, _, stderr) = run(&dir, &["lod", "s.gltf", "-o", "out.gltf"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(dir.join("out.bin").exists());
+    assert_levels_in_order(&dir.join("out.gltf"), 4);
+}
+
+#[test]
+fn lod_indexes_a_non_indexed_mesh_and_carries_other_attributes() {
+    let dir = Scratch::folder();
+    let s = sphere(12, 24);
+    let flat = Fixture {
+        positions: s
+            .indices
+            .as_ref()
+            .unwrap()
+            .iter()
+            .map(|&i| s.positions[i as usize])
+            .collect(),
+        indices: None,
+        colors: true,
+        mode: 4,
+    };
+    write_gltf(&dir, "flat", &flat, |_| {});
+    let (code, _, stderr) = run(&dir, &["lod", "flat.gltf", "-o", "out.glb"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stderr.contains("COLOR_0") && stderr.contains("warning"),
+        "{stderr}"
+    );
+    let (doc, _, _) = gltf::import(dir.join("out.glb")).unwrap();
+    for mesh in doc.meshes().skip(1) {
+        let p = mesh.primitives().next().unwrap();
+        assert!(
+            p.get(&gltf::Semantic::Colors(0)).is_some(),
+            "COLOR_0 was carried"
+        );
+    }
+    assert_levels_in_order(&dir.join("out.glb"), 4);
+}
+
+#[test]
+fn lod_bad_inputs_name_the_file_and_mesh() {
+    type Case = (
+        &'static str,
+        Fixture,
+        fn(&mut serde_json::Value),
+        &'static str,
+    );
+    let nan = {
+        let mut s = sphere(6, 12);
+        s.positions[5][1] = f32::NAN;
+        s
+    };
+    let cases: Vec<Case> = vec![
+        (
+            "points",
+            Fixture {
+                mode: 0,
+                ..sphere(6, 12)
+            },
+            |_| {},
+            "no triangles (points or lines only)",
+        ),
+        (
+            "lines",
+            Fixture {
+                mode: 1,
+                ..sphere(6, 12)
+            },
+            |_| {},
+            "no triangles (points or lines only)",
+        ),
+        (
+            "flat",
+            Fixture {
+                positions: vec![[1.0, 1.0, 1.0]; 4],
+                indices: Some(vec![0, 1, 2, 1, 2, 3]),
+                colors: false,
+                mode: 4,
+            },
+            |_| {},
+            "degenerate",
+        ),
+        ("nan", nan, |_| {}, "not finite"),
+        (
+            "index",
+            Fixture {
+                positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                indices: Some(vec![0, 1, 9]),
+                colors: false,
+                mode: 4,
+            },
+            |_| {},
+            "out of range",
+        ),
+        (
+            "short",
+            sphere(6, 12),
+            |doc| {
+                doc["bufferViews"][0]["byteLength"] =
+                    json!(doc["buffers"][0]["byteLength"].as_u64().unwrap() + 64)
+            },
+            "past the end of buffer",
+        ),
+    ];
+    for (name, fixture, edit, want) in cases {
+        let dir = Scratch::folder();
+        write_gltf(&dir, name, &fixture, edit);
+        let file = format!("{name}.gltf");
+        let (code, _, stderr) = run(&dir, &["lod", &file, "-o", "out.glb", "--strict"]);
+        assert_eq!(code, 1, "{name}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{name}: {stderr}");
+        assert!(
+            stderr.contains(&file) && stderr.contains("mesh 0 'ball'"),
+            "{name}: {stderr}"
+        );
+        assert!(stderr.contains(want), "{name}: wanted `{want}` in {stderr}");
+        assert!(
+            !dir.join("out.glb").exists(),
+            "{name}: wrote an output anyway"
+        );
+    }
+    let dir = crate::cli::fixture(&[("text.gltf", b"this is not glTF")]);
+    let (code, _, stderr) = run(&dir, &["lod", "text.gltf", "-o", "out.glb"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("text.gltf") && stderr.contains("not a valid glTF"),
+        "{stderr}"
+    );
+    let (code, _, stderr) = run(&dir, &["lod", "missing.gltf", "-o", "out.glb"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("missing.gltf"), "{stderr}");
+}
+
+/// An outside loader: Babylon.js's glTF loader (npm `babylonjs-loaders`, headless in node with a
+/// NullEngine) reads the levels through `MSFT_lod`. It loads the coarsest first: allowed `k`
+/// levels it shows the k-th coarsest, so the triangle counts it ends with grow with `k` and are
+/// our levels' counts in reverse.
+#[test]
+fn babylon_loads_the_msft_lod_levels_in_order() {
+    let Some(mut node) = crate::support::node_script("babylon-lod.cjs", "babylonjs-loaders") else {
+        return;
+    };
+    let dir = Scratch::folder();
+    write_gltf(&dir, "s", &sphere(12, 24), |_| {});
+    let (code, _, stderr) = run(
+        &dir,
+        &[
+            "lod", "s.gltf", "-o", "out.glb", "--levels", "4", "--report", "r.json",
+        ],
+    );
+    assert_eq!(code, 0, "{stderr}");
+    let out = node.arg(dir.join("out.glb")).arg("4").output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line = stdout
+        .lines()
+        .rev()
+        .find(|l| l.starts_with('{'))
+        .expect("a JSON line");
+    let got: serde_json::Value = serde_json::from_str(line).unwrap();
+    let loads: Vec<u64> = got["loads"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| {
+            l.as_array()
+                .unwrap()
+                .iter()
+                .map(|t| t.as_u64().unwrap())
+                .sum()
+        })
+        .collect();
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("r.json")).unwrap()).unwrap();
+    let mut ours: Vec<u64> = report["meshes"][0]["levels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["triangles"].as_u64().unwrap())
+        .collect();
+    ours.reverse();
+    assert_eq!(loads, ours, "Babylon.js {}", got["babylon"]);
+}
