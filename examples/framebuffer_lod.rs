@@ -21,7 +21,10 @@ use std::time::Instant;
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController, psnr_rgba8};
 use lodkit::gpu::GpuContext;
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::framebuffer_lod::{
+    LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
+    UpsampleSettings,
+};
 use lodkit::gpu::gbuffer_scene::{GBufferRenderer, GDrawItem, ShadingTerm};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
@@ -85,7 +88,13 @@ fn main() -> Result<(), Box<dyn Error>> {
     let prepass_pass = GBufferRenderer::new(&gpu, FORMAT, ShadingTerm::Albedo)?;
     let low = LowResBuffer::new(&gpu, w, h, FORMAT)?;
     let prepass = LowResBuffer::new(&gpu, w, h, FORMAT)?;
-    let upsample = UpsamplePass::new(&gpu, FORMAT)?;
+    let upsample = UpsamplePass::new(
+        &gpu,
+        &UpsamplePassDescriptor {
+            target_format: FORMAT,
+            ..Default::default()
+        },
+    )?;
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = texture_2d(&gpu, SIZE, FORMAT, usage, "frame")?;
     let target_view = target.create_view(&Default::default());
@@ -111,17 +120,18 @@ fn main() -> Result<(), Box<dyn Error>> {
         prepass_pass.render(&gpu, &prepass, 1.0, view, proj, &items, clear, FAR)?;
         shading.render(&gpu, &low, r, view, proj, &items, clear, FAR)?;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let geometry = prepass.geometry();
-        upsample.encode(
-            &gpu,
-            &mut encoder,
-            &low,
-            r,
-            geometry,
-            SIGMA_Z,
-            SIGMA_N,
-            &target_view,
-        )?;
+        let sigmas = RangeSigmas {
+            depth: SIGMA_Z,
+            normal: SIGMA_N,
+        };
+        let upsampled = UpsampleFrame {
+            low: &low,
+            full_geometry: prepass.geometry(),
+            full_albedo: None,
+            target: &target_view,
+            settings: UpsampleSettings { r, sigmas },
+        };
+        upsample.record(&gpu, &mut encoder, &upsampled)?;
         gpu.queue.submit([encoder.finish()]);
         gpu.wait_idle()?;
         Ok(start.elapsed().as_secs_f32() * 1e3)

@@ -408,7 +408,10 @@ mod controller {
 mod rendered {
     use lodkit::framebuffer_lod::{multiply_rgba8, psnr_rgba8};
     use lodkit::gpu::GpuError;
-    use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+    use lodkit::gpu::framebuffer_lod::{
+        LowResBuffer, RangeSigmas, UpsampleComposite, UpsampleFrame, UpsamplePass,
+        UpsamplePassDescriptor, UpsampleSettings,
+    };
     use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
     use lodkit::gpu::readback::read_texture_rgba8;
     use lodkit::gpu::resources::texture_2d;
@@ -428,67 +431,71 @@ mod rendered {
         let reference = read_texture_rgba8(gpu, full.color()).unwrap();
         let low = LowResBuffer::new(gpu, W, H, format).unwrap();
         let albedo = LowResBuffer::new(gpu, W, H, format).unwrap();
-        let upsample = UpsamplePass::new(gpu, format).unwrap();
-        let fine_pass = UpsamplePass::fine_grained(gpu, format).unwrap();
+        let desc = UpsamplePassDescriptor {
+            target_format: format,
+            ..Default::default()
+        };
+        let upsample = UpsamplePass::new(gpu, &desc).unwrap();
+        let fine_desc = UpsamplePassDescriptor {
+            composite: UpsampleComposite::TimesAlbedo,
+            ..desc
+        };
+        let fine_pass = UpsamplePass::new(gpu, &fine_desc).unwrap();
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let target = texture_2d(gpu, (W, H), format, usage, "upsampled").unwrap();
         let view = target.create_view(&Default::default());
-        // Each pass records only with its own encode call.
+        fn frame<'a>(
+            (low, full, view): (&'a LowResBuffer, &'a LowResBuffer, &'a wgpu::TextureView),
+            r: f32,
+            sigmas: RangeSigmas,
+            albedo: Option<&'a wgpu::Texture>,
+        ) -> UpsampleFrame<'a> {
+            UpsampleFrame {
+                low,
+                full_geometry: full.geometry(),
+                full_albedo: albedo,
+                target: view,
+                settings: UpsampleSettings { r, sigmas },
+            }
+        }
+        let frame = |r, sigmas, albedo| frame((&low, &full, &view), r, sigmas, albedo);
+        let sigmas = RangeSigmas {
+            depth: 0.25,
+            normal: 0.4,
+        };
+        // An albedo where the pass has no composite, and none where it has: refused.
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let (g, a) = (full.geometry(), albedo.color());
-        let wrong = fine_pass.encode(gpu, &mut encoder, &low, 2.0, g, 0.25, 0.4, &view);
+        let wrong = fine_pass.record(gpu, &mut encoder, &frame(2.0, sigmas, None));
         assert!(matches!(wrong, Err(GpuError::Mismatch { .. })), "{wrong:?}");
-        let wrong =
-            upsample.encode_fine_grained(gpu, &mut encoder, &low, 2.0, g, a, 0.25, 0.4, &view);
+        let with_albedo = frame(2.0, sigmas, Some(albedo.color()));
+        let wrong = upsample.record(gpu, &mut encoder, &with_albedo);
         assert!(matches!(wrong, Err(GpuError::Mismatch { .. })), "{wrong:?}");
+        let run = |pass: &UpsamplePass, f: UpsampleFrame| {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            pass.record(gpu, &mut encoder, &f).unwrap();
+            gpu.queue.submit([encoder.finish()]);
+            read_texture_rgba8(gpu, &target).unwrap()
+        };
         let mut rows = Vec::new();
         let mut gain_at_2 = 0.0;
         for r in [2.0f32, 4.0] {
             scene.render(gpu, &low, r).unwrap();
             let mut psnr = [0.0f32; 2];
-            for (i, (sz, sn)) in [(f32::INFINITY, f32::INFINITY), (0.25, 0.4)]
-                .into_iter()
-                .enumerate()
-            {
-                let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                upsample
-                    .encode(gpu, &mut encoder, &low, r, full.geometry(), sz, sn, &view)
-                    .unwrap();
-                gpu.queue.submit([encoder.finish()]);
-                psnr[i] = psnr_rgba8(&read_texture_rgba8(gpu, &target).unwrap(), &reference);
+            for (i, s) in [RangeSigmas::OFF, sigmas].into_iter().enumerate() {
+                psnr[i] = psnr_rgba8(&run(&upsample, frame(r, s, None)), &reference);
             }
             // Fine-grained: only the lighting goes through L; the albedo is drawn at full res.
             scene
                 .render_term(gpu, &low, r, ShadingTerm::Lighting)
                 .unwrap();
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            upsample
-                .encode(
-                    gpu,
-                    &mut encoder,
-                    &low,
-                    r,
-                    full.geometry(),
-                    0.25,
-                    0.4,
-                    &view,
-                )
-                .unwrap();
-            gpu.queue.submit([encoder.finish()]);
-            let lighting = read_texture_rgba8(gpu, &target).unwrap();
+            let lighting = run(&upsample, frame(r, sigmas, None));
             scene
                 .render_term(gpu, &albedo, 1.0, ShadingTerm::Albedo)
                 .unwrap();
             let albedo_pixels = read_texture_rgba8(gpu, albedo.color()).unwrap();
             // The fine-grained pass multiplies in the upsample: within 1 of the product of the
             // two RGBA8 images (it multiplies before the lighting is quantized).
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let (g, a) = (full.geometry(), albedo.color());
-            fine_pass
-                .encode_fine_grained(gpu, &mut encoder, &low, r, g, a, 0.25, 0.4, &view)
-                .unwrap();
-            gpu.queue.submit([encoder.finish()]);
-            let composite = read_texture_rgba8(gpu, &target).unwrap();
+            let composite = run(&fine_pass, frame(r, sigmas, Some(albedo.color())));
             let product = multiply_rgba8(&lighting, &albedo_pixels);
             let worst = composite
                 .iter()
@@ -523,6 +530,85 @@ mod rendered {
             gain_at_2 >= 3.0,
             "gain at r = 2 is {gain_at_2:.2} dB, target >= 3 dB"
         );
+    }
+
+    /// Two upsamples recorded in one encoder with different parameters (r = 2 and r = 3, and
+    /// other sigmas), each into a target of its own, give each the image the same recording
+    /// gives alone: every recording reads its own parameters, whatever else the encoder holds.
+    #[test]
+    fn two_recordings_in_one_encoder_each_read_their_own_parameters() {
+        let gpu = lodkit_test_gpu!();
+        let format = wgpu::TextureFormat::Rgba8Unorm;
+        let scene = EdgeScene::new(gpu, format, W as f32 / H as f32).unwrap();
+        let full = LowResBuffer::new(gpu, W, H, format).unwrap();
+        scene.render(gpu, &full, 1.0).unwrap();
+        let lows = [2.0f32, 3.0].map(|r| {
+            let low = LowResBuffer::new(gpu, W, H, format).unwrap();
+            scene.render(gpu, &low, r).unwrap();
+            (low, r)
+        });
+        let desc = UpsamplePassDescriptor {
+            target_format: format,
+            ..Default::default()
+        };
+        let pass = UpsamplePass::new(gpu, &desc).unwrap();
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let targets = [0, 1].map(|_| texture_2d(gpu, (W, H), format, usage, "t").unwrap());
+        let views = targets
+            .each_ref()
+            .map(|t| t.create_view(&Default::default()));
+        let sigmas = [
+            RangeSigmas::default(),
+            RangeSigmas {
+                depth: 0.05,
+                normal: 0.1,
+            },
+        ];
+        let frame = |k: usize| UpsampleFrame {
+            low: &lows[k].0,
+            full_geometry: full.geometry(),
+            full_albedo: None,
+            target: &views[k],
+            settings: UpsampleSettings {
+                r: lows[k].1,
+                sigmas: sigmas[k],
+            },
+        };
+        let alone: Vec<Vec<u8>> = (0..2)
+            .map(|k| {
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                pass.record(gpu, &mut encoder, &frame(k)).unwrap();
+                gpu.queue.submit([encoder.finish()]);
+                read_texture_rgba8(gpu, &targets[k]).unwrap()
+            })
+            .collect();
+        assert_ne!(
+            alone[0], alone[1],
+            "the two recordings draw different images"
+        );
+        for t in &targets {
+            // Cleared, so that a recording that drew nothing would be seen.
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let view = t.create_view(&Default::default());
+            drop(lodkit::gpu::resources::begin_color_pass(
+                &mut encoder,
+                &view,
+                wgpu::Color::RED,
+                "clear",
+            ));
+            gpu.queue.submit([encoder.finish()]);
+        }
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        pass.record(gpu, &mut encoder, &frame(0)).unwrap();
+        pass.record(gpu, &mut encoder, &frame(1)).unwrap();
+        gpu.queue.submit([encoder.finish()]);
+        for k in 0..2 {
+            let together = read_texture_rgba8(gpu, &targets[k]).unwrap();
+            assert!(
+                together == alone[k],
+                "recording {k} in one encoder with another differs from it alone"
+            );
+        }
     }
 
     #[test]

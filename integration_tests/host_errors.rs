@@ -10,7 +10,10 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use glam::Mat4;
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::framebuffer_lod::{
+    LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
+    UpsampleSettings,
+};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, GBufferRenderer, ShadingTerm};
 use lodkit::gpu::lod_buffer_scene::LodBufferRenderer;
 use lodkit::gpu::readback::{read_buffer, read_texture, read_texture_rgba8};
@@ -290,7 +293,14 @@ fn formats_the_passes_cannot_use_are_named() {
             ),
             (
                 "UpsamplePass::new",
-                UpsamplePass::new(gpu, format).map(drop),
+                UpsamplePass::new(
+                    gpu,
+                    &UpsamplePassDescriptor {
+                        target_format: format,
+                        ..Default::default()
+                    },
+                )
+                .map(drop),
             ),
             (
                 "LodBufferRenderer::new",
@@ -393,33 +403,50 @@ fn passes_given_mismatched_inputs_name_both() {
     let low = LowResBuffer::new(gpu, 32, 24, RGBA8).unwrap();
     let full = LowResBuffer::new(gpu, 32, 24, RGBA8).unwrap();
     let half = LowResBuffer::new(gpu, 16, 12, RGBA8).unwrap();
-    let upsample = UpsamplePass::new(gpu, RGBA8).unwrap();
+    let desc = UpsamplePassDescriptor {
+        target_format: RGBA8,
+        ..Default::default()
+    };
+    let upsample = UpsamplePass::new(gpu, &desc).unwrap();
     let run = |geometry: &wgpu::Texture, sigma: f32, view: &wgpu::TextureView| {
-        no_panic("UpsamplePass::encode", || {
-            upsample.encode(gpu, &mut encoder(), &low, 2.0, geometry, sigma, sigma, view)
+        no_panic("UpsamplePass::record", || {
+            let frame = UpsampleFrame {
+                low: &low,
+                full_geometry: geometry,
+                full_albedo: None,
+                target: view,
+                settings: UpsampleSettings {
+                    r: 2.0,
+                    sigmas: RangeSigmas {
+                        depth: sigma,
+                        normal: sigma,
+                    },
+                },
+            };
+            upsample.record(gpu, &mut encoder(), &frame)
         })
     };
     mismatch(
         run(half.geometry(), 1.0, &right),
-        "full_geometry",
+        "frame.full_geometry",
         "16 x 12",
         "32 x 24",
     );
     mismatch(
         run(full.color(), 1.0, &right),
-        "full_geometry",
+        "frame.full_geometry",
         "Rgba8Unorm",
         "Rgba16Float",
     );
     mismatch(
         run(full.geometry(), 1.0, &small),
-        "target",
+        "frame.target",
         "16 x 24",
         "32 x 24",
     );
     mismatch(
         run(full.geometry(), 1.0, &other),
-        "target",
+        "frame.target",
         "Rgba16Float",
         "Rgba8Unorm",
     );
@@ -429,7 +456,7 @@ fn passes_given_mismatched_inputs_name_both() {
             matches!(
                 r,
                 Err(GpuError::Invalid {
-                    parameter: "sigma_z",
+                    parameter: "frame.settings.sigmas.depth",
                     ..
                 })
             ),

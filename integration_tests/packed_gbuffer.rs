@@ -304,13 +304,17 @@ fn packed_upsample_at_twins_match_and_stay_within_half_precision_of_the_unpacked
     }
 }
 
-/// A packed L drawn by the edge scene and upsampled by `UpsamplePass::packed` gives the image of
+/// A packed L drawn by the edge scene and upsampled by a pass built for `LowResLayout::Packed`
+/// gives the image of
 /// the unpacked route (RGBA8 target: the halves' rounding stays within one 8-bit step); an L and
-/// a pass of different layouts are a `Mismatch` naming `low`.
+/// a pass of different layouts are a `Mismatch` naming `frame.low`.
 #[test]
 fn packed_route_renders_the_unpacked_image_and_layouts_must_match() {
     use lodkit::gpu::GpuError;
-    use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+    use lodkit::gpu::framebuffer_lod::{
+        LowResBuffer, LowResLayout, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
+        UpsampleSettings,
+    };
     use lodkit::gpu::gbuffer_scene::EdgeScene;
     use lodkit::gpu::readback::read_texture_rgba8;
     use lodkit::gpu::resources::texture_2d;
@@ -324,10 +328,14 @@ fn packed_route_renders_the_unpacked_image_and_layouts_must_match() {
         LowResBuffer::new(gpu, w, h, format).unwrap(),
         LowResBuffer::packed(gpu, w, h).unwrap(),
     ];
-    let passes = [
-        UpsamplePass::new(gpu, format).unwrap(),
-        UpsamplePass::packed(gpu, format).unwrap(),
-    ];
+    let passes = [LowResLayout::ColorAndGeometry, LowResLayout::Packed].map(|low_res| {
+        let desc = UpsamplePassDescriptor {
+            target_format: format,
+            low_res,
+            ..Default::default()
+        };
+        UpsamplePass::new(gpu, &desc).unwrap()
+    });
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = texture_2d(gpu, (w, h), format, usage, "target").unwrap();
     let view = target.create_view(&Default::default());
@@ -335,8 +343,17 @@ fn packed_route_renders_the_unpacked_image_and_layouts_must_match() {
     for (low, pass) in lows.iter().zip(&passes) {
         scene.render(gpu, low, r).unwrap();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        pass.encode(gpu, &mut encoder, low, r, full.geometry(), 0.25, 0.4, &view)
-            .unwrap();
+        let frame = UpsampleFrame {
+            low,
+            full_geometry: full.geometry(),
+            full_albedo: None,
+            target: &view,
+            settings: UpsampleSettings {
+                r,
+                ..Default::default()
+            },
+        };
+        pass.record(gpu, &mut encoder, &frame).unwrap();
         gpu.queue.submit([encoder.finish()]);
         images.push(read_texture_rgba8(gpu, &target).unwrap());
     }
@@ -361,21 +378,19 @@ fn packed_route_renders_the_unpacked_image_and_layouts_must_match() {
         "the packed route drew nothing"
     );
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    let wrong = passes[0].encode(
-        gpu,
-        &mut encoder,
-        &lows[1],
-        r,
-        full.geometry(),
-        0.25,
-        0.4,
-        &view,
-    );
+    let frame = UpsampleFrame {
+        low: &lows[1],
+        full_geometry: full.geometry(),
+        full_albedo: None,
+        target: &view,
+        settings: UpsampleSettings::default(),
+    };
+    let wrong = passes[0].record(gpu, &mut encoder, &frame);
     assert!(
         matches!(
             wrong,
             Err(GpuError::Mismatch {
-                parameter: "low",
+                parameter: "frame.low",
                 ..
             })
         ),

@@ -7,7 +7,9 @@ use super::error::{buffer_size, check_format_usages, target_extent, texture_exte
 use super::{GpuContext, GpuError};
 
 mod draw_uniforms;
+mod params;
 pub use draw_uniforms::DrawUniforms;
+pub use params::RecordedUniform;
 
 /// A 2D texture with one mip level and one sample (a zero side is taken as 1).
 pub fn texture_2d(

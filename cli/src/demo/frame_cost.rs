@@ -23,8 +23,8 @@ use super::DemoError;
 use super::clock::{Clock, Timer, median};
 use super::plots::{BarChart, Chart, Series, line_chart, stacked_bars};
 use super::report::Table;
-use super::upsampling::{SIGMA_N, SIGMA_Z};
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use super::timing::{pass_descriptor, settings};
+use lodkit::gpu::framebuffer_lod::{LowResBuffer, LowResLayout, UpsampleFrame, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::{GpuContext, GpuError};
@@ -146,12 +146,12 @@ impl<'a> Frame<'a> {
             ],
             prepass: LowResBuffer::new(gpu, w, h, format)?,
             upsample: [
-                UpsamplePass::new(gpu, format)?,
-                UpsamplePass::packed(gpu, format)?,
+                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::ColorAndGeometry, false))?,
+                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, false))?,
             ],
             fine: [
-                UpsamplePass::fine_grained(gpu, format)?,
-                UpsamplePass::packed_fine_grained(gpu, format)?,
+                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::ColorAndGeometry, true))?,
+                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, true))?,
             ],
             view: texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default()),
         };
@@ -188,15 +188,20 @@ impl<'a> Frame<'a> {
         term: ShadingTerm,
         p: usize,
     ) -> Result<(), GpuError> {
-        let gpu = self.gpu;
-        let (low, g, view) = (&self.low[p], self.prepass.geometry(), &self.view);
-        let (sz, sn) = (SIGMA_Z, SIGMA_N);
-        if term == ShadingTerm::Lighting {
-            let albedo = self.prepass.color();
-            self.fine[p].encode_fine_grained(gpu, encoder, low, r, g, albedo, sz, sn, view)
+        let fine = term == ShadingTerm::Lighting;
+        let frame = UpsampleFrame {
+            low: &self.low[p],
+            full_geometry: self.prepass.geometry(),
+            full_albedo: fine.then(|| self.prepass.color()),
+            target: &self.view,
+            settings: settings(r),
+        };
+        let pass = if fine {
+            &self.fine[p]
         } else {
-            self.upsample[p].encode(gpu, encoder, low, r, g, sz, sn, view)
-        }
+            &self.upsample[p]
+        };
+        pass.record(self.gpu, encoder, &frame)
     }
 
     fn upsample(&self, r: f32, term: ShadingTerm, p: usize) -> Result<f64, GpuError> {

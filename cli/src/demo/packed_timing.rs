@@ -5,10 +5,11 @@
 
 use super::clock::{Record, Timer, interleaved};
 use super::reads::{Reads, Texels};
-use super::timing::{BILINEAR, FORMAT, PassRatio, plain_pass, record_fullscreen};
-use super::upsampling::{SIGMA_N, SIGMA_Z};
+use super::timing::{
+    BILINEAR, FORMAT, PassRatio, pass_descriptor, plain_pass, record_fullscreen, settings,
+};
 use lodkit::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::framebuffer_lod::{LowResBuffer, LowResLayout, UpsampleFrame, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
 use lodkit::gpu::resources::{texture_2d, textures_and_uniform, uniform_buffer};
 use lodkit::gpu::{GpuContext, GpuError};
@@ -50,7 +51,7 @@ struct Scale { uv_scale: vec2<f32>, _pad: vec2<f32> }
 ";
 
 /// At resize factor `r` on the edge scene: the packed bilateral upsample pass and its five loads
-/// alone against the bilinear pass; then the fold-in (`UpsamplePass::packed_fine_grained`, the
+/// alone against the bilinear pass; then the fold-in (`UpsampleComposite::TimesAlbedo` over a packed L, the
 /// fine-grained route's composite with `bilateral_upsample_packed_at` inside) against the same
 /// composite with a bilinear sample.
 pub fn packed_upsample_vs_bilinear(
@@ -70,15 +71,18 @@ pub fn packed_upsample_vs_bilinear(
     scene.render_term(gpu, &packed, r, ShadingTerm::Lighting)?;
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
     let view = texture_2d(gpu, size, FORMAT, usage, "target")?.create_view(&Default::default());
-    let upsample = UpsamplePass::packed(gpu, FORMAT)?;
-    let fold_in = UpsamplePass::packed_fine_grained(gpu, FORMAT)?;
+    let upsample = UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, false))?;
+    let fold_in = UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, true))?;
     let run_pass = |encoder: &mut wgpu::CommandEncoder, fine: bool| {
-        let (g, a, (sz, sn)) = (full.geometry(), full.color(), (SIGMA_Z, SIGMA_N));
-        if fine {
-            fold_in.encode_fine_grained(gpu, encoder, &packed, r, g, a, sz, sn, &view)
-        } else {
-            upsample.encode(gpu, encoder, &packed, r, g, sz, sn, &view)
-        }
+        let frame = UpsampleFrame {
+            low: &packed,
+            full_geometry: full.geometry(),
+            full_albedo: fine.then(|| full.color()),
+            target: &view,
+            settings: settings(r),
+        };
+        let pass = if fine { &fold_in } else { &upsample };
+        pass.record(gpu, encoder, &frame)
     };
     let (vw, vh) = low.viewport(r);
     let s = [vw as f32 / w as f32, vh as f32 / h as f32, 0.0, 0.0];

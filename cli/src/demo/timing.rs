@@ -13,7 +13,10 @@ use super::clock::{Clock, Timer, interleaved};
 use super::reads::{Reads, Texels};
 use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::framebuffer_lod::{
+    LowResBuffer, LowResLayout, RangeSigmas, UpsampleComposite, UpsampleFrame, UpsamplePass,
+    UpsamplePassDescriptor, UpsampleSettings,
+};
 use lodkit::gpu::gbuffer_scene::EdgeScene;
 use lodkit::gpu::resources::{
     begin_color_pass, fullscreen_pipeline_with, texture_2d, textures_and_uniform, uniform_buffer,
@@ -74,6 +77,31 @@ pub(super) fn plain_pass_with(
     })?;
     let module = gpu.shader_module(name, &composed)?;
     fullscreen_pipeline_with(gpu, &module, FORMAT, layout, name)
+}
+
+/// The demo's upsample pass over an L of `layout`, times a full-resolution albedo when
+/// `times_albedo` (fine-grained resizing), into [`FORMAT`] targets.
+pub(super) fn pass_descriptor(layout: LowResLayout, times_albedo: bool) -> UpsamplePassDescriptor {
+    UpsamplePassDescriptor {
+        target_format: FORMAT,
+        low_res: layout,
+        composite: if times_albedo {
+            UpsampleComposite::TimesAlbedo
+        } else {
+            UpsampleComposite::Upsampled
+        },
+    }
+}
+
+/// The demo's upsampling parameters at resize factor `r`.
+pub(super) fn settings(r: f32) -> UpsampleSettings {
+    UpsampleSettings {
+        r,
+        sigmas: RangeSigmas {
+            depth: SIGMA_Z,
+            normal: SIGMA_N,
+        },
+    }
 }
 
 /// Target format of the timed passes.
@@ -158,7 +186,7 @@ pub fn upsample_vs_bilinear(
     scene.render(gpu, &full, 1.0)?;
     let low = LowResBuffer::new(gpu, w, h, FORMAT)?;
     scene.render(gpu, &low, r)?;
-    let upsample = UpsamplePass::new(gpu, FORMAT)?;
+    let upsample = UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::ColorAndGeometry, false))?;
     let target = texture_2d(
         gpu,
         size,
@@ -199,16 +227,14 @@ pub fn upsample_vs_bilinear(
         }))
     };
     let run_bilateral = |encoder: &mut wgpu::CommandEncoder| {
-        upsample.encode(
-            gpu,
-            encoder,
-            &low,
-            r,
-            full.geometry(),
-            SIGMA_Z,
-            SIGMA_N,
-            &view,
-        )
+        let frame = UpsampleFrame {
+            low: &low,
+            full_geometry: full.geometry(),
+            full_albedo: None,
+            target: &view,
+            settings: settings(r),
+        };
+        upsample.record(gpu, encoder, &frame)
     };
     let scale_bytes: &[u8] = bytemuck::cast_slice(&s);
     let run_bilinear = |encoder: &mut wgpu::CommandEncoder| {

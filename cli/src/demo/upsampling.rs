@@ -13,7 +13,10 @@ use lodkit::framebuffer_lod::{
     FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
     RlsController, StepController, psnr_rgba8, simulate, ssim_rgba8, step_response,
 };
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, UpsamplePass};
+use lodkit::gpu::framebuffer_lod::{
+    LowResBuffer, LowResLayout, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
+    UpsampleSettings,
+};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
@@ -31,6 +34,14 @@ pub const SHADING_WORK: u32 = 64;
 pub const SIGMA_Z: f32 = 0.25;
 /// See [`SIGMA_Z`].
 pub const SIGMA_N: f32 = 0.4;
+
+/// [`SIGMA_Z`] and [`SIGMA_N`] as the pass takes them.
+fn demo_sigmas() -> RangeSigmas {
+    RangeSigmas {
+        depth: SIGMA_Z,
+        normal: SIGMA_N,
+    }
+}
 
 /// Quality and speed of one resize factor.
 #[derive(Clone, Debug, Serialize)]
@@ -98,14 +109,19 @@ pub fn measure_upsampling(
         LowResBuffer::packed(gpu, w, h)?,
     ];
     let albedo = LowResBuffer::new(gpu, w, h, format)?;
-    let upsample = [
-        UpsamplePass::new(gpu, format)?,
-        UpsamplePass::packed(gpu, format)?,
-    ];
-    let fine_pass = [
-        UpsamplePass::fine_grained(gpu, format)?,
-        UpsamplePass::packed_fine_grained(gpu, format)?,
-    ];
+    let layouts = [LowResLayout::ColorAndGeometry, LowResLayout::Packed];
+    let pass = |layout, times_albedo| {
+        let desc = super::timing::pass_descriptor(layout, times_albedo);
+        UpsamplePass::new(
+            gpu,
+            &UpsamplePassDescriptor {
+                target_format: format,
+                ..desc
+            },
+        )
+    };
+    let upsample = [pass(layouts[0], false)?, pass(layouts[1], false)?];
+    let fine_pass = [pass(layouts[0], true)?, pass(layouts[1], true)?];
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = texture_2d(gpu, size, format, usage, "upsampled")?;
     let view = target.create_view(&Default::default());
@@ -114,13 +130,26 @@ pub fn measure_upsampling(
                            p: usize,
                            r: f32,
                            geometry: &wgpu::Texture,
-                           (sz, sn): (f32, f32)| {
-        upsample[p].encode(gpu, e, &lows[p], r, geometry, sz, sn, &view)
+                           sigmas: RangeSigmas| {
+        let frame = UpsampleFrame {
+            low: &lows[p],
+            full_geometry: geometry,
+            full_albedo: None,
+            target: &view,
+            settings: UpsampleSettings { r, sigmas },
+        };
+        upsample[p].record(gpu, e, &frame)
     };
     // Fine-grained: the upsampled lighting times the full-resolution albedo, in the upsample.
     let record_fine = |e: &mut wgpu::CommandEncoder, p: usize, r: f32| {
-        let (g, a, (sz, sn)) = (albedo.geometry(), albedo.color(), (SIGMA_Z, SIGMA_N));
-        fine_pass[p].encode_fine_grained(gpu, e, &lows[p], r, g, a, sz, sn, &view)
+        let frame = UpsampleFrame {
+            low: &lows[p],
+            full_geometry: albedo.geometry(),
+            full_albedo: Some(albedo.color()),
+            target: &view,
+            settings: super::timing::settings(r),
+        };
+        fine_pass[p].record(gpu, e, &frame)
     };
     let submit = |record: &dyn Fn(&mut wgpu::CommandEncoder) -> Result<(), GpuError>| {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -128,17 +157,17 @@ pub fn measure_upsampling(
         gpu.queue.submit([encoder.finish()]);
         Ok::<(), GpuError>(())
     };
-    let upsample_with = |p: usize, r: f32, geometry: &wgpu::Texture, sz: f32, sn: f32| {
-        submit(&|e| record_upsample(e, p, r, geometry, (sz, sn)))
+    let upsample_with = |p: usize, r: f32, geometry: &wgpu::Texture, sigmas: RangeSigmas| {
+        submit(&|e| record_upsample(e, p, r, geometry, sigmas))
     };
     let fine_with = |p: usize, r: f32| submit(&|e| record_fine(e, p, r));
     let mut rows = Vec::new();
     for r in RESIZE_FACTORS {
         let mut images = Vec::new();
         scene.render(gpu, &lows[0], r)?;
-        upsample_with(0, r, full.geometry(), f32::INFINITY, f32::INFINITY)?;
+        upsample_with(0, r, full.geometry(), RangeSigmas::OFF)?;
         images.push(read_texture_rgba8(gpu, &target)?);
-        upsample_with(0, r, full.geometry(), SIGMA_Z, SIGMA_N)?;
+        upsample_with(0, r, full.geometry(), demo_sigmas())?;
         images.push(read_texture_rgba8(gpu, &target)?);
         // Fine-grained: only the lighting goes through the low-res buffer; the upsample pass
         // multiplies it by the full-res albedo (the frame the timing below measures).
@@ -148,7 +177,7 @@ pub fn measure_upsampling(
         images.push(read_texture_rgba8(gpu, &target)?);
         // The same two from a packed L.
         scene.render(gpu, &lows[1], r)?;
-        upsample_with(1, r, full.geometry(), SIGMA_Z, SIGMA_N)?;
+        upsample_with(1, r, full.geometry(), demo_sigmas())?;
         images.push(read_texture_rgba8(gpu, &target)?);
         scene.render_term(gpu, &lows[1], r, ShadingTerm::Lighting)?;
         fine_with(1, r)?;
@@ -192,7 +221,7 @@ pub fn measure_upsampling(
                 ts.push(time(&|e| {
                     scene.record_term(gpu, e, &prepass, 1.0, albedo_term)?;
                     scene.record_term(gpu, e, low, r, full_term)?;
-                    record_upsample(e, p, r, prepass.geometry(), (SIGMA_Z, SIGMA_N))
+                    record_upsample(e, p, r, prepass.geometry(), demo_sigmas())
                 })?);
                 ts.push(time(&|e| {
                     scene.record_term(gpu, e, &albedo, 1.0, albedo_term)?;
