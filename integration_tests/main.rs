@@ -22,6 +22,7 @@ mod gpu_select_path;
 mod gpu_twins;
 mod harness;
 mod host_errors;
+mod house;
 mod lod_chain;
 mod object_motion;
 mod packed_gbuffer;

@@ -45,22 +45,51 @@ impl ResizeLimits {
     /// assert_eq!(l.apply(2.0, f32::NAN), 2.0);
     /// ```
     pub fn apply(&self, r: f32, wanted: f32) -> f32 {
-        let r_max = if self.r_max.is_nan() {
-            1.0
-        } else {
-            self.r_max.max(1.0)
-        };
-        let r = if r.is_nan() { 1.0 } else { r.clamp(1.0, r_max) };
+        let r = clamp_factor(r, self.r_max);
         if wanted.is_nan() {
-            return r.clamp(1.0, r_max);
+            return r;
         }
         let step = if self.max_step.is_nan() {
             0.0
         } else {
             self.max_step.max(0.0)
         };
-        wanted.clamp(r - step, r + step).clamp(1.0, r_max)
+        clamp_factor(wanted.clamp(r - step, r + step), self.r_max)
     }
+}
+
+/// A resize factor made usable: NaN is 1, and r is kept in [1, `r_max`] (an `r_max` below 1 or
+/// NaN is 1). Every host that takes an r from a user or a controller goes through this one
+/// function (lodkit's `LowResBuffer`, lodkit_bevy's controller).
+///
+/// ```
+/// # use lodkit::framebuffer_lod::clamp_factor;
+/// assert_eq!(clamp_factor(2.5, 4.0), 2.5);
+/// assert_eq!(clamp_factor(0.3, 4.0), 1.0);
+/// assert_eq!(clamp_factor(f32::NAN, 4.0), 1.0);
+/// assert_eq!(clamp_factor(f32::INFINITY, 16.0), 16.0);
+/// ```
+pub fn clamp_factor(r: f32, r_max: f32) -> f32 {
+    let r_max = if r_max.is_nan() { 1.0 } else { r_max.max(1.0) };
+    if r.is_nan() { 1.0 } else { r.clamp(1.0, r_max) }
+}
+
+/// The low-resolution size for a full-resolution `full` size at resize factor `r`: ceil(side /
+/// r) on each side, at least 1 and at most the side; r through [`clamp_factor`] (no upper
+/// bound but the size). The one computation of L's size: lodkit's `LowResBuffer::viewport` and
+/// lodkit_bevy's framebuffer LOD call it.
+///
+/// ```
+/// # use lodkit::framebuffer_lod::low_res_size;
+/// assert_eq!(low_res_size((1920, 1080), 2.0), (960, 540));
+/// assert_eq!(low_res_size((1281, 721), 2.0), (641, 361));
+/// assert_eq!(low_res_size((64, 48), f32::NAN), (64, 48));
+/// assert_eq!(low_res_size((64, 48), 1e9), (1, 1));
+/// ```
+pub fn low_res_size((width, height): (u32, u32), r: f32) -> (u32, u32) {
+    let r = clamp_factor(r, f32::MAX);
+    let side = |s: u32| ((s as f32 / r).ceil() as u32).clamp(1, s.max(1));
+    (side(width), side(height))
 }
 
 /// A resize controller: told each frame's time, answers the r for the next frame.

@@ -9,7 +9,7 @@
 
 use glam::Mat4;
 
-use super::error::{check_color_format, has_usage, target_extent, texture_matches};
+use super::checks::{check_color_format, has_usage, target_extent, texture_matches};
 use super::resources::{
     TextureSet, begin_color_pass, begin_load_pass, begin_targets_pass, fullscreen_pipeline_with,
     new_set, one_group_layout, resize_set, texture_2d, texture_entry, textures_and_uniform,

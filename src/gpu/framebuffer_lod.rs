@@ -2,7 +2,7 @@
 //! full size and rendered through a viewport that shrinks with r (changing r never reallocates),
 //! and the upsample pass as a ready object.
 
-use super::error::{check_format_usages, texture_extent};
+use super::checks::{check_format_usages, texture_extent};
 use super::resources::{TextureSet, begin_targets_pass, new_set, resize_set, texture_2d};
 use super::{GpuContext, GpuError};
 use crate::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT, gbuffer_pack_texel};
@@ -126,12 +126,7 @@ impl LowResBuffer {
     ///
     /// Changing r only changes this viewport; the textures stay.
     pub fn viewport(&self, r: f32) -> (u32, u32) {
-        let r = if r.is_finite() { r.max(1.0) } else { 1.0 };
-        let (w, h) = self.full_size;
-        (
-            ((w as f32 / r).ceil() as u32).clamp(1, w),
-            ((h as f32 / r).ceil() as u32).clamp(1, h),
-        )
+        crate::framebuffer_lod::low_res_size(self.full_size, r)
     }
 
     /// Color texture (of a packed L: the packed texture).

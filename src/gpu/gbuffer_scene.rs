@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::error::{check_low_res_format, same_color_format};
+use super::checks::{check_low_res_format, same_color_format};
 use super::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
 use super::resources::{
     DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, uniform_buffer,

@@ -3,8 +3,8 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+use super::checks::{check_color_format, same_color_format};
 use super::counters::FragmentCounter;
-use super::error::{check_color_format, same_color_format};
 use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
 use super::resources::{
     DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, r32float_texture,

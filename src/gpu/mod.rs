@@ -7,6 +7,7 @@
 //! error scopes, and a lost device is reported by the next call (docs/errors.md).
 
 mod capabilities;
+mod checks;
 mod context;
 pub mod counters;
 mod error;

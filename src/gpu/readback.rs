@@ -2,7 +2,7 @@
 
 use std::sync::{Arc, Mutex, PoisonError};
 
-use super::error::{buffer_size, has_usage};
+use super::checks::{buffer_size, has_usage};
 use super::{GpuContext, GpuError};
 
 /// Reads an RGBA8 (or BGRA8, returned as stored) 2D texture into tightly packed rows.

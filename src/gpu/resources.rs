@@ -3,13 +3,25 @@
 //! that creates a resource checks its sizes and formats against the device and runs inside error
 //! scopes (see [`GpuError`]).
 
-use super::error::{buffer_size, check_format_usages, target_extent, texture_extent};
+use super::checks::{buffer_size, check_format_usages, target_extent, texture_extent};
 use super::{GpuContext, GpuError};
 
 mod draw_uniforms;
 mod params;
 pub use draw_uniforms::DrawUniforms;
 pub use params::RecordedUniform;
+
+/// Vertex buffer layout of the meshes [`mesh_pipeline`] draws (`scene::Mesh`): 24 bytes a
+/// vertex, [`MESH_VERTEX_ATTRIBUTES`].
+pub const MESH_VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: 24,
+    step_mode: wgpu::VertexStepMode::Vertex,
+    attributes: &MESH_VERTEX_ATTRIBUTES,
+};
+
+/// Vertex attributes of those meshes: position at location 0, normal at location 1.
+pub const MESH_VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 2] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
 
 /// A 2D texture with one mip level and one sample (a zero side is taken as 1).
 pub fn texture_2d(
@@ -285,7 +297,7 @@ pub fn mesh_pipeline(
                     module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
-                    buffers: &[Some(super::scene::MESH_VERTEX_LAYOUT)],
+                    buffers: &[Some(MESH_VERTEX_LAYOUT)],
                 },
                 primitive: wgpu::PrimitiveState {
                     cull_mode: Some(wgpu::Face::Back),

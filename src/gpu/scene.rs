@@ -7,8 +7,8 @@ use std::f32::consts::{PI, TAU};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 
+use super::checks::texture_extent;
 use super::counters::FragmentCounter;
-use super::error::texture_extent;
 use super::resources::{
     DrawUniforms, begin_targets_pass, buffer_with_data, camera_draw_layouts, mesh_pipeline,
     r32float_texture, texture_2d, texture_entry, uniform_buffer,
@@ -182,16 +182,9 @@ impl GpuMesh {
     }
 }
 
-/// Vertex buffer layout of [`Mesh`].
-pub const MESH_VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
-    array_stride: 24,
-    step_mode: wgpu::VertexStepMode::Vertex,
-    attributes: &MESH_VERTEX_ATTRIBUTES,
-};
-
-/// Vertex attributes of [`Mesh`]: position at location 0, normal at location 1.
-pub const MESH_VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 2] =
-    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+/// Vertex buffer layout and attributes of [`Mesh`] (position at location 0, normal at 1): the
+/// layout `resources::mesh_pipeline` builds pipelines with.
+pub use super::resources::{MESH_VERTEX_ATTRIBUTES, MESH_VERTEX_LAYOUT};
 
 /// Rust mirror of `Camera` in `passes/lod_mesh.wgsl`.
 #[repr(C)]

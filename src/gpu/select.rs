@@ -34,16 +34,18 @@
 
 mod chunks;
 mod types;
+mod views;
 
 pub use types::{
     GpuLodGroup, GpuLodInstance, GpuLodSelectorDescriptor, GpuSelectCamera, GpuSelectChunk,
     GpuSelectEntry, GpuSelectFrame, LevelMesh, SlotRange,
 };
 
-use chunks::{Chunk, DRAW_BYTES, ENTRY_BYTES, INSTANCE_BYTES, STATE_BYTES};
+use chunks::{Chunk, ENTRY_BYTES, INSTANCE_BYTES};
 
 use super::GpuContext;
-use super::error::{GpuError, buffer_size};
+use super::GpuError;
+use super::checks::buffer_size;
 use crate::select::{LodSettings, distance_kind};
 
 /// A view's selection read back (tests and debugging): per instance its state (packed word,
@@ -373,79 +375,6 @@ impl GpuLodSelector {
         Ok(ViewId(self.views.len() - 1))
     }
 
-    fn make_view(&self, gpu: &GpuContext, call: &'static str) -> Result<View, GpuError> {
-        let rw = wgpu::BufferUsages::STORAGE
-            | wgpu::BufferUsages::COPY_SRC
-            | wgpu::BufferUsages::COPY_DST;
-        let draw_bytes = (self.slots.len().max(1) as u64) * DRAW_BYTES;
-        let draws = create(
-            gpu,
-            call,
-            draw_bytes,
-            rw | wgpu::BufferUsages::INDIRECT,
-            "lodkit select draws",
-        )?;
-        let camera = super::resources::uniform_buffer(
-            gpu,
-            std::mem::size_of::<GpuSelectCamera>(),
-            "lodkit select camera",
-        )?;
-        let mut chunks = Vec::with_capacity(self.chunks.len());
-        for chunk in &self.chunks {
-            let n = chunk.plan.count.max(1) as usize;
-            buffer_size(gpu, call, "states", n as u64 * STATE_BYTES)?;
-            let new_states = vec![[crate::select::LodState::NEW.packed(), 0u32]; n];
-            let states = super::resources::buffer_with_data(
-                gpu,
-                bytemuck::cast_slice(&new_states),
-                rw,
-                "lodkit select states",
-            )?;
-            let entries = create(
-                gpu,
-                call,
-                chunk.plan.entry_bytes,
-                rw,
-                "lodkit select entries",
-            )?;
-            let buffers = [
-                &camera,
-                &self.group_buffer,
-                &chunk.instances,
-                &chunk.slot_first,
-                &states,
-                &draws,
-                &entries,
-                &chunk.info,
-            ];
-            let bind_group = gpu.guarded(call, || {
-                let entries: Vec<wgpu::BindGroupEntry> = buffers
-                    .iter()
-                    .enumerate()
-                    .map(|(k, b)| wgpu::BindGroupEntry {
-                        binding: k as u32,
-                        resource: b.as_entire_binding(),
-                    })
-                    .collect();
-                Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("lodkit select"),
-                    layout: &self.pipeline.get_bind_group_layout(0),
-                    entries: &entries,
-                }))
-            })?;
-            chunks.push(ViewChunk {
-                states,
-                entries,
-                bind_group,
-            });
-        }
-        Ok(View {
-            camera,
-            draws,
-            chunks,
-        })
-    }
-
     /// Records one view's selection for `frame` into `encoder`: the camera upload, the reset of
     /// the counts (a copy of the draw template) and one dispatch per chunk. Nothing is read back.
     pub fn record(
@@ -575,36 +504,6 @@ impl GpuLodSelector {
     /// Instances set.
     pub fn instance_count(&self) -> u32 {
         self.instance_count
-    }
-
-    /// Reads a view's states and lists back (tests and debugging, not the frame loop): the
-    /// states (packed word, progress) of every instance, and each slot's entries over all chunks.
-    pub fn read_back(&self, gpu: &GpuContext, view: ViewId) -> Result<SelectReadback, GpuError> {
-        const CALL: &str = "GpuLodSelector::read_back";
-        let v = self.view(CALL, view)?;
-        let read = |buffer: &wgpu::Buffer, size: u64| {
-            let encoder = gpu.device.create_command_encoder(&Default::default());
-            super::readback::read_buffer(gpu, encoder, buffer, size)
-        };
-        let draws: Vec<u32> = bytemuck::pod_collect_to_vec(&read(&v.draws, v.draws.size())?);
-        let mut states = Vec::with_capacity(self.instance_count as usize);
-        let mut lists = vec![Vec::new(); self.slot_meshes.len()];
-        for (chunk, vc) in self.chunks.iter().zip(&v.chunks) {
-            if chunk.plan.count == 0 {
-                continue;
-            }
-            let bytes = read(&vc.states, u64::from(chunk.plan.count) * STATE_BYTES)?;
-            states.extend(bytemuck::pod_collect_to_vec::<u8, [u32; 2]>(&bytes));
-            let entries: Vec<GpuSelectEntry> =
-                bytemuck::pod_collect_to_vec(&read(&vc.entries, vc.entries.size())?);
-            for range in &chunk.plan.slots {
-                let first = (range.entries_offset / ENTRY_BYTES) as usize;
-                let d = (range.draw_offset / DRAW_BYTES) as usize;
-                let n = (draws[d * 5 + 1] as usize).min(range.capacity as usize);
-                lists[range.slot as usize].extend_from_slice(&entries[first..first + n]);
-            }
-        }
-        Ok(SelectReadback { states, lists })
     }
 }
 

@@ -15,7 +15,7 @@ use super::DemoError;
 use super::clock::Timer;
 use super::frame_cost::Frame;
 use super::plots::{Chart, Series, line_chart};
-use super::report::Table;
+use super::table::Table;
 use lodkit::framebuffer_lod::{
     PaperController, ResizeController, ResizeLimits, RlsController, SimulatedFrame, StepController,
     step_response,

@@ -22,7 +22,7 @@ use serde::Serialize;
 use super::DemoError;
 use super::clock::{Clock, Timer, median};
 use super::plots::{BarChart, Chart, Series, line_chart, stacked_bars};
-use super::report::Table;
+use super::table::Table;
 use super::timing::{pass_descriptor, settings};
 use lodkit::gpu::framebuffer_lod::{LowResBuffer, LowResLayout, UpsampleFrame, UpsamplePass};
 use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};

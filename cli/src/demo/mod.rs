@@ -26,6 +26,8 @@ pub mod report;
 pub mod report_fb;
 pub mod scene;
 pub mod selection;
+pub mod table;
+pub mod technique;
 pub mod timing;
 pub mod transitions;
 pub mod upsampling;

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::plots::{Chart, Series, line_chart};
 use super::reads::Reads;
+use super::table::{Table, esc, img, pct, times};
 use super::upsampling::{
     CONTROLLER_SEEDS, METHODS, ROUTES, SHADING_WORK, SIGMA_N, SIGMA_Z, TARGET_MS,
 };
@@ -16,22 +17,6 @@ fn write(path: &Path, text: &str) -> Result<(), DemoError> {
         std::fs::create_dir_all(dir).map_err(|e| DemoError::io(dir, e))?;
     }
     std::fs::write(path, text).map_err(|e| DemoError::io(path, e))
-}
-
-fn pct(v: f32) -> String {
-    format!("{:.1} %", v * 100.0)
-}
-
-fn times(v: Option<f64>) -> String {
-    v.map_or("n/a".to_owned(), |v| format!("{v:.3}x"))
-}
-
-/// Escapes text for HTML.
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 /// Writes the plots under `out/plots/`.
@@ -138,44 +123,6 @@ pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
             y_from_zero: true,
         },
     )
-}
-
-/// A table of the report, written as Markdown (docs) or HTML (`index.html`).
-pub(super) struct Table {
-    /// Column titles.
-    pub(super) header: &'static [&'static str],
-    /// Cells, row by row.
-    pub(super) rows: Vec<Vec<String>>,
-}
-
-impl Table {
-    pub(super) fn markdown(&self) -> String {
-        let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
-        let header: Vec<String> = self.header.iter().map(|h| h.to_string()).collect();
-        let mut s = line(&header);
-        s.push_str(&line(&vec!["---".to_owned(); header.len()]));
-        for r in &self.rows {
-            s.push_str(&line(r));
-        }
-        s
-    }
-
-    pub(super) fn html(&self) -> String {
-        let mut s = String::from("<table>\n<tr>");
-        for h in self.header {
-            let _ = write!(s, "<th>{}</th>", esc(h));
-        }
-        s.push_str("</tr>\n");
-        for r in &self.rows {
-            s.push_str("<tr>");
-            for cell in r {
-                let _ = write!(s, "<td>{}</td>", esc(cell));
-            }
-            s.push_str("</tr>\n");
-        }
-        s.push_str("</table>\n");
-        s
-    }
 }
 
 /// The transition metrics of `scene`: quality (pop, see-through) or cost.
@@ -462,11 +409,6 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
 /// `lodkit demo --docs`.
 pub const HAND_WRITTEN: &str =
     "<!-- Written by hand from here on; `lodkit demo --docs` keeps this part. -->";
-
-/// An image with its caption, for `index.html`.
-pub(super) fn img(src: &str, alt: &str) -> String {
-    format!("<figure><img src=\"{src}\" alt=\"{alt}\"><figcaption>{alt}</figcaption></figure>\n")
-}
 
 /// Writes `report.json` and `index.html` into `out`.
 pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {

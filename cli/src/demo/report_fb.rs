@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::{DemoError, DemoReport, closed_loop, frame_cost};
 
-use super::report::img as figure;
+use super::table::img as figure;
 
 const BREAKDOWN_TEXT: &str = "Each pass of a frame timed on its own (wall time of submit and wait, median of the rounds): the full-resolution geometry prepass the upsampling needs (depth and normal, with the cheap albedo term), the low-resolution shading pass, and the upsample pass. The fine-grained route shades only the lighting at low resolution; its full-resolution albedo pass writes the geometry, so it is the prepass. Speed-up: the full-resolution frame's time over the sum of the passes.";
 

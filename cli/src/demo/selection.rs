@@ -18,7 +18,7 @@ use serde::Serialize;
 
 use super::DemoError;
 use super::clock::{Clock, Timer};
-use super::report::Table;
+use super::table::Table;
 
 /// Instance counts measured.
 pub const SIZES: [usize; 3] = [10_000, 100_000, 1_000_000];

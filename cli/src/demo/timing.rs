@@ -11,7 +11,6 @@ use serde::Serialize;
 
 use super::clock::{Clock, Timer, interleaved};
 use super::reads::{Reads, Texels};
-use super::upsampling::{SIGMA_N, SIGMA_Z};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
 use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, LowResLayout, RangeSigmas, UpsampleComposite, UpsampleFrame, UpsamplePass,
@@ -93,14 +92,24 @@ pub(super) fn pass_descriptor(layout: LowResLayout, times_albedo: bool) -> Upsam
     }
 }
 
+/// Edge-stopping parameters of the bilateral filter in the demo.
+pub const SIGMA_Z: f32 = 0.25;
+/// See [`SIGMA_Z`].
+pub const SIGMA_N: f32 = 0.4;
+
+/// [`SIGMA_Z`] and [`SIGMA_N`] as the pass takes them.
+pub(super) fn sigmas() -> RangeSigmas {
+    RangeSigmas {
+        depth: SIGMA_Z,
+        normal: SIGMA_N,
+    }
+}
+
 /// The demo's upsampling parameters at resize factor `r`.
 pub(super) fn settings(r: f32) -> UpsampleSettings {
     UpsampleSettings {
         r,
-        sigmas: RangeSigmas {
-            depth: SIGMA_Z,
-            normal: SIGMA_N,
-        },
+        sigmas: sigmas(),
     }
 }
 

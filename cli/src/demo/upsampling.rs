@@ -30,18 +30,8 @@ pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];
 /// shaders). The scene costs little to shade without it.
 pub const SHADING_WORK: u32 = 64;
 
-/// Edge-stopping parameters of the bilateral filter in the demo.
-pub const SIGMA_Z: f32 = 0.25;
-/// See [`SIGMA_Z`].
-pub const SIGMA_N: f32 = 0.4;
-
-/// [`SIGMA_Z`] and [`SIGMA_N`] as the pass takes them.
-fn demo_sigmas() -> RangeSigmas {
-    RangeSigmas {
-        depth: SIGMA_Z,
-        normal: SIGMA_N,
-    }
-}
+use super::timing::sigmas as demo_sigmas;
+pub use super::timing::{SIGMA_N, SIGMA_Z};
 
 /// Quality and speed of one resize factor.
 #[derive(Clone, Debug, Serialize)]

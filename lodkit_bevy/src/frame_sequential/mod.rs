@@ -89,6 +89,7 @@ mod render;
 mod select;
 mod silhouette;
 mod tag;
+mod view;
 
 use bevy::asset::embedded_asset;
 use bevy::camera::Hdr;
@@ -145,8 +146,8 @@ impl Plugin for FrameSequentialLodPlugin {
             .expect("UUID handles never fail to insert");
         app.add_plugins((
             MaterialPlugin::<FrameSequentialMaterial>::default(),
-            ExtractComponentPlugin::<render::FrameSequentialView>::default(),
-            UniformComponentPlugin::<render::CombineParams>::default(),
+            ExtractComponentPlugin::<view::FrameSequentialView>::default(),
+            UniformComponentPlugin::<view::CombineParams>::default(),
         ));
         select::build(app);
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {

@@ -18,22 +18,10 @@ use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::view::ExtractedView;
 
-use super::render::{CombineParams, FrameSequentialView};
+use super::view::{CombineParams, FrameSequentialView};
 
 /// Name of the pass in Bevy's render diagnostics (`render/<name>/...`).
 pub const OLDER_DEPTH_PASS: &str = "lodkit_frame_sequential_older_depth";
-
-/// A level the older-level depth pass draws: the level of a group in transition that this
-/// frame does not draw.
-#[derive(Clone, Debug)]
-pub struct OlderLevel {
-    /// The level's mesh.
-    pub mesh: AssetId<Mesh>,
-    /// The group's world_from_local this frame.
-    pub world_from_local: Mat4,
-    /// The level material's face culling (the pass culls as the main pass does).
-    pub cull_mode: Option<Face>,
-}
 
 /// One draw's uniform.
 #[derive(ShaderType, Clone, Copy)]

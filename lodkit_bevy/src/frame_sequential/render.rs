@@ -25,53 +25,12 @@ use bevy::render::texture::{FallbackImage, GpuImage};
 use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
 use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 
-use super::older_depth::{self, OLDER_DEPTH_PASS, OlderDepthDraws, OlderDepthPipeline, OlderLevel};
+use super::older_depth::{self, OLDER_DEPTH_PASS, OlderDepthDraws, OlderDepthPipeline};
+use super::view::{CombineParams, FrameSequentialView};
 
 /// Name of the combine pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
 /// `render/<name>/elapsed_gpu` and `render/<name>/fragment_shader_invocations`.
 pub const COMBINE_PASS: &str = "lodkit_frame_sequential_combine";
-
-/// What the render world needs of the camera's frame (inserted every frame by the plugin).
-/// When it goes, the render world drops the camera's ping-pong textures, bind group and
-/// pipeline with it.
-#[derive(Component, Clone, Debug)]
-pub struct FrameSequentialView {
-    /// This frame's view_from_world (next frame's reprojection source).
-    pub view_from_world: Mat4,
-    /// This frame's clip_from_view.
-    pub clip_from_view: Mat4,
-    /// This frame's clip space to last frame's (`lodkit::reproject::new_to_old_matrix`).
-    pub new_to_old: Mat4,
-    /// Per t-instance id whose group moved since last frame, the same matrix with the group's
-    /// motion. Without motion vectors its pixels are reprojected with it; with them, the combine
-    /// uses it only to tell where the group moved away from a pixel.
-    pub object_new_to_old: Vec<(u32, Mat4)>,
-    /// Per t-instance drawn this frame with the pattern anchored to the screen: its id and the
-    /// tau at which it is displayed next frame (as its tag carries it).
-    pub drawn_tau_next: Vec<(u32, f32)>,
-    /// Per t-instance whose other level the older buffer holds (drawn last frame, screen
-    /// pattern): its id and the tau at which that level is displayed this frame, this frame's
-    /// threshold for it (complementary to the level drawn now).
-    pub older_tau: Vec<(u32, f32)>,
-    /// The levels this frame does not draw of the groups in transition, for the older-level
-    /// depth pass (empty unless the coverage is exact; levels with a silhouette are not here).
-    pub older_levels: Vec<OlderLevel>,
-    /// Per t-instance whose older level's silhouette is known (`OlderCoverage::Silhouette`):
-    /// its id and the silhouette's segments in pixels; the depth pass does not draw it.
-    pub silhouettes: Vec<(u32, Vec<[f32; 4]>)>,
-    /// Whether the coverage is exact (`FrameSequentialLod::coverage` is not `Estimated`): the
-    /// combine reads the silhouettes and the older-level depth pass, which then runs.
-    pub exact_coverage: bool,
-    /// Whether the combine reads Bevy's motion vectors (the camera has `MotionVectorPrepass`).
-    pub motion_vectors: bool,
-    /// The combine's rectangles (pixels, top left origin), not overlapping.
-    pub rects: Vec<URect>,
-    /// Whether this frame is kept (its color and depth copied) as the next frame's older one.
-    pub keep: bool,
-    /// Which copy of the pair this frame writes (`TransitionScheduler::buffer_index`); the
-    /// other holds the older frame.
-    pub buffer: usize,
-}
 
 impl SyncComponent<RenderApp> for FrameSequentialView {
     type Target = (
@@ -100,22 +59,6 @@ impl ExtractComponent<RenderApp> for FrameSequentialView {
             ),
         };
         Some((view.clone(), params))
-    }
-}
-
-/// The uniform of combine.wesl (one dynamic-offset slot per camera, written by Bevy's
-/// `UniformComponentPlugin`).
-#[derive(Component, ShaderType, Clone, Copy, Debug)]
-pub struct CombineParams {
-    new_to_old: Mat4,
-    flags: UVec4,
-}
-
-impl CombineParams {
-    /// Whether the combine reads the older-level depth pass this frame (exact coverage, and
-    /// every older level drawn).
-    pub(super) fn set_exact_coverage(&mut self, on: bool) {
-        self.flags.y = u32::from(on);
     }
 }
 

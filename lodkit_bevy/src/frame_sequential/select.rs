@@ -18,11 +18,10 @@ use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection, LodState};
 
-use super::older_depth::OlderLevel;
 use super::rects::{Bounds, group_rect, level_bounds, to_lodkit};
-use super::render::FrameSequentialView;
 use super::silhouette::{Surfaces, forget_changed_meshes};
 use super::tag::{decode_tag, encode_tag};
+use super::view::{FrameSequentialView, OlderLevel};
 use super::{
     FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, OlderCoverage,
     VisibilitySpace,

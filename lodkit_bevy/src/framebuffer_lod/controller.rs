@@ -4,61 +4,17 @@
 use std::time::Duration;
 
 use bevy::prelude::*;
-use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController};
+use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController, clamp_factor};
 
-use super::timer::GpuFrameTimes;
-use super::{
+use super::settings::{
     FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodFrameTimes,
-    FramebufferLodResolution, FramerateTarget, MAX_FACTOR,
+    FramebufferLodResolution, FramebufferLodState, FramerateTarget, MAX_FACTOR,
 };
-
-/// What framebuffer LOD is doing on a camera (added with [`FramebufferLod`], updated every frame
-/// in `Last`; read it, don't write it).
-#[derive(Component, Clone, Debug)]
-pub struct FramebufferLodState {
-    /// The resize factor r the next frame renders the effect at.
-    pub factor: f32,
-    /// The camera's last measured frame time (`None` before the first measurement): its GPU time
-    /// where the device has timestamp queries (unless the target asks for
-    /// [`FrameTimeSource::WallClock`]), else the real time between frames. With an adaptive
-    /// resolution this is what the controller was given.
-    pub frame_time: Option<Duration>,
-    /// The r that frame time was rendered at.
-    pub measured_factor: f32,
-    /// Where that frame time came from: [`FrameTimeSource::GpuTimestamps`],
-    /// [`FrameTimeSource::WallClock`] or [`FrameTimeSource::Provided`].
-    pub measured_with: Option<FrameTimeSource>,
-    /// The controller's estimates (K, C) of eq. 3, t = K / r^2 + C, in seconds (adaptive only).
-    pub estimates: Option<(f32, f32)>,
-    /// Whether the render world writes timestamps for this camera.
-    pub(super) gpu_timed: bool,
-    controller: Option<(FramerateTarget, RlsController)>,
-    /// The last three (r, seconds) measurements (NaN before there are three).
-    recent: [(f32, f32); 3],
-}
-
-impl Default for FramebufferLodState {
-    fn default() -> Self {
-        Self {
-            factor: 1.0,
-            frame_time: None,
-            measured_factor: 1.0,
-            measured_with: None,
-            estimates: None,
-            gpu_timed: false,
-            controller: None,
-            recent: [(f32::NAN, f32::NAN); 3],
-        }
-    }
-}
+use super::timer::GpuFrameTimes;
 
 /// The limits of `target` made valid: r_max in [1, MAX_FACTOR], a finite non-negative step.
 fn limits(target: &FramerateTarget) -> ResizeLimits {
-    let r_max = if target.max_factor.is_nan() {
-        1.0
-    } else {
-        target.max_factor.clamp(1.0, MAX_FACTOR)
-    };
+    let r_max = clamp_factor(target.max_factor, MAX_FACTOR);
     let max_step = if target.max_step.is_finite() {
         target.max_step.max(0.0)
     } else {
@@ -123,11 +79,7 @@ pub(super) fn update_resolution(
         }
         let Some(target) = target else {
             if let FramebufferLodResolution::Fixed(r) = settings.resolution {
-                state.factor = if r.is_nan() {
-                    1.0
-                } else {
-                    r.clamp(1.0, MAX_FACTOR)
-                };
+                state.factor = clamp_factor(r, MAX_FACTOR);
             }
             state.controller = None;
             state.estimates = None;

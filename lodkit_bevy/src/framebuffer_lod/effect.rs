@@ -22,7 +22,8 @@ use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 use bevy::shader::{ShaderDefVal, ShaderRef};
 
 use super::FramebufferLodPlugin;
-use super::render::{LOW_FORMAT, effect_view_layout};
+use super::layout::effect_view_layout;
+use super::settings::LOW_FORMAT;
 
 /// The bind group index of a [`FramebufferLodEffect`]'s own bindings. Group 0 holds what
 /// `lodkit_bevy::framebuffer_lod` declares (view, globals, prepass, settings).

@@ -14,21 +14,22 @@ use bevy::log::warn_once;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RecordDiagnostics;
 use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex, ExtractComponent};
-use bevy::render::globals::{GlobalsBuffer, GlobalsUniform};
-use bevy::render::render_resource::binding_types::{texture_2d, texture_depth_2d, uniform_buffer};
+use bevy::render::globals::GlobalsBuffer;
+use bevy::render::render_resource::binding_types::texture_2d;
 use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::sync_component::SyncComponent;
-use bevy::render::view::{ExtractedView, ViewTarget, ViewUniform, ViewUniformOffset, ViewUniforms};
+use bevy::render::view::{ExtractedView, ViewTarget, ViewUniformOffset, ViewUniforms};
 use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 
-use super::controller::FramebufferLodState;
 use super::effect::{EffectBinding, FRAMEBUFFER_LOD_EFFECT_BIND_GROUP_INDEX};
+use super::layout::{FramebufferLodUniform, common_entries, effect_view_layout};
+use super::settings::{
+    ExtractedFramebufferLod, FramebufferLod, FramebufferLodComposite, FramebufferLodState,
+    LOW_FORMAT,
+};
 use super::timer::{self, GpuFrameTimer};
-use super::{FramebufferLod, FramebufferLodComposite};
 
-/// Format of the low-resolution color and geometry targets (lodkit::gbuffer's geometry layout).
-pub(super) const LOW_FORMAT: TextureFormat = TextureFormat::Rgba16Float;
 /// View depth given to the sky: far beyond any scene, inside half-float range.
 const SKY_DEPTH: f32 = 60_000.0;
 /// Name of the effect pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
@@ -37,33 +38,6 @@ const SKY_DEPTH: f32 = 60_000.0;
 pub const EFFECT_PASS: &str = "lodkit_framebuffer_lod_effect";
 /// Name of the upsample pass in Bevy's render diagnostics (as [`EFFECT_PASS`]).
 pub const UPSAMPLE_PASS: &str = "lodkit_framebuffer_lod_upsample";
-
-/// What the render world keeps of a camera's [`FramebufferLod`].
-#[derive(Component, Clone, Debug)]
-pub struct ExtractedFramebufferLod {
-    composite: FramebufferLodComposite,
-    /// r this frame.
-    pub(super) factor: f32,
-    /// Whether the camera's GPU time is measured (adaptive r on GPU timestamps).
-    pub(super) gpu_timed: bool,
-    /// The low-resolution viewport this frame: ceil(main-pass viewport / r).
-    low_size: UVec2,
-    /// The camera's main-pass viewport in its render target: top-left corner and size.
-    origin: UVec2,
-    full_size: UVec2,
-}
-
-/// The settings the shaders read (`FramebufferLodSettings` in framebuffer_lod.wesl).
-#[derive(Component, ShaderType, Clone, Copy, Debug)]
-pub struct FramebufferLodUniform {
-    low_size: Vec2,
-    full_size: Vec2,
-    origin: Vec2,
-    factor: f32,
-    depth_sigma: f32,
-    normal_sigma: f32,
-    sky_depth: f32,
-}
 
 impl SyncComponent<RenderApp> for FramebufferLod {
     type Target = (
@@ -102,7 +76,9 @@ impl ExtractComponent<RenderApp> for FramebufferLod {
         // The sizes are the render world's (prepare_viewports): a MainPassResolutionOverride
         // lives there.
         camera.physical_viewport_size()?;
-        let factor = state.factor.clamp(1.0, super::MAX_FACTOR);
+        // The controller keeps the factor in [1, MAX_FACTOR] (clamp_factor), the one place r is
+        // clamped.
+        let factor = state.factor;
         let (depth_sigma, normal_sigma) = settings.upsample.sigmas();
         Some((
             ExtractedFramebufferLod {
@@ -172,10 +148,9 @@ fn prepare_viewports(
         let size = resolution_override
             .map_or(viewport.zw(), |o| o.0.min(viewport.zw()))
             .max(UVec2::ONE);
-        let low = (size.as_vec2() / uniform.factor)
-            .ceil()
-            .as_uvec2()
-            .clamp(UVec2::ONE, size);
+        // lodkit's one computation of L's size: ceil(size / r), at least 1.
+        let (w, h) = lodkit::framebuffer_lod::low_res_size((size.x, size.y), uniform.factor);
+        let low = UVec2::new(w, h);
         extracted.origin = viewport.xy();
         extracted.full_size = size;
         extracted.low_size = low;
@@ -183,27 +158,6 @@ fn prepare_viewports(
         uniform.full_size = size.as_vec2();
         uniform.low_size = low.as_vec2();
     }
-}
-
-/// The bindings `lodkit_bevy::framebuffer_lod` declares in group 0: view, globals, depth and
-/// normal prepass, settings.
-fn common_entries() -> [BindGroupLayoutEntryBuilder; 5] {
-    [
-        uniform_buffer::<ViewUniform>(true),
-        uniform_buffer::<GlobalsUniform>(false),
-        texture_depth_2d(),
-        texture_2d(TextureSampleType::Float { filterable: true }),
-        uniform_buffer::<FramebufferLodUniform>(true),
-    ]
-}
-
-/// Group 0 of the effect pass (the effect's own bindings are group 1).
-pub(super) fn effect_view_layout() -> BindGroupLayoutDescriptor {
-    let [a, b, c, d, e] = common_entries();
-    BindGroupLayoutDescriptor::new(
-        "lodkit_framebuffer_lod_effect",
-        &BindGroupLayoutEntries::sequential(ShaderStages::FRAGMENT, (a, b, c, d, e)),
-    )
 }
 
 /// Bind group layouts and shader of the upsample pass, and the effect pass's group 0.

@@ -17,7 +17,7 @@ use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery
 use bevy::render::sync_world::MainEntity;
 use bevy::render::{Render, RenderSystems};
 
-use super::render::ExtractedFramebufferLod;
+use super::settings::ExtractedFramebufferLod;
 
 /// Readback buffers per camera: enough for a frame or two of latency.
 const SLOTS: usize = 4;

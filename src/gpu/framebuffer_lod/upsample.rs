@@ -4,7 +4,7 @@
 
 use super::LowResBuffer;
 use crate::gbuffer::GEOMETRY_FORMAT;
-use crate::gpu::error::{check_color_format, texture_matches};
+use crate::gpu::checks::{check_color_format, texture_matches};
 use crate::gpu::resources::{
     RecordedUniform, begin_color_pass, fullscreen_pipeline, textures_and_uniform,
 };

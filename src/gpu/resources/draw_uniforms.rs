@@ -3,7 +3,7 @@
 use bytemuck::Pod;
 
 use super::uniform_buffer;
-use crate::gpu::error::buffer_size;
+use crate::gpu::checks::buffer_size;
 use crate::gpu::{GpuContext, GpuError};
 
 /// Per-draw uniforms in one buffer, one aligned slot per draw, bound with a dynamic offset.

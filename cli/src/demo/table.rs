@@ -1,0 +1,65 @@
+//! The report's building blocks: tables written as Markdown (docs) or HTML (`index.html`),
+//! figures and HTML escaping.
+
+use std::fmt::Write as _;
+
+/// Escapes text for HTML.
+pub(super) fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A share as a percentage with one decimal.
+pub(super) fn pct(v: f32) -> String {
+    format!("{:.1} %", v * 100.0)
+}
+
+/// A ratio with three decimals, `n/a` where there is none.
+pub(super) fn times(v: Option<f64>) -> String {
+    v.map_or("n/a".to_owned(), |v| format!("{v:.3}x"))
+}
+
+/// An image with its caption, for `index.html`.
+pub(super) fn img(src: &str, alt: &str) -> String {
+    format!("<figure><img src=\"{src}\" alt=\"{alt}\"><figcaption>{alt}</figcaption></figure>\n")
+}
+
+/// A table of the report, written as Markdown (docs) or HTML (`index.html`).
+pub(super) struct Table {
+    /// Column titles.
+    pub(super) header: &'static [&'static str],
+    /// Cells, row by row.
+    pub(super) rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    pub(super) fn markdown(&self) -> String {
+        let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
+        let header: Vec<String> = self.header.iter().map(|h| h.to_string()).collect();
+        let mut s = line(&header);
+        s.push_str(&line(&vec!["---".to_owned(); header.len()]));
+        for r in &self.rows {
+            s.push_str(&line(r));
+        }
+        s
+    }
+
+    pub(super) fn html(&self) -> String {
+        let mut s = String::from("<table>\n<tr>");
+        for h in self.header {
+            let _ = write!(s, "<th>{}</th>", esc(h));
+        }
+        s.push_str("</tr>\n");
+        for r in &self.rows {
+            s.push_str("<tr>");
+            for cell in r {
+                let _ = write!(s, "<td>{}</td>", esc(cell));
+            }
+            s.push_str("</tr>\n");
+        }
+        s.push_str("</table>\n");
+        s
+    }
+}
