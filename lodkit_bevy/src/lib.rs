@@ -36,6 +36,8 @@
 
 pub mod frame_sequential;
 pub mod framebuffer_lod;
+#[cfg(feature = "lod_chain")]
+pub mod lod_chain;
 mod shaders;
 
 pub use frame_sequential::{FrameSequentialLod, FrameSequentialLodPlugin};

@@ -61,7 +61,7 @@ pub struct Args {
 
 const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] [--frames DIR] \
 [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection] \
-[--coverage estimated|silhouette|depth-pass] [--without-prepass-only]";
+[--coverage estimated|silhouette|depth-pass] [--without-prepass-only] [--chain]";
 
 fn parse() -> Result<Option<Args>, String> {
     let mut args = Args {
@@ -98,6 +98,7 @@ fn parse() -> Result<Option<Args>, String> {
                 }
             }
             "--no-reprojection" => args.reprojection = false,
+            "--chain" => scene::use_chain(),
             "--coverage" => {
                 args.coverage = match value()?.as_str() {
                     "estimated" => OlderCoverage::Estimated,

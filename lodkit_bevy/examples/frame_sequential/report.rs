@@ -257,6 +257,30 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     if let Some(dir) = &args.frames {
         report.insert("frames_dir".into(), dir.display().to_string().into());
     }
+    // With --chain, the moving group's levels as lodkit's LOD chain built them.
+    if crate::scene::groups()[2].from_chain {
+        let chain = crate::scene::chain().chain();
+        let distances = crate::scene::chain()
+            .lod_group(&crate::scene::chain_camera())
+            .map_err(|e| Failure(1, format!("the chain's group: {e}")))?;
+        let levels: Vec<Value> = chain
+            .levels()
+            .iter()
+            .zip(distances.levels())
+            .map(|(level, lod)| {
+                serde_json::json!({
+                    "triangles": level.triangles(),
+                    "error": level.error(),
+                    "distance": lod.distance * crate::scene::p11(),
+                })
+            })
+            .collect();
+        report.insert("chain_levels".into(), levels.into());
+        report.insert(
+            "chain_pixel_error".into(),
+            crate::scene::CHAIN_PIXEL_ERROR.into(),
+        );
+    }
     let stats = h.app().world().resource::<FrameSequentialStats>().clone();
     report.insert("frames_scheduled".into(), stats.frames.into());
     report.insert("frames_kept".into(), stats.frames_kept.into());

@@ -25,7 +25,7 @@ use crate::scene::{
 };
 
 pub const WIDTH: u32 = 320;
-pub const HEIGHT: u32 = 192;
+pub const HEIGHT: u32 = crate::scene::HEIGHT;
 pub const BACKGROUND: Color = Color::srgb(0.08, 0.09, 0.12);
 /// Updates to wait for the last readbacks of a run.
 const DRAIN_UPDATES: usize = 12;

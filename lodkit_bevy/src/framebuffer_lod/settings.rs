@@ -165,7 +165,8 @@ pub enum FrameTimeSource {
     WallClock,
     /// The app's own measurements: each frame the controller takes what the app pushed into the
     /// camera's [`FramebufferLodFrameTimes`] (an engine's profiler, a frame-time model in a
-    /// test). Push before [`FramebufferLodSystems::Control`] in `Last`.
+    /// test). Push before
+    /// [`FramebufferLodSystems::Control`](super::FramebufferLodSystems::Control) in `Last`.
     Provided,
 }
 
