@@ -10,6 +10,7 @@ mod ci_formats;
 mod cli;
 mod combine_regions;
 mod demo;
+mod demo_chain;
 mod docs_figures;
 mod engine_tree;
 mod fast_path;

@@ -1,7 +1,7 @@
 //! An upper bound of the two-sided Hausdorff distance between two triangle meshes.
 //!
-//! Two bounds of `sup f` over a piece `Q` of a source triangle, where `f(x) = d(x, S)` is the
-//! distance to the target surface:
+//! Three bounds of `sup f` over a piece `Q` of a source triangle, where `f(x) = d(x, T)` is the
+//! distance to the target surface `T`:
 //!
 //! - **Lipschitz**: `f` is 1-Lipschitz, and `Q`'s three corners cover it within `r` (its
 //!   circumradius when acute, half its longest side otherwise; both at most `longest / sqrt(3)`,
@@ -10,15 +10,23 @@
 //!   (the distance to a convex set), so over the triangle `Q` its maximum is at a corner:
 //!   `sup_Q f <= max d(corner, t)`. The candidates `t` are the triangles nearest to `Q`'s
 //!   corners and centroid.
+//! - **Partition** ([`partition`]): `Q` cut into convex pieces along the outlines of the target
+//!   triangles under it, each piece bounded by the convex bound of the triangle over it.
 //!
 //! [`directed_bound`] evaluates `f` at every vertex of the source (the largest value found, `lb`,
-//! is a lower bound of the supremum), then refines each triangle: a piece whose smaller bound is
-//! within the tolerance of `lb` is done; any other is cut, along the plane through the edge two
-//! neighbouring candidates share (where the nearest triangle changes), or else at its edge
-//! midpoints, and `f` is evaluated at the new corners. The result is the largest bound over the
-//! accepted pieces: an upper bound whatever the cuts, at most `lb + tolerance` above the largest
-//! distance found unless a piece reaches the depth limit (then still an upper bound, only a
-//! looser one). Distances are computed in f64 from the f32 positions; the caller rounds up.
+//! is a lower bound of the supremum), then bounds every source triangle with the cheapest of
+//! these that is within the tolerance of `lb`: Lipschitz and convex first, then the partition
+//! among the nearest triangles of its corners, then the partition among every target triangle
+//! near it. The triangles still above the tolerance are looked at again, largest bound first:
+//! `f` at the point where the bound is reached often raises `lb` to it; the rest are refined
+//! ([`refine`]: cut at the edge midpoints, each piece bounded again). The result is the largest
+//! bound over all triangles: an upper bound whatever the cuts and candidates, which only decide
+//! how tight it is (at most `lb + tolerance` above the largest distance found unless a piece
+//! reaches the depth limit; then still an upper bound, only a looser one). Distances are
+//! computed in f64 from the f32 positions; the caller rounds up.
+
+mod partition;
+mod refine;
 
 use glam::DVec3;
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
@@ -28,16 +36,16 @@ struct Tri {
     a: DVec3,
     b: DVec3,
     c: DVec3,
-    /// Its vertex indices (neighbours share two).
-    ids: [u32; 3],
-    /// Unit normal (zero when degenerate).
-    normal: DVec3,
     envelope: AABB<[f64; 3]>,
 }
 
 impl Tri {
     fn distance(&self, p: DVec3) -> f64 {
-        point_triangle_distance2(p, self.a, self.b, self.c).sqrt()
+        self.distance2(p).sqrt()
+    }
+
+    fn distance2(&self, p: DVec3) -> f64 {
+        point_triangle_distance2(p, self.a, self.b, self.c)
     }
 }
 
@@ -51,6 +59,15 @@ impl RTreeObject for Tri {
 impl PointDistance for Tri {
     fn distance_2(&self, point: &[f64; 3]) -> f64 {
         point_triangle_distance2(DVec3::from_array(*point), self.a, self.b, self.c)
+    }
+
+    /// The box's distance first: most triangles a search visits are farther than that already.
+    fn distance_2_if_less_or_equal(&self, point: &[f64; 3], max_distance_2: f64) -> Option<f64> {
+        if self.envelope.distance_2(point) > max_distance_2 {
+            return None;
+        }
+        let d = self.distance_2(point);
+        (d <= max_distance_2).then_some(d)
     }
 }
 
@@ -88,6 +105,8 @@ pub(crate) fn point_triangle_distance2(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -
 /// A triangle mesh to measure distances to.
 pub(crate) struct Surface {
     tree: RTree<Tri>,
+    /// Which vertices the triangles use (`d = 0` there).
+    vertices: Vec<bool>,
 }
 
 impl Surface {
@@ -103,15 +122,40 @@ impl Surface {
                     a,
                     b,
                     c,
-                    ids: [t[0], t[1], t[2]],
-                    normal: (b - a).cross(c - a).normalize_or_zero(),
                     envelope: AABB::from_corners(lo.to_array(), hi.to_array()),
                 }
             })
             .collect();
+        let mut vertices = vec![false; positions.len()];
+        for &i in indices {
+            vertices[i as usize] = true;
+        }
         Surface {
             tree: RTree::bulk_load(tris),
+            vertices,
         }
+    }
+
+    /// Whether a triangle of the surface has vertex `v` of the shared positions.
+    fn has_vertex(&self, v: u32) -> bool {
+        self.vertices.get(v as usize).copied().unwrap_or(false)
+    }
+
+    /// The triangles whose bounding boxes meet the box of the triangle `s` moved by up to
+    /// `margin` along its normal either way (the target triangles within `margin` of `s`'s
+    /// plane that are over or under it), in no order.
+    fn candidates(&self, s: &[DVec3; 3], margin: f64) -> Vec<&Tri> {
+        let n = (s[1] - s[0]).cross(s[2] - s[0]).normalize_or_zero();
+        let grow = if n == DVec3::ZERO {
+            DVec3::splat(margin)
+        } else {
+            n.abs() * margin
+        } + DVec3::splat(longest_side(s) * 1e-9);
+        let lo = s[0].min(s[1]).min(s[2]) - grow;
+        let hi = s[0].max(s[1]).max(s[2]) + grow;
+        self.tree
+            .locate_in_envelope_intersecting(&AABB::from_corners(lo.to_array(), hi.to_array()))
+            .collect()
     }
 
     /// Distance from `p` to the surface and the nearest triangle (+inf and `None` for an empty
@@ -150,15 +194,17 @@ pub(crate) struct Tolerance {
 }
 
 impl Tolerance {
-    fn slack(&self, lb: f64) -> f64 {
+    pub(crate) fn slack(&self, lb: f64) -> f64 {
         (self.relative * lb).max(self.absolute)
     }
 }
 
-/// Deepest cut of one source triangle.
-const MAX_DEPTH: u32 = 12;
+/// The smallest margin around a source triangle, relative to its longest side, within which
+/// target triangles are candidates for its partition.
+const MARGIN: f64 = 0.05;
 
-/// Upper bound of `sup_{x in source} d(x, target)` over the triangles `indices` of `positions`.
+/// Upper bound of `sup_{x in source} d(x, target)` over the triangles `indices` of `positions`
+/// (which the target indexes too).
 pub(crate) fn directed_bound(
     positions: &[[f32; 3]],
     indices: &[u32],
@@ -166,160 +212,128 @@ pub(crate) fn directed_bound(
     tolerance: Tolerance,
 ) -> f64 {
     let p = |i: u32| DVec3::from(positions[i as usize].map(f64::from));
-    // f at every vertex the source uses.
+    // f at every vertex the source uses (with the nearest triangle): zero at the target's own
+    // vertices.
     let mut used: Vec<u32> = indices.to_vec();
     used.sort_unstable();
     used.dedup();
-    let samples = parallel_map(&used, |&v| target.nearest(p(v)));
-    let mut at_vertex = vec![None; positions.len()];
-    for (&v, s) in used.iter().zip(&samples) {
-        at_vertex[v as usize] = Some(*s);
+    let samples = parallel_map(&used, |&v| {
+        if target.has_vertex(v) {
+            (0.0, None)
+        } else {
+            let s = target.nearest(p(v));
+            (s.distance, s.nearest)
+        }
+    });
+    let mut at_vertex = vec![(0.0, None); positions.len()];
+    for (&v, &s) in used.iter().zip(&samples) {
+        at_vertex[v as usize] = s;
     }
     let triangles: Vec<[u32; 3]> = indices
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
         .collect();
-    // f at every centroid too: with the vertices, a lower bound close to the supremum before
-    // any piece is refined (refining against a small early `lb` would split pieces far finer
-    // than the tolerance of the final result needs).
+    // f at the centroid of every triangle whose corners are all on the target (no nearest
+    // triangle to start from): with the vertices, a lower bound close to the supremum before
+    // any triangle is bounded.
     let centres = parallel_map(&triangles, |t| {
-        target.nearest((p(t[0]) + p(t[1]) + p(t[2])) / 3.0)
+        t.iter()
+            .all(|&v| at_vertex[v as usize].1.is_none())
+            .then(|| target.nearest((p(t[0]) + p(t[1]) + p(t[2])) / 3.0))
     });
-    let lb = samples
+    let mut lb = samples
         .iter()
-        .chain(&centres)
-        .map(|s| s.distance)
+        .map(|s| s.0)
+        .chain(centres.iter().flatten().map(|s| s.distance))
         .fold(0.0, f64::max);
-    let work: Vec<([u32; 3], Sample)> = triangles.into_iter().zip(centres).collect();
-    let bounds = parallel_map(&work, |(t, centre)| {
-        let mut lb = lb;
-        let corners = t.map(|v| at_vertex[v as usize].expect("every used vertex was sampled"));
-        refine(target, corners, Some(*centre), 0, &mut lb, tolerance)
+    // Every triangle's bound: the cheap ones where they are within the tolerance already, the
+    // partition among the nearest triangles of its corners (or centroid) where not, and among
+    // all the target triangles near it where that is not enough.
+    let work: Vec<([u32; 3], Option<Sample>)> = triangles.iter().copied().zip(centres).collect();
+    let accept = lb + tolerance.slack(lb);
+    let first = parallel_map(&work, |(t, centre)| {
+        let corners = t.map(p);
+        let f = t.map(|v| at_vertex[v as usize].0);
+        let mut near: Vec<&Tri> = Vec::with_capacity(3);
+        for n in t
+            .iter()
+            .filter_map(|&v| at_vertex[v as usize].1)
+            .chain(centre.and_then(|c| c.nearest))
+        {
+            if !near.iter().any(|&m| std::ptr::eq(m, n)) {
+                near.push(n);
+            }
+        }
+        let longest = longest_side(&corners);
+        let lipschitz = f[0].max(f[1]).max(f[2]) + longest / 3f64.sqrt();
+        let convex = near
+            .iter()
+            .map(|n| corners.iter().map(|&x| n.distance(x)).fold(0.0, f64::max))
+            .fold(f64::INFINITY, f64::min);
+        let mut best = (lipschitz.min(convex), None);
+        if best.0 <= accept {
+            return best;
+        }
+        if near.len() > 1
+            && let Some(b) = partition::partition_bound(corners, &near)
+            && b.bound < best.0
+        {
+            best = (b.bound, Some(b.at));
+            if b.bound <= accept {
+                return best;
+            }
+        }
+        let local = f[0]
+            .max(f[1])
+            .max(f[2])
+            .max(centre.map_or(0.0, |c| c.distance));
+        let candidates = target.candidates(&corners, 2.0 * local + MARGIN * longest);
+        match partition::partition_bound(corners, &candidates) {
+            Some(b) if b.bound < best.0 => (b.bound, Some(b.at)),
+            _ => best,
+        }
     });
-    bounds.into_iter().fold(lb, f64::max)
+    // Branch and bound: only a triangle whose bound is above the tolerance of the largest
+    // distance found so far is looked at again, largest first.
+    let mut reported = lb;
+    let mut open: Vec<usize> = Vec::new();
+    for (k, &(bound, _)) in first.iter().enumerate() {
+        if bound <= accept {
+            reported = reported.max(bound);
+        } else {
+            open.push(k);
+        }
+    }
+    open.sort_unstable_by(|&a, &b| first[b].0.total_cmp(&first[a].0));
+    for k in open {
+        let (bound, at) = first[k];
+        if bound <= lb + tolerance.slack(lb) {
+            // Every triangle after this one is bounded lower still.
+            reported = reported.max(bound);
+            break;
+        }
+        if let Some(at) = at {
+            // The distance where the bound is reached is often the bound itself.
+            lb = lb.max(target.nearest(at).distance);
+            if bound <= lb + tolerance.slack(lb) {
+                reported = reported.max(bound);
+                continue;
+            }
+        }
+        let corners = triangles[k].map(|v| target.nearest(p(v)));
+        let refined = refine::refine(target, corners, 0, &mut lb, tolerance);
+        reported = reported.max(refined.min(bound));
+    }
+    reported.max(lb)
 }
 
-/// The bound over the triangle piece with corners `c`.
-fn refine<'a>(
-    target: &'a Surface,
-    c: [Sample<'a>; 3],
-    centre: Option<Sample<'a>>,
-    depth: u32,
-    lb: &mut f64,
-    tolerance: Tolerance,
-) -> f64 {
-    let p = c.map(|s| s.at);
-    let longest = (p[1] - p[0])
+/// Length of the longest side of a triangle.
+fn longest_side(p: &[DVec3; 3]) -> f64 {
+    (p[1] - p[0])
         .length_squared()
         .max((p[2] - p[1]).length_squared())
         .max((p[0] - p[2]).length_squared())
-        .sqrt();
-    let lipschitz = c[0].distance.max(c[1].distance).max(c[2].distance) + longest / 3f64.sqrt();
-    // The centroid's nearest triangle is often the one whose prism holds the whole piece.
-    let centre = centre.unwrap_or_else(|| target.nearest((p[0] + p[1] + p[2]) / 3.0));
-    *lb = lb.max(centre.distance);
-    let convex = c
-        .iter()
-        .chain([&centre])
-        .filter_map(|s| s.nearest)
-        .map(|t| p.iter().map(|&x| t.distance(x)).fold(0.0, f64::max))
-        .fold(f64::INFINITY, f64::min);
-    let bound = lipschitz.min(convex);
-    if bound <= *lb + tolerance.slack(*lb) || depth >= MAX_DEPTH {
-        return bound;
-    }
-    // Plane cuts do not shorten the longest side: every other cut is at the midpoints.
-    let plane = if depth.is_multiple_of(2) {
-        cut_between_neighbours(&c)
-    } else {
-        None
-    };
-    let pieces = plane.unwrap_or_else(|| midpoint_pieces(&p));
-    pieces
-        .into_iter()
-        .map(|piece| {
-            let corners = piece.map(|x| corner(target, &c, x, lb));
-            refine(target, corners, None, depth + 1, lb, tolerance)
-        })
-        .fold(0.0, f64::max)
-}
-
-/// The sample at `x`: a parent corner's when `x` is one, else a new evaluation (raising `lb`).
-fn corner<'a>(target: &'a Surface, parent: &[Sample<'a>; 3], x: DVec3, lb: &mut f64) -> Sample<'a> {
-    if let Some(s) = parent.iter().find(|s| s.at == x) {
-        return *s;
-    }
-    let s = target.nearest(x);
-    *lb = lb.max(s.distance);
-    s
-}
-
-/// The four pieces of a triangle cut at its edge midpoints.
-fn midpoint_pieces(p: &[DVec3; 3]) -> Vec<[DVec3; 3]> {
-    let m = [
-        (p[0] + p[1]) * 0.5,
-        (p[1] + p[2]) * 0.5,
-        (p[2] + p[0]) * 0.5,
-    ];
-    vec![
-        [p[0], m[0], m[2]],
-        [m[0], p[1], m[1]],
-        [m[2], m[1], p[2]],
-        [m[0], m[1], m[2]],
-    ]
-}
-
-/// Where two corners' nearest target triangles share an edge, the triangle cut by the plane
-/// through that edge halfway between their normals (the nearest triangle changes about there);
-/// `None` when no two share an edge or the plane misses the triangle.
-fn cut_between_neighbours(c: &[Sample; 3]) -> Option<Vec<[DVec3; 3]>> {
-    let tris: Vec<&Tri> = c.iter().filter_map(|s| s.nearest).collect();
-    for (i, a) in tris.iter().enumerate() {
-        for b in &tris[i + 1..] {
-            let shared: Vec<u32> = a.ids.into_iter().filter(|v| b.ids.contains(v)).collect();
-            if shared.len() != 2 {
-                continue;
-            }
-            let at_id = |id: u32| {
-                let k = a.ids.iter().position(|&v| v == id).expect("shared");
-                [a.a, a.b, a.c][k]
-            };
-            let (e0, e1) = (at_id(shared[0]), at_id(shared[1]));
-            let mean = if a.normal.dot(b.normal) >= 0.0 {
-                a.normal + b.normal
-            } else {
-                a.normal - b.normal
-            };
-            let n = (e1 - e0).cross(mean);
-            if n.length_squared() == 0.0 {
-                continue;
-            }
-            let p = c.map(|s| s.at);
-            let side = p.map(|x| (x - e0).dot(n));
-            if let Some(pieces) = split_by_plane(&p, &side) {
-                return Some(pieces);
-            }
-        }
-    }
-    None
-}
-
-/// The triangle `p` cut where the signed distances `side` change sign: a triangle and a quad
-/// (as two triangles); `None` unless the plane separates its corners.
-fn split_by_plane(p: &[DVec3; 3], side: &[f64; 3]) -> Option<Vec<[DVec3; 3]>> {
-    // The corner alone on its side.
-    let lone = (0..3).find(|&i| {
-        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-        (side[i] > 0.0 && side[j] < 0.0 && side[k] < 0.0)
-            || (side[i] < 0.0 && side[j] > 0.0 && side[k] > 0.0)
-    })?;
-    let (j, k) = ((lone + 1) % 3, (lone + 2) % 3);
-    let at = |a: usize, b: usize| {
-        let t = side[a] / (side[a] - side[b]);
-        p[a] + (p[b] - p[a]) * t
-    };
-    let (x, y) = (at(lone, j), at(lone, k));
-    Some(vec![[p[lone], x, y], [x, p[j], p[k]], [x, p[k], y]])
+        .sqrt()
 }
 
 /// `f` over `items` on every available core, in order.

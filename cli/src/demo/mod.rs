@@ -10,6 +10,7 @@
 //! # Ok::<(), lodkit_cli::demo::DemoError>(())
 //! ```
 
+pub mod chain;
 pub mod clock;
 pub mod closed_loop;
 pub mod combine_timing;
@@ -202,6 +203,8 @@ pub struct DemoReport {
     pub selection: selection::SelectionReport,
     /// Host-side figures (composition, selection).
     pub cpu: Vec<cpu::CpuFigure>,
+    /// The generated LOD chain's levels, when its scene was measured.
+    pub chain: Option<chain::ChainReport>,
     /// Whether the plots have text (a font was found).
     pub plot_text: bool,
     /// Wall time of the whole run, seconds.
@@ -366,6 +369,11 @@ pub fn run_on(
     bar.set_message("GPU LOD selection against select_batch");
     let selection = selection::measure(gpu, &timer, 5, &selection::SIZES)?;
     bar.inc(1);
+    let chain = if scenes.iter().any(|s| s.name == chain::SCENE) {
+        Some(chain::report(out)?)
+    } else {
+        None
+    };
     let info = gpu.adapter.get_info();
     let now = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -392,6 +400,7 @@ pub fn run_on(
         controllers,
         selection,
         cpu,
+        chain,
         plot_text: plots::plot_font().is_some(),
         seconds: 0.0,
     };

@@ -436,6 +436,9 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
     h.push_str("</p>\n");
     for scene in &report.scenes {
         let _ = writeln!(h, "<h3>Scene {scene}</h3>");
+        if let Some(chain) = report.chain.as_ref().filter(|c| &c.scene == scene) {
+            h.push_str(&super::chain::html(chain));
+        }
         let rows: Vec<_> = report
             .transitions
             .iter()

@@ -126,6 +126,11 @@ pub enum Shape {
         /// Rings of each canopy sphere of that tree.
         rings: u32,
     },
+    /// Level `level` of the demo's generated LOD chain ([`super::chain`]), 0 the original.
+    Chain {
+        /// The level.
+        level: u32,
+    },
 }
 
 impl Shape {
@@ -138,6 +143,7 @@ impl Shape {
             }
             Shape::Sphere { rings, segments } => Mesh::sphere(rings, segments),
             Shape::Cube => Mesh::cube(),
+            Shape::Chain { level } => super::chain::level_mesh(level).unwrap_or_default(),
             Shape::Box { half } => {
                 let mut m = Mesh::default();
                 m.append(&Mesh::cube(), Mat4::from_scale(Vec3::from(half)));
@@ -177,6 +183,7 @@ impl Shape {
             Shape::Sphere { rings, segments } => sphere(rings.max(2), segments.max(3)),
             Shape::Cube | Shape::Box { .. } => 12,
             Shape::Impostor { .. } => 2,
+            Shape::Chain { .. } => self.mesh().triangles() as u64,
             Shape::Tree { puffs, rings } => {
                 12 + u64::from(puffs) * sphere(rings.max(2), rings.saturating_mul(2).max(3))
             }
@@ -228,6 +235,10 @@ impl Shape {
             {
                 Err(format!("rings = {rings} is outside 2..=64"))
             }
+            Shape::Chain { level } if level as usize >= super::chain::levels() => Err(format!(
+                "Chain level = {level}: the chain has {} levels",
+                super::chain::levels()
+            )),
             Shape::Box { half } if !half.iter().all(|h| *h > 0.0 && *h <= 100.0) => {
                 Err(format!("Box half = {half:?} must lie in (0, 100]"))
             }
@@ -400,9 +411,14 @@ impl DemoScene {
         Mat4::from_translation(o.position.into()) * Mat4::from_scale(o.scale.into())
     }
 
-    /// The built-in scenes: `simple`, `trees` and `field`.
+    /// The built-in scenes: `simple`, `trees`, `field` and `chain`.
     pub fn built_in() -> Vec<DemoScene> {
-        vec![Self::simple(), Self::trees(), Self::field()]
+        vec![
+            Self::simple(),
+            Self::trees(),
+            Self::field(),
+            super::chain::scene(),
+        ]
     }
 
     /// A SIMPLE-like scene (Scherzer & Wimmer 2008, Fig. 9): a grid of red spheres (LOD 0)

@@ -1,0 +1,70 @@
+//! Refining a source triangle whose first bound is above the tolerance: the smallest of three
+//! bounds over each piece, pieces cut at their edge midpoints until the bound is within the
+//! tolerance of the largest distance found.
+
+use glam::DVec3;
+
+use super::partition::partition_bound;
+use super::{MARGIN, Sample, Surface, Tolerance, longest_side};
+
+/// Deepest cut of one source triangle.
+const MAX_DEPTH: u32 = 12;
+
+/// The bound over the triangle piece with corners `c` (samples of `f`): the smallest of
+///
+/// - the Lipschitz bound `max f(corners) + longest / sqrt(3)`;
+/// - the convexity bound with the nearest triangle to a corner or the centroid;
+/// - the partition bound ([`partition_bound`]);
+///
+/// and the piece is cut in four while that is above `lb` plus the tolerance. Every `f`
+/// evaluated raises `lb`.
+pub(super) fn refine<'a>(
+    target: &'a Surface,
+    c: [Sample<'a>; 3],
+    depth: u32,
+    lb: &mut f64,
+    tolerance: Tolerance,
+) -> f64 {
+    let p = c.map(|s| s.at);
+    let longest = longest_side(&p);
+    let near = c[0].distance.max(c[1].distance).max(c[2].distance);
+    let lipschitz = near + longest / 3f64.sqrt();
+    let centre = target.nearest((p[0] + p[1] + p[2]) / 3.0);
+    *lb = lb.max(centre.distance);
+    let convex = c
+        .iter()
+        .chain([&centre])
+        .filter_map(|s| s.nearest)
+        .map(|t| p.iter().map(|&x| t.distance(x)).fold(0.0, f64::max))
+        .fold(f64::INFINITY, f64::min);
+    let mut bound = lipschitz.min(convex);
+    if bound > *lb + tolerance.slack(*lb) {
+        let margin = 2.0 * near.max(centre.distance) + MARGIN * longest;
+        if let Some(b) = partition_bound(p, &target.candidates(&p, margin)) {
+            bound = bound.min(b.bound);
+            *lb = lb.max(target.nearest(b.at).distance);
+        }
+    }
+    if bound <= *lb + tolerance.slack(*lb) || depth >= MAX_DEPTH {
+        return bound;
+    }
+    let m = [
+        (p[0] + p[1]) * 0.5,
+        (p[1] + p[2]) * 0.5,
+        (p[2] + p[0]) * 0.5,
+    ]
+    .map(|x: DVec3| {
+        let s = target.nearest(x);
+        *lb = lb.max(s.distance);
+        s
+    });
+    [
+        [c[0], m[0], m[2]],
+        [m[0], c[1], m[1]],
+        [m[2], m[1], c[2]],
+        [m[0], m[1], m[2]],
+    ]
+    .into_iter()
+    .map(|piece| refine(target, piece, depth + 1, lb, tolerance))
+    .fold(0.0, f64::max)
+}
