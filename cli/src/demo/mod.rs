@@ -11,6 +11,7 @@
 //! ```
 
 pub mod chain;
+pub mod chain_levels;
 pub mod clock;
 pub mod closed_loop;
 pub mod combine_timing;

@@ -143,7 +143,7 @@ impl Shape {
             }
             Shape::Sphere { rings, segments } => Mesh::sphere(rings, segments),
             Shape::Cube => Mesh::cube(),
-            Shape::Chain { level } => super::chain::level_mesh(level).unwrap_or_default(),
+            Shape::Chain { level } => super::chain_levels::level_mesh(level).unwrap_or_default(),
             Shape::Box { half } => {
                 let mut m = Mesh::default();
                 m.append(&Mesh::cube(), Mat4::from_scale(Vec3::from(half)));
@@ -235,10 +235,12 @@ impl Shape {
             {
                 Err(format!("rings = {rings} is outside 2..=64"))
             }
-            Shape::Chain { level } if level as usize >= super::chain::levels() => Err(format!(
-                "Chain level = {level}: the chain has {} levels",
-                super::chain::levels()
-            )),
+            Shape::Chain { level } if level as usize >= super::chain_levels::levels() => {
+                Err(format!(
+                    "Chain level = {level}: the chain has {} levels",
+                    super::chain_levels::levels()
+                ))
+            }
             Shape::Box { half } if !half.iter().all(|h| *h > 0.0 && *h <= 100.0) => {
                 Err(format!("Box half = {half:?} must lie in (0, 100]"))
             }
@@ -409,16 +411,6 @@ impl DemoScene {
     pub fn model(&self, i: usize) -> Mat4 {
         let o = &self.objects[i];
         Mat4::from_translation(o.position.into()) * Mat4::from_scale(o.scale.into())
-    }
-
-    /// The built-in scenes: `simple`, `trees`, `field` and `chain`.
-    pub fn built_in() -> Vec<DemoScene> {
-        vec![
-            Self::simple(),
-            Self::trees(),
-            Self::field(),
-            super::chain::scene(),
-        ]
     }
 
     /// A SIMPLE-like scene (Scherzer & Wimmer 2008, Fig. 9): a grid of red spheres (LOD 0)
