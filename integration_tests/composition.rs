@@ -342,19 +342,24 @@ fn every_wgsl_function_has_a_rust_twin_of_the_same_name() {
             .as_deref()
             .unwrap()
             .trim_start_matches("lodkit::");
-        let rust = std::fs::read_to_string(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("src/{topic}.rs")),
-        )
-        .unwrap_or_else(|_| {
-            panic!(
-                "src/{topic}.rs (the Rust twins of {}) is missing",
-                module.path
-            )
-        });
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let mut rust =
+            std::fs::read_to_string(src.join(format!("{topic}.rs"))).unwrap_or_else(|_| {
+                panic!(
+                    "src/{topic}.rs (the Rust twins of {}) is missing",
+                    module.path
+                )
+            });
+        // A topic's file may keep some twins in files of its folder (src/<topic>/*.rs).
+        if let Ok(dir) = std::fs::read_dir(src.join(topic)) {
+            for entry in dir.flatten() {
+                rust.push_str(&std::fs::read_to_string(entry.path()).unwrap_or_default());
+            }
+        }
         for f in &module.functions {
             assert!(
                 rust.contains(&format!("pub fn {}(", f.name)),
-                "src/{topic}.rs has no twin of {}",
+                "src/{topic}.rs (or src/{topic}/) has no twin of {}",
                 f.name
             );
         }

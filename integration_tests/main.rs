@@ -6,6 +6,7 @@
 #[macro_use]
 mod support;
 mod alpha_tested;
+mod combine_coverage;
 mod composition;
 mod cost;
 mod cost_bounds;

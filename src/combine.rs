@@ -1,9 +1,18 @@
 //! The combination rule of two LOD buffers (Scherzer & Wimmer 2008, sec. 3.4): Rust twins of
-//! `lodkit::combine`.
+//! `lodkit::combine`. [`combine_at`] is the paper's rule read where the camera's reprojection
+//! puts each pixel; the pieces from [`combine_read_own`] on read the older level where it is
+//! known to cover the pixel (put together in
+//! [`combine_coverage::combine_pixel`](crate::combine_coverage::combine_pixel)).
 
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
+pub(crate) mod older;
 mod rects;
+pub use older::{
+    COMBINE_BLOCK_REACH, COMBINE_COVER_REACH, COMBINE_SNAP, CombineRead, combine_cover_texel,
+    combine_displayed_word, combine_other_texel, combine_own_color, combine_ray_offset,
+    combine_read_own, combine_region_position, combine_snap,
+};
 pub use rects::{ScreenRect, displaced_bounds, merge_rects, screen_rect};
 
 /// One texel of a LOD buffer (mirror of WGSL `LodSample`).
@@ -398,7 +407,7 @@ pub fn combine_at_moved(
 ) -> Option<Vec4> {
     let inside = pixel.x < newer.width && pixel.y < newer.height;
     (inside && images_fit(newer, older))
-        .then(|| combine_pixel(newer, older, pixel, new_to_old, motion, convention).color)
+        .then(|| combine_rule_pixel(newer, older, pixel, new_to_old, motion, convention).color)
 }
 
 /// Whether two LOD images have the same, non-zero size and complete texel arrays.
@@ -416,7 +425,7 @@ fn images_fit(newer: &LodImage, older: &LodImage) -> bool {
 }
 
 /// [`combine_at`] with the rule it applied and whether a GPU may read another texel.
-fn combine_pixel(
+fn combine_rule_pixel(
     newer: &LodImage,
     older: &LodImage,
     pixel: UVec2,
@@ -535,7 +544,7 @@ pub fn combine_images(
         .map(|p| {
             let pixel = UVec2::new(p % newer.width, p / newer.width);
             let motion = newer.motion_at(p as usize);
-            combine_pixel(newer, older, pixel, new_to_old, motion, convention)
+            combine_rule_pixel(newer, older, pixel, new_to_old, motion, convention)
         })
         .collect()
 }

@@ -17,7 +17,8 @@
 //!   frame-sequential LOD interpolation (Scherzer & Wimmer 2008): the transition scheduler, the
 //!   visibility textures, and Rust twins of the LOD-buffer, reprojection and combine shaders;
 //!   [`silhouette`]: where the level not drawn this frame covers the screen, from its mesh's
-//!   silhouette (no rasterization).
+//!   silhouette (no rasterization); [`combine_coverage`]: the combine that reads the older
+//!   level where its silhouette (or a depth pass) says it covers the pixel.
 //! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
 //! - [`metrics`]: how a transition looks on read-back frames: pop, flicker (change over net
 //!   change, direction reversals), PSNR, medians.
@@ -48,6 +49,7 @@
 pub mod alpha_mask;
 pub mod bilateral;
 pub mod combine;
+pub mod combine_coverage;
 pub mod frame_sequential;
 pub mod framebuffer_lod;
 pub mod fullscreen;

@@ -14,6 +14,8 @@
 //!   forth adds change and no net change), and the count of per-pixel direction reversals. Pop
 //!   cannot see flicker (a transition that blinks every frame spreads its change evenly and
 //!   scores a low pop); this does.
+//! - [`see_through`] and [`ghosts`]: pixels both levels cover where a frame shows the
+//!   background, and pixels neither covers where it shows an object.
 //! - [`psnr_rgba8`] and [`median`].
 //!
 //! ```
@@ -41,6 +43,9 @@
 //! ```
 
 use thiserror::Error;
+
+mod coverage;
+pub use coverage::{ghosts, see_through};
 
 /// A pixel's step smaller than this in every channel (in 8-bit levels) is not a direction: it
 /// neither counts as a reversal nor sets the direction a later step reverses (rounding in a renderer's
@@ -72,6 +77,16 @@ pub enum MetricsError {
         frame: usize,
         /// Its length in bytes.
         len: usize,
+    },
+    /// A coverage mask ([`see_through`], [`ghosts`]) with another pixel count than `fine`.
+    #[error("the {what} mask has {len} pixels where the fine one has {expected}")]
+    MaskMismatch {
+        /// "coarse" or "shown".
+        what: &'static str,
+        /// Its length in pixels.
+        len: usize,
+        /// The fine mask's length.
+        expected: usize,
     },
 }
 

@@ -27,6 +27,12 @@ use std::collections::HashMap;
 use glam::{Mat4, Vec2, Vec3};
 use thiserror::Error;
 
+mod coverage;
+pub use coverage::{
+    SILHOUETTE_ON, SILHOUETTE_TIE, bin_silhouette, convex_hull, hull_triangles, polygon_area,
+    silhouette_covers, silhouette_hull, silhouette_texel,
+};
+
 /// One silhouette segment in pixels (x right, y down, pixel centers at `i + 0.5`): from
 /// `(x0, y0)` to `(x1, y1)`, its front face on the same side for every segment of a mesh.
 pub type Segment = [f32; 4];
@@ -158,17 +164,44 @@ impl Surface {
         size: (u32, u32),
         front_ccw: bool,
     ) -> Result<Vec<Segment>, SilhouetteError> {
+        self.outline(&self.points, clip_from_local, eye, size, front_ccw)
+    }
+
+    /// [`silhouette`](Self::silhouette) of the mesh with each vertex moved by `displace`
+    /// (object space in, object space out): a vertex animation the host can evaluate, such as
+    /// wind sway, keeps its exact coverage. Facing is tested on the moved triangles.
+    pub fn silhouette_displaced(
+        &self,
+        clip_from_local: Mat4,
+        eye: Vec3,
+        size: (u32, u32),
+        front_ccw: bool,
+        displace: impl Fn(Vec3) -> Vec3,
+    ) -> Result<Vec<Segment>, SilhouetteError> {
+        let moved: Vec<Vec3> = self.points.iter().map(|&p| displace(p)).collect();
+        self.outline(&moved, clip_from_local, eye, size, front_ccw)
+    }
+
+    /// The silhouette with the welded vertices at `points`.
+    fn outline(
+        &self,
+        points: &[Vec3],
+        clip_from_local: Mat4,
+        eye: Vec3,
+        size: (u32, u32),
+        front_ccw: bool,
+    ) -> Result<Vec<Segment>, SilhouetteError> {
         let front: Vec<bool> = self
             .triangles
             .iter()
             .map(|v| {
-                let [a, b, c] = v.map(|i| self.points[i as usize]);
+                let [a, b, c] = v.map(|i| points[i as usize]);
                 ((b - a).cross(c - a).dot(eye - a) > 0.0) == front_ccw
             })
             .collect();
         let half = Vec2::new(size.0 as f32, size.1 as f32) / 2.0;
         let project = |id: u32| {
-            let clip = clip_from_local * self.points[id as usize].extend(1.0);
+            let clip = clip_from_local * points[id as usize].extend(1.0);
             (clip.w > 1e-6).then(|| {
                 let ndc = clip.truncate().truncate() / clip.w;
                 Vec2::new((ndc.x + 1.0) * half.x, (1.0 - ndc.y) * half.y)

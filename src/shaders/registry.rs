@@ -373,14 +373,21 @@ fn functions(source: &str, language: Language) -> Vec<FunctionInfo> {
 }
 
 /// `name` for a file-scope GLSL function definition `type name(...)` starting at column 0, or a
-/// function-like macro `#define lodkit_name(...)` (how GLSL twins take textures).
+/// function-like macro `#define lodkit_name(...)` (how GLSL twins take textures); not for a
+/// prototype, a hook the includer defines (the other way GLSL twins read textures).
 fn glsl_function_name(line: &str) -> Option<&str> {
     if let Some(rest) = line.strip_prefix("#define ") {
         let name = identifier(rest);
         let exported = name.starts_with("lodkit_") && rest[name.len()..].starts_with('(');
         return exported.then_some(name);
     }
-    if line.starts_with(char::is_whitespace) || line.starts_with('#') || line.starts_with("//") {
+    // A prototype (`type name(...);`) declares a hook the includer defines: no function here.
+    let prototype = line.trim_end().ends_with(");");
+    if line.starts_with(char::is_whitespace)
+        || line.starts_with('#')
+        || line.starts_with("//")
+        || prototype
+    {
         return None;
     }
     let open = line.find('(')?;

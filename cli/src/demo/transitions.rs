@@ -276,15 +276,19 @@ fn silhouette_error(
     masks: &[Vec<bool>; 2],
 ) -> Result<f32, DemoError> {
     let over = over_black_and_white(gpu, renderer, technique, true)?;
-    let (mut union, mut wrong) = (0usize, 0usize);
-    for i in 0..masks[0].len().min(over[0].len() / 4) {
-        let (a, b) = (masks[0][i], masks[1][i]);
-        union += usize::from(a || b);
-        let hole = a && b && shows_background(&over, i);
-        let ghost = !a && !b && over[0][i * 4..i * 4 + 3].iter().any(|&c| c > 8);
-        wrong += usize::from(hole || ghost);
-    }
-    Ok(share(wrong, union))
+    let n = masks[0].len().min(masks[1].len()).min(over[0].len() / 4);
+    let (fine, coarse) = (&masks[0][..n], &masks[1][..n]);
+    let union = (0..n).filter(|&i| fine[i] || coarse[i]).count();
+    // A hole: the renders over black and white scenery differ. A ghost: the render over black
+    // scenery shows something.
+    let opaque: Vec<bool> = (0..n).map(|i| !shows_background(&over, i)).collect();
+    let lit: Vec<bool> = (0..n)
+        .map(|i| over[0][i * 4..i * 4 + 3].iter().any(|&c| c > 8))
+        .collect();
+    let internal = |e: lodkit::metrics::MetricsError| DemoError::Internal(e.to_string());
+    let holes = lodkit::metrics::see_through(fine, coarse, &opaque).map_err(internal)?;
+    let ghosts = lodkit::metrics::ghosts(fine, coarse, &lit).map_err(internal)?;
+    Ok(share(holes + ghosts, union))
 }
 
 fn share(part: usize, whole: usize) -> f32 {

@@ -32,6 +32,26 @@
 //       where the moved read misses the t-instance, lodkit_combine_search_texel where the camera
 //       alone puts the pixel
 //   lodkit_depth_closer(a, b) -> bool
+// Pieces of the combine with the older level's coverage known (lodkit/combine_coverage.glsl puts
+// them together in lodkit_combine_pixel), reading the older buffer through hooks:
+//   lodkit_CombineRead { texel, color, found }   the older texel a pixel combines with
+//   LODKIT_COMBINE_COVER_REACH, LODKIT_COMBINE_BLOCK_REACH (texels), LODKIT_COMBINE_SNAP
+//   lodkit_combine_region_position(pixel, size) -> vec4   clip position of a region vertex
+//   lodkit_combine_displayed_word(word, anchored, older_tau, pattern) -> uint   the older word
+//       shown at this frame's threshold where its level is anchored to the screen pattern
+//   lodkit_combine_ray_offset(at, texel, size) -> float   texels from texel's center to at
+//   lodkit_combine_cover_texel(id, read, base, depth, new_to_old, motion, reach) -> uvec2   the
+//       neighbour holding id whose older sample lies on the pixel's ray
+//   lodkit_combine_snap(fraction) -> vec2   bilinear fractions within the snap of 0 or 1 snapped
+//   lodkit_combine_own_color(id, at, fallback) -> vec4   the blend of the texels around at holding id
+//   lodkit_combine_other_texel(id, read, at) -> uvec2   the nearest texel not holding id
+//   lodkit_combine_read_own(owner, uv, depth, new_to_old, motion, reach) -> lodkit_CombineRead
+// Hooks (GLSL cannot pass a texture to a function on every target, so these call functions the
+// includer defines, after its samplers, only if it calls them; texel = uvec2):
+//   vec4 lodkit_combine_fetch_color(uvec2 texel)   the older buffer's color
+//   uint lodkit_combine_fetch_word(uvec2 texel)   its id word
+//   float lodkit_combine_fetch_depth(uvec2 texel)   its clip depth (the depth attachment)
+//   uvec2 lodkit_combine_fetch_size()   its size
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z).
 #ifndef LODKIT_COMBINE_GLSL
@@ -39,6 +59,7 @@
 
 #include "lodkit/lod_buffer.glsl"
 #include "lodkit/reproject.glsl"
+#include "lodkit/visibility.glsl"
 
 /// One texel of a LOD buffer: color, instance id (0 = n-instance), clip depth.
 struct lodkit_LodSample {
@@ -234,5 +255,149 @@ vec4 lodkit_combine_texels(vec4 newer_color, uint newer_word, vec3 old, vec4 old
         texelFetch((oc), LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo), 0), \
         texelFetch((oid), LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo), 0).x, \
         texelFetch((od), LODKIT_COMBINE_OLDER_(nc, nid, nd, oid, od, px, m, mo), 0).x)
+
+/// The older texel a pixel combines with and the older color to show for it.
+struct lodkit_CombineRead {
+    uvec2 texel;
+    vec4 color;
+    /// false: no older level at this pixel; it shows the newer buffer.
+    bool found;
+};
+
+/// lodkit_combine_cover_texel's reach (texels) where the older level is estimated.
+const float LODKIT_COMBINE_COVER_REACH = 0.999;
+/// lodkit_combine_cover_texel's reach where the older level is known to cover the pixel.
+const float LODKIT_COMBINE_BLOCK_REACH = 1.5;
+/// Bilinear fractions within this of 0 or 1 are taken as that.
+const float LODKIT_COMBINE_SNAP = 0.01;
+
+/// Hook: the older buffer's color at `texel` (defined by the includer).
+vec4 lodkit_combine_fetch_color(uvec2 texel);
+/// Hook: the older buffer's id word at `texel`.
+uint lodkit_combine_fetch_word(uvec2 texel);
+/// Hook: the older buffer's clip depth at `texel`.
+float lodkit_combine_fetch_depth(uvec2 texel);
+/// Hook: the older buffer's size.
+uvec2 lodkit_combine_fetch_size();
+
+/// Clip position of a combine region's vertex at `pixel` (pixels, top-left origin).
+vec4 lodkit_combine_region_position(vec2 pixel, vec2 size) {
+    return vec4(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0, 0.0, 1.0);
+}
+
+/// The older `word` with its shown-next flag from the screen `pattern` at `older_tau` where its
+/// level is `anchored`; else `word`.
+uint lodkit_combine_displayed_word(uint word, bool anchored, float older_tau, float pattern) {
+    if (lodkit_lod_buffer_id(word) == 0u || !anchored) {
+        return word;
+    }
+    uint next = LODKIT_LOD_BUFFER_SHOWN_NEXT << 30u;
+    return lodkit_visibility_shown(pattern, older_tau) ? (word | next) : (word & ~next);
+}
+
+/// How far (texels, the larger axis) texture-space `at` lies from the center of `texel`.
+float lodkit_combine_ray_offset(vec2 at, uvec2 texel, uvec2 size) {
+    vec2 offset = abs(at * vec2(size) - (vec2(texel) + 0.5));
+    return max(offset.x, offset.y);
+}
+
+/// The texel of the 3x3 block around `read` holding `id` whose older sample lies nearest the
+/// pixel's ray (from `base`, moved by `motion`), if within `reach` texels; else `read`.
+uvec2 lodkit_combine_cover_texel(uint id, uvec2 read, vec4 base, float depth, mat4 new_to_old, vec2 motion, float reach) {
+    uvec2 size = lodkit_combine_fetch_size();
+    uvec2 best = read;
+    float best_offset = reach;
+    for (uint k = 1u; k < 9u; k++) {
+        uvec2 t = lodkit_combine_ring_texel(read, size, k);
+        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(t)) == id) {
+            vec2 ray = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(t), new_to_old).xy;
+            float offset = lodkit_combine_ray_offset(ray + motion, t, size);
+            if (offset < best_offset) {
+                best = t;
+                best_offset = offset;
+            }
+        }
+    }
+    return best;
+}
+
+/// Bilinear fractions with a value within LODKIT_COMBINE_SNAP of 0 or 1 taken as that.
+vec2 lodkit_combine_snap(vec2 fraction) {
+    vec2 near = roundEven(fraction);
+    vec2 off = abs(fraction - near);
+    return vec2(off.x < LODKIT_COMBINE_SNAP ? near.x : fraction.x, off.y < LODKIT_COMBINE_SNAP ? near.y : fraction.y);
+}
+
+/// The bilinear blend (lodkit_combine_snap) of the 2x2 older texels around `at` holding `id`,
+/// renormalized; `fallback` where none does.
+vec4 lodkit_combine_own_color(uint id, vec2 at, vec4 fallback) {
+    uvec2 size = lodkit_combine_fetch_size();
+    vec2 f = at * vec2(size) - 0.5;
+    vec2 i0 = floor(f);
+    vec2 fr = lodkit_combine_snap(f - i0);
+    vec4 sum = vec4(0.0);
+    float weight = 0.0;
+    for (uint k = 0u; k < 4u; k++) {
+        ivec2 t = ivec2(i0 + vec2(float(k & 1u), float(k >> 1u)));
+        if (any(lessThan(t, ivec2(0))) || any(greaterThanEqual(t, ivec2(size)))) {
+            continue;
+        }
+        float w = ((k & 1u) == 1u ? fr.x : 1.0 - fr.x) * ((k >> 1u) == 1u ? fr.y : 1.0 - fr.y);
+        uvec2 texel = uvec2(t);
+        if (w > 0.0 && lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == id) {
+            sum += w * lodkit_combine_fetch_color(texel);
+            weight += w;
+        }
+    }
+    if (weight <= 0.0) {
+        return fallback;
+    }
+    return sum / weight;
+}
+
+/// The texel of the 3x3 block around `read` that does not hold `id`, nearest to `at`; `read` if
+/// every one holds it.
+uvec2 lodkit_combine_other_texel(uint id, uvec2 read, vec2 at) {
+    uvec2 size = lodkit_combine_fetch_size();
+    uvec2 best = read;
+    float best_distance = 1.0e9;
+    for (uint k = 0u; k < 9u; k++) {
+        uvec2 t = lodkit_combine_ring_texel(read, size, k);
+        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(t)) != id) {
+            vec2 d = at * vec2(size) - (vec2(t) + 0.5);
+            if (dot(d, d) < best_distance) {
+                best = t;
+                best_distance = dot(d, d);
+            }
+        }
+    }
+    return best;
+}
+
+/// The read of `owner`'s older level: refined at the older depth only where that texel holds
+/// `owner`, else lodkit_combine_cover_texel within `reach`; the color lodkit_combine_own_color.
+lodkit_CombineRead lodkit_combine_read_own(uint owner, vec2 uv, float depth, mat4 new_to_old, vec2 motion, float reach) {
+    uvec2 size = lodkit_combine_fetch_size();
+    vec4 base = lodkit_reproject_base(uv, new_to_old);
+    vec2 first = lodkit_reproject_from_base(base, depth, new_to_old).xy + motion;
+    vec2 at = first;
+    uvec2 first_texel = lodkit_combine_texel(first, size);
+    if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(first_texel)) == owner) {
+        vec2 refined = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(first_texel), new_to_old).xy + motion;
+        at = lodkit_in_viewport(refined) ? refined : first;
+    }
+    uvec2 texel = lodkit_combine_texel(at, size);
+    if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) != owner) {
+        texel = lodkit_combine_cover_texel(owner, texel, base, depth, new_to_old, motion, reach);
+        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == owner) {
+            at = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(texel), new_to_old).xy + motion;
+        }
+    }
+    vec4 color = lodkit_combine_fetch_color(texel);
+    if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == owner) {
+        color = lodkit_combine_own_color(owner, at, color);
+    }
+    return lodkit_CombineRead(texel, color, true);
+}
 
 #endif // LODKIT_COMBINE_GLSL

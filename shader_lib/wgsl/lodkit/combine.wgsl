@@ -38,24 +38,38 @@
 //       -> vec4<f32>   the combined color from the fetched texels (old = reproject(uv, newer
 //       depth); words: lodkit::lod_buffer id words)
 //   combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel,
-//       new_to_old) -> vec4<f32>   the whole per-pixel combine (passes/combine.wgsl), to fold
-//       into a full-screen pass an engine already has (tonemapping, TAA): no pass of its own.
-//       The depths are the LOD buffers' depth attachments bound as texture_2d<f32>
-//       (unfilterable float; a depth view of Depth32Float). Nothing moves by itself.
+//       new_to_old) -> vec4<f32>   the paper's per-pixel combine, to fold into a full-screen pass
+//       an engine already has (depths: the depth attachments as texture_2d<f32>); still scenes
 //   combine_at_moved(newer_color, ..., older_depth, pixel, new_to_old, motion) -> vec4<f32>
-//       combine_at for a pixel whose surface moved by itself: `motion` is its object motion
-//       (the LOD pass's location 2, or combine_object_motion of the engine's motion vectors);
-//       where neither the moved read nor its side texels hold the t-instance, the 3x3 block
-//       where the camera alone puts the pixel is searched (combine_search_texel)
+//       combine_at for a pixel whose surface moved by `motion` (its object motion); where the
+//       moved read and its side texels miss the t-instance, combine_search_texel where the
+//       camera alone puts the pixel
 //   combine_object_motion(uv, depth, new_to_old, motion_vector) -> vec2<f32>   the object
-//       motion of a pixel from an engine's motion vector (uv now minus uv in the previous frame,
-//       camera motion included, as TAA uses): what the camera's reprojection does not explain
+//       motion from an engine's motion vector (uv now minus uv before, camera motion included)
 //   depth_closer(a, b) -> bool   a strictly closer than b under the depth convention
+// Pieces of the combine with the older level's coverage known (lodkit::combine_coverage puts
+// them together in combine_pixel, for a pass drawn over the levels' silhouettes):
+//   CombineRead { texel, color, found }   the older texel a pixel combines with, its color
+//   COMBINE_COVER_REACH, COMBINE_BLOCK_REACH (texels), COMBINE_SNAP   combine_cover_texel's reach
+//       where the older level is estimated / known to cover the pixel; combine_snap's margin
+//   combine_region_position(pixel, size) -> vec4<f32>   clip position of a region vertex in pixels
+//   combine_displayed_word(word, anchored, older_tau, pattern) -> u32   the older word shown at
+//       this frame's threshold where its level is anchored to the screen pattern
+//   combine_ray_offset(at, texel, size) -> f32   texels from texel's center to at
+//   combine_cover_texel(older_id, older_depth, id, read, base, depth, new_to_old, motion,
+//       reach) -> vec2<u32>   the neighbour holding id whose older sample lies on the pixel's ray
+//   combine_snap(fraction) -> vec2<f32>   bilinear fractions within COMBINE_SNAP of 0 or 1 snapped
+//   combine_own_color(older_color, older_id, id, at, fallback) -> vec4<f32>   the bilinear blend
+//       of the texels around at holding id
+//   combine_other_texel(older_id, id, read, at) -> vec2<u32>   the nearest texel not holding id
+//   combine_read_own(older_color, older_id, older_depth, owner, uv, depth, new_to_old, motion,
+//       reach) -> CombineRead   a t-instance's own older level, refined only on its own texels
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z); off: 0 near.
 #define_import_path lodkit::combine
 #import lodkit::lod_buffer::{lod_buffer_id, lod_buffer_shown, LOD_BUFFER_SHOWN_NOW, LOD_BUFFER_SHOWN_NEXT}
 #import lodkit::reproject::{reproject, reproject_base, reproject_from_base, reproject_refine, in_viewport}
+#import lodkit::visibility::visibility_shown
 
 /// One texel of a LOD buffer: color, instance id (0 = n-instance), clip depth.
 struct LodSample {
@@ -291,4 +305,138 @@ fn combine_at_moved(
         older_word,
         textureLoad(older_depth, older, 0).x,
     );
+}
+/// The older texel a pixel combines with and the older color to show for it.
+struct CombineRead {
+    texel: vec2<u32>,
+    color: vec4<f32>,
+    /// false: no older level at this pixel; it shows the newer buffer.
+    found: bool,
+}
+
+/// combine_cover_texel's reach (texels) where the older level is estimated: the reach of the
+/// four samples around a point, less 1/1000 (a pixel that did not move takes no neighbour).
+const COMBINE_COVER_REACH: f32 = 0.999;
+/// combine_cover_texel's reach where the older level is known to cover the pixel: the 3x3 block.
+const COMBINE_BLOCK_REACH: f32 = 1.5;
+/// Bilinear fractions within this of 0 or 1 are taken as that (combine_snap).
+const COMBINE_SNAP: f32 = 0.01;
+/// Clip position of a combine region's vertex at `pixel` (pixels, top-left origin) on a target
+/// of `size` pixels.
+fn combine_region_position(pixel: vec2<f32>, size: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0, 0.0, 1.0);
+}
+
+/// The older `word` with its shown-next flag from the screen `pattern` at `older_tau` where its
+/// level is `anchored` to the screen (complementary to the newer level there); else `word`.
+fn combine_displayed_word(word: u32, anchored: bool, older_tau: f32, pattern: f32) -> u32 {
+    if (lod_buffer_id(word) == 0u || !anchored) {
+        return word;
+    }
+    let next = LOD_BUFFER_SHOWN_NEXT << 30u;
+    return select(word & ~next, word | next, visibility_shown(pattern, older_tau));
+}
+
+/// How far (texels, the larger axis) texture-space `at` lies from the center of `texel`.
+fn combine_ray_offset(at: vec2<f32>, texel: vec2<u32>, size: vec2<u32>) -> f32 {
+    let offset = abs(at * vec2<f32>(size) - (vec2<f32>(texel) + 0.5));
+    return max(offset.x, offset.y);
+}
+
+/// The texel of the 3x3 block around `read` holding `id` whose older sample lies nearest the
+/// pixel's ray (from `base`, moved by `motion`), if within `reach` texels; else `read`.
+fn combine_cover_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, id: u32, read: vec2<u32>, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>, reach: f32) -> vec2<u32> {
+    let size = textureDimensions(older_id, 0);
+    var best = read;
+    var best_offset = reach;
+    for (var k = 1u; k < 9u; k++) {
+        let t = combine_ring_texel(read, size, k);
+        if (lod_buffer_id(textureLoad(older_id, t, 0).x) == id) {
+            let ray = reproject_refine(base, depth, textureLoad(older_depth, t, 0).x, new_to_old).xy;
+            let offset = combine_ray_offset(ray + motion, t, size);
+            if (offset < best_offset) {
+                best = t;
+                best_offset = offset;
+            }
+        }
+    }
+    return best;
+}
+
+/// Bilinear fractions with a value within COMBINE_SNAP of 0 or 1 taken as that.
+fn combine_snap(fraction: vec2<f32>) -> vec2<f32> {
+    let near = round(fraction);
+    return select(fraction, near, abs(fraction - near) < vec2<f32>(COMBINE_SNAP));
+}
+
+/// The bilinear blend (combine_snap) of the 2x2 older texels around `at` holding `id`,
+/// renormalized; `fallback` where none does.
+fn combine_own_color(older_color: texture_2d<f32>, older_id: texture_2d<u32>, id: u32, at: vec2<f32>, fallback: vec4<f32>) -> vec4<f32> {
+    let size = textureDimensions(older_color, 0);
+    let f = at * vec2<f32>(size) - 0.5;
+    let i0 = floor(f);
+    let fr = combine_snap(f - i0);
+    var sum = vec4<f32>(0.0);
+    var weight = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        let t = vec2<i32>(i0 + vec2<f32>(f32(k & 1u), f32(k >> 1u)));
+        if (any(t < vec2<i32>(0)) || any(t >= vec2<i32>(size))) {
+            continue;
+        }
+        let w = select(1.0 - fr.x, fr.x, (k & 1u) == 1u) * select(1.0 - fr.y, fr.y, (k >> 1u) == 1u);
+        let texel = vec2<u32>(t);
+        if (w > 0.0 && lod_buffer_id(textureLoad(older_id, texel, 0).x) == id) {
+            sum += w * textureLoad(older_color, texel, 0);
+            weight += w;
+        }
+    }
+    if (weight <= 0.0) {
+        return fallback;
+    }
+    return sum / weight;
+}
+
+/// The texel of the 3x3 block around `read` that does not hold `id`, nearest to `at`
+/// (texture-space uv); `read` if every one holds it.
+fn combine_other_texel(older_id: texture_2d<u32>, id: u32, read: vec2<u32>, at: vec2<f32>) -> vec2<u32> {
+    let size = textureDimensions(older_id, 0);
+    var best = read;
+    var best_distance = 1.0e9;
+    for (var k = 0u; k < 9u; k++) {
+        let t = combine_ring_texel(read, size, k);
+        if (lod_buffer_id(textureLoad(older_id, t, 0).x) != id) {
+            let d = at * vec2<f32>(size) - (vec2<f32>(t) + 0.5);
+            if (dot(d, d) < best_distance) {
+                best = t;
+                best_distance = dot(d, d);
+            }
+        }
+    }
+    return best;
+}
+
+/// The read of `owner`'s older level: refined at the older depth only where that texel holds
+/// `owner`, else combine_cover_texel within `reach`; the color combine_own_color.
+fn combine_read_own(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>, reach: f32) -> CombineRead {
+    let size = textureDimensions(older_color, 0);
+    let base = reproject_base(uv, new_to_old);
+    let first = reproject_from_base(base, depth, new_to_old).xy + motion;
+    var at = first;
+    let first_texel = combine_texel(first, size);
+    if (lod_buffer_id(textureLoad(older_id, first_texel, 0).x) == owner) {
+        let refined = reproject_refine(base, depth, textureLoad(older_depth, first_texel, 0).x, new_to_old).xy + motion;
+        at = select(first, refined, in_viewport(refined));
+    }
+    var texel = combine_texel(at, size);
+    if (lod_buffer_id(textureLoad(older_id, texel, 0).x) != owner) {
+        texel = combine_cover_texel(older_id, older_depth, owner, texel, base, depth, new_to_old, motion, reach);
+        if (lod_buffer_id(textureLoad(older_id, texel, 0).x) == owner) {
+            at = reproject_refine(base, depth, textureLoad(older_depth, texel, 0).x, new_to_old).xy + motion;
+        }
+    }
+    var color = textureLoad(older_color, texel, 0);
+    if (lod_buffer_id(textureLoad(older_id, texel, 0).x) == owner) {
+        color = combine_own_color(older_color, older_id, owner, at, color);
+    }
+    return CombineRead(texel, color, true);
 }

@@ -1,0 +1,421 @@
+//! The combine with the older level's coverage known (`lodkit::combine_coverage` and the pieces
+//! of `lodkit::combine` it is built from) on the GPU, WGSL and GLSL, against the Rust twins, on a
+//! hand-made pair of LOD buffers whose answers are known: the older level's silhouette covers a
+//! pixel the older buffer's read misses, a neighbour is taken only where its sample lies on the
+//! pixel's ray, and the older color is the bilinear blend of the same object's texels.
+
+use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
+use lodkit::combine::{
+    COMBINE_BLOCK_REACH, COMBINE_COVER_REACH, DepthConvention, LodImage, combine_cover_texel,
+    combine_displayed_word, combine_other_texel, combine_ray_offset, combine_read_own,
+    combine_snap, combine_texel, combine_uv,
+};
+use lodkit::combine_coverage::{
+    CombineData, CombineDataDescriptor, CombineNewer, CombineObjectData, CoverageRoute,
+    combine_far_depth, combine_new_to_old, combine_object, combine_pixel,
+};
+use lodkit::lod_buffer::{lod_buffer_id, lod_buffer_word};
+use lodkit::reproject::{reproject, reproject_base};
+use lodkit::shaders::SourceLanguage;
+use lodkit::silhouette::silhouette_covers;
+
+use crate::harness::{Probe, Route, Word, assert_twin, floats, run_on, words};
+
+const W: u32 = 16;
+const H: u32 = 12;
+/// Output words per pixel.
+const OUT: usize = 20;
+/// The camera moved so that every pixel's center reprojects 0.3 texel right of its own texel's
+/// center (NDC x + 0.3 * 2 / 16): a read lands at x + 0.8 texels, 0.2 texel from any edge.
+const SHIFT: f32 = 0.0375;
+
+/// The t-instance whose older level's coverage is its silhouette, and its older texels.
+const SIL: u32 = 3;
+const SIL_X: std::ops::RangeInclusive<u32> = 4..=9;
+const SIL_Y: std::ops::RangeInclusive<u32> = 3..=8;
+/// The t-instance whose older level is estimated from last frame's picture.
+const EST: u32 = 5;
+
+/// The scene: older and newer LOD buffers, the newer words, the screen pattern per pixel.
+struct Scene {
+    older: LodImage,
+    newer: LodImage,
+    pattern: Vec<f32>,
+    data: CombineData,
+}
+
+fn at(x: u32, y: u32) -> usize {
+    (y * W + x) as usize
+}
+
+fn scene() -> Scene {
+    let n = (W * H) as usize;
+    let noise = lodkit::noise::white_noise(9 * n, 41);
+    let colors = |k: usize| -> Vec<Vec4> {
+        (0..n)
+            .map(|i| {
+                Vec4::new(
+                    noise[k * n + i],
+                    noise[(k + 1) * n + i],
+                    noise[(k + 2) * n + i],
+                    1.0,
+                )
+            })
+            .collect()
+    };
+    // Older: the silhouette t-instance on texels 4..=9 x 3..=8, the estimated one on 11..=13 x
+    // 2..=5, background elsewhere.
+    let older_id = |x: u32, y: u32| {
+        if SIL_X.contains(&x) && SIL_Y.contains(&y) {
+            SIL
+        } else if (11..=13).contains(&x) && (2..=5).contains(&y) {
+            EST
+        } else {
+            0
+        }
+    };
+    // Newer: the silhouette t-instance on 4..=8 x 3..=8 (the level drawn this frame is smaller),
+    // the estimated one on 10..=14 x 2..=5 (larger).
+    let newer_id = |x: u32, y: u32| {
+        if (4..=8).contains(&x) && SIL_Y.contains(&y) {
+            SIL
+        } else if (10..=14).contains(&x) && (2..=5).contains(&y) {
+            EST
+        } else {
+            0
+        }
+    };
+    let depth = |id: u32| match id {
+        SIL => 0.95,
+        EST => 0.97,
+        _ => 1.0,
+    };
+    let image = |id: &dyn Fn(u32, u32) -> u32, k: usize| {
+        let ids: Vec<u32> = (0..n as u32).map(|p| id(p % W, p / W)).collect();
+        LodImage {
+            width: W,
+            height: H,
+            colors: colors(k),
+            depths: ids.iter().map(|&i| depth(i)).collect(),
+            ids,
+            flags: vec![3; n],
+            motion: Vec::new(),
+        }
+    };
+    let older = image(&older_id, 0);
+    let newer = image(&newer_id, 3);
+    let mut pattern: Vec<f32> = noise[6 * n..7 * n].to_vec();
+    // Where the silhouette test is checked, the older level is displayed (pattern <= tau 0.5).
+    pattern[at(3, 5)] = 0.1;
+    // The older level's silhouette under this frame's camera: the square from (3, 3) to (10, 9)
+    // in pixels (its texels 4..=9 moved 0.3 texel left by the camera, widened by its edges),
+    // which covers pixel column 3 where the older buffer's read finds background.
+    let (x0, y0, x1, y1) = (3.0, 3.0, 10.0, 9.0);
+    let square = [
+        [x0, y0, x0, y1],
+        [x0, y1, x1, y1],
+        [x1, y1, x1, y0],
+        [x1, y0, x0, y0],
+    ];
+    let camera = Mat4::from_translation(Vec3::new(SHIFT, 0.0, 0.0));
+    let objects = [
+        CombineObjectData {
+            id: SIL,
+            new_to_old: camera,
+            older_tau: Some(0.5),
+            route: CoverageRoute::Silhouette(&square),
+        },
+        CombineObjectData {
+            id: EST,
+            new_to_old: camera,
+            older_tau: None,
+            route: CoverageRoute::Estimate,
+        },
+    ];
+    let data = CombineData::new(&CombineDataDescriptor {
+        new_to_old: camera,
+        height: H,
+        objects: &objects,
+        ..Default::default()
+    })
+    .unwrap();
+    Scene {
+        older,
+        newer,
+        pattern,
+        data,
+    }
+}
+
+fn newer_at(s: &Scene, p: usize) -> CombineNewer {
+    CombineNewer {
+        color: s.newer.colors[p],
+        word: s.newer.word(p),
+        depth: s.newer.depths[p],
+        motion: Vec2::ZERO,
+        pattern: s.pattern[p],
+        level_depth: combine_far_depth(DepthConvention::Standard),
+    }
+}
+
+/// The Rust twins' words for every pixel (the probe's outputs).
+fn twin_words(s: &Scene) -> Vec<u32> {
+    let size = UVec2::new(W, H);
+    let texels = &s.data.texels;
+    (0..W * H)
+        .flat_map(|p| {
+            let px = UVec2::new(p % W, p / W);
+            let newer = newer_at(s, p as usize);
+            let c = combine_pixel(&newer, px, &s.older, texels, DepthConvention::Standard).unwrap();
+            let m = combine_new_to_old(texels, 0);
+            let uv = combine_uv(px, size);
+            let a = reproject(uv, newer.depth, &m).truncate();
+            let read = combine_texel(a, size);
+            let r = combine_read_own(
+                &s.older,
+                SIL,
+                uv,
+                newer.depth,
+                &m,
+                Vec2::ZERO,
+                COMBINE_BLOCK_REACH,
+            );
+            let base = reproject_base(uv, &m);
+            let cover = combine_cover_texel(
+                &s.older,
+                EST,
+                read,
+                base,
+                newer.depth,
+                &m,
+                Vec2::ZERO,
+                COMBINE_COVER_REACH,
+            );
+            let other = combine_other_texel(&s.older, SIL, read, a);
+            let table = combine_object(texels, SIL).silhouette;
+            let covers = silhouette_covers(texels, table, px.as_vec2() + 0.5);
+            let offset = combine_ray_offset(a, read, size);
+            let shown = combine_displayed_word(newer.word, true, 0.5, newer.pattern);
+            let snap = combine_snap(Vec2::new(newer.pattern, 1.0 - newer.pattern * 0.02));
+            let mut w = words(&c.to_array());
+            w.extend([r.texel.x, r.texel.y]);
+            w.extend(words(&r.color.to_array()));
+            w.extend([
+                u32::from(r.found),
+                cover.x,
+                cover.y,
+                other.x,
+                other.y,
+                covers as u32,
+            ]);
+            w.extend(words(&[offset]));
+            w.push(shown);
+            w.extend(words(&[snap.x, snap.y]));
+            w
+        })
+        .collect()
+}
+
+/// Holds the words of one language (or of the Rust twins) to what the scene was made to give,
+/// worked out by hand from its texels (not by the code under test).
+fn check_known(out: &[u32], s: &Scene, who: &str) {
+    let pixel = |x: u32, y: u32| &out[at(x, y) * OUT..(at(x, y) + 1) * OUT];
+    let color = |w: &[u32], k: usize| Vec4::from_slice(&floats(&w[k..k + 4]));
+    let close = |a: Vec4, b: Vec4, tol: f32| (a - b).abs().max_element() <= tol;
+    let older = |x: u32, y: u32| s.older.colors[at(x, y)];
+    // Silhouette: pixel (3, 5) shows background and reads older background at x 3.8; the older
+    // level's silhouette covers it, so it shows that level: its texel (4, 5), 0.7 texel from the
+    // ray (the bilinear blend of texels 3 and 4 keeps only 4, the same object's).
+    let got = color(pixel(3, 5), 0);
+    assert!(
+        close(got, older(4, 5), 1e-5),
+        "{who}: pixel (3, 5) inside the older silhouette shows {got}, not the older level's {}",
+        older(4, 5)
+    );
+    for (x, want) in [(2, 0), (3, 1), (9, 1), (10, 0)] {
+        assert_eq!(
+            pixel(x, 5)[15],
+            want,
+            "{who}: silhouette_covers at pixel ({x}, 5)"
+        );
+    }
+    // On the ray: pixel (14, 3) reads background at x 14.8; the estimated t-instance's texel
+    // (13, 3) lies 1.3 texels from the ray, past COMBINE_COVER_REACH: not taken, and the pixel
+    // keeps its newer color (closer than the background). At pixel (10, 3) the read x 10.8 has
+    // (11, 3) 0.7 texel away: taken.
+    assert_eq!(
+        pixel(14, 3)[11..13],
+        [14, 3],
+        "{who}: cover texel at (14, 3)"
+    );
+    assert_eq!(
+        pixel(10, 3)[11..13],
+        [11, 3],
+        "{who}: cover texel at (10, 3)"
+    );
+    let got = color(pixel(14, 3), 0);
+    let want = s.newer.colors[at(14, 3)];
+    assert!(
+        close(got, want, 1e-5),
+        "{who}: pixel (14, 3) shows {got}, not its newer color {want}"
+    );
+    // The blend: the read of the silhouette t-instance at pixel (5, 5) lies at x 5.8, y on the
+    // texel row's center: 0.7 of texel 5 and 0.3 of texel 6. At (9, 5) (x 9.8) texel 10 is
+    // background: texel 9 alone.
+    let blend = 0.7 * older(5, 5) + 0.3 * older(6, 5);
+    let got = color(pixel(5, 5), 6);
+    assert_eq!(pixel(5, 5)[4..6], [5, 5], "{who}: read texel at (5, 5)");
+    assert!(
+        close(got, blend, 1e-4),
+        "{who}: older color at (5, 5) {got}, not the blend {blend}"
+    );
+    let got = color(pixel(9, 5), 6);
+    assert!(
+        close(got, older(9, 5), 1e-5),
+        "{who}: older color at (9, 5) {got}, not texel 9's {}",
+        older(9, 5)
+    );
+    // The ray offset of every read is 0.3 texel; the snap keeps 0.3 and takes 0.995 as 1.
+    assert!(
+        (f32::from_bits(pixel(0, 0)[16]) - 0.3).abs() < 1e-4,
+        "{who}: ray offset"
+    );
+}
+
+#[test]
+fn combine_coverage_pieces_give_the_hand_made_answers() {
+    let s = scene();
+    check_known(&twin_words(&s), &s, "Rust twins");
+    assert_eq!(combine_snap(Vec2::new(0.995, 0.3)), Vec2::new(1.0, 0.3));
+    // The scene's words are what it says.
+    assert_eq!(lod_buffer_id(s.newer.word(at(14, 3))), EST);
+    assert_eq!(s.newer.word(at(3, 5)), lod_buffer_word(0, 3));
+}
+
+#[test]
+fn combine_coverage_twins_match() {
+    let gpu = lodkit_test_gpu!();
+    let s = scene();
+    let want = twin_words(&s);
+    let inputs: Vec<u32> = (0..W * H)
+        .flat_map(|p| {
+            let i = p as usize;
+            let mut w = vec![p % W, p / W];
+            w.extend(words(&s.newer.colors[i].to_array()));
+            w.push(s.newer.word(i));
+            w.extend(words(&[s.newer.depths[i], s.pattern[i]]));
+            w
+        })
+        .collect();
+    let colors = s.older.colors.clone();
+    let depths: Vec<Vec4> = s.older.depths.iter().map(|d| Vec4::splat(*d)).collect();
+    let ids: Vec<[u32; 4]> = (0..(W * H) as usize)
+        .map(|p| [s.older.word(p), 0, 0, 0])
+        .collect();
+    let wgsl = format!(
+        "let px = vec2(inp_u(0u), inp_u(1u));
+        let size = vec2({W}u, {H}u);
+        let newer = CombineNewer(vec4(inp_f(2u), inp_f(3u), inp_f(4u), inp_f(5u)), inp_u(6u), inp_f(7u), vec2(0.0), inp_f(8u), combine_far_depth());
+        let c = combine_pixel(newer, px, probe_rgba0, probe_urgba0, probe_rgba1, probe_urgba1);
+        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);
+        let m = combine_new_to_old(probe_urgba1, 0u);
+        let uv = combine_uv(px, size);
+        let a = reproject(uv, newer.depth, m).xy;
+        let read = combine_texel(a, size);
+        let r = combine_read_own(probe_rgba0, probe_urgba0, probe_rgba1, {SIL}u, uv, newer.depth, m, vec2(0.0), COMBINE_BLOCK_REACH);
+        out_u(4u, r.texel.x); out_u(5u, r.texel.y);
+        out_f(6u, r.color.x); out_f(7u, r.color.y); out_f(8u, r.color.z); out_f(9u, r.color.w);
+        out_u(10u, u32(r.found));
+        let cover = combine_cover_texel(probe_urgba0, probe_rgba1, {EST}u, read, reproject_base(uv, m), newer.depth, m, vec2(0.0), COMBINE_COVER_REACH);
+        out_u(11u, cover.x); out_u(12u, cover.y);
+        let other = combine_other_texel(probe_urgba0, {SIL}u, read, a);
+        out_u(13u, other.x); out_u(14u, other.y);
+        let table = combine_object(probe_urgba1, {SIL}u).silhouette;
+        out_u(15u, bitcast<u32>(silhouette_covers(probe_urgba1, table, vec2<f32>(px) + 0.5)));
+        out_f(16u, combine_ray_offset(a, read, size));
+        out_u(17u, combine_displayed_word(newer.word, true, 0.5, newer.pattern));
+        let snap = combine_snap(vec2(newer.pattern, 1.0 - newer.pattern * 0.02));
+        out_f(18u, snap.x); out_f(19u, snap.y);"
+    );
+    let glsl = format!(
+        "uvec2 px = uvec2(inp_u(0u), inp_u(1u));
+        uvec2 size = uvec2({W}u, {H}u);
+        lodkit_CombineNewer newer = lodkit_CombineNewer(vec4(inp_f(2u), inp_f(3u), inp_f(4u), inp_f(5u)), inp_u(6u), inp_f(7u), vec2(0.0), inp_f(8u), lodkit_combine_far_depth());
+        vec4 c = lodkit_combine_pixel(newer, px);
+        out_f(0u, c.x); out_f(1u, c.y); out_f(2u, c.z); out_f(3u, c.w);
+        mat4 m = lodkit_combine_new_to_old(0u);
+        vec2 uv = lodkit_combine_uv(px, size);
+        vec2 a = lodkit_reproject(uv, newer.depth, m).xy;
+        uvec2 read = lodkit_combine_texel(a, size);
+        lodkit_CombineRead r = lodkit_combine_read_own({SIL}u, uv, newer.depth, m, vec2(0.0), LODKIT_COMBINE_BLOCK_REACH);
+        out_u(4u, r.texel.x); out_u(5u, r.texel.y);
+        out_f(6u, r.color.x); out_f(7u, r.color.y); out_f(8u, r.color.z); out_f(9u, r.color.w);
+        out_u(10u, uint(r.found));
+        uvec2 cover = lodkit_combine_cover_texel({EST}u, read, lodkit_reproject_base(uv, m), newer.depth, m, vec2(0.0), LODKIT_COMBINE_COVER_REACH);
+        out_u(11u, cover.x); out_u(12u, cover.y);
+        uvec2 other = lodkit_combine_other_texel({SIL}u, read, a);
+        out_u(13u, other.x); out_u(14u, other.y);
+        uvec4 table = lodkit_combine_object({SIL}u).silhouette;
+        out_u(15u, uint(lodkit_silhouette_covers(table, vec2(px) + 0.5)));
+        out_f(16u, lodkit_combine_ray_offset(a, read, size));
+        out_u(17u, lodkit_combine_displayed_word(newer.word, true, 0.5, newer.pattern));
+        vec2 snap = lodkit_combine_snap(vec2(newer.pattern, 1.0 - newer.pattern * 0.02));
+        out_f(18u, snap.x); out_f(19u, snap.y);"
+    );
+    // The GLSL twins read the textures through the hooks the includer defines.
+    let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
+vec4 lodkit_combine_fetch_color(uvec2 t) { return texelFetch(sampler2D(probe_rgba0, probe_sampler), ivec2(t), 0); }
+uint lodkit_combine_fetch_word(uvec2 t) { return texelFetch(usampler2D(probe_urgba0, probe_sampler), ivec2(t), 0).x; }
+float lodkit_combine_fetch_depth(uvec2 t) { return texelFetch(sampler2D(probe_rgba1, probe_sampler), ivec2(t), 0).x; }
+uvec2 lodkit_combine_fetch_size() { return uvec2(textureSize(sampler2D(probe_rgba0, probe_sampler), 0)); }
+uvec4 lodkit_silhouette_fetch(uint i) {
+    uint w = uint(textureSize(usampler2D(probe_urgba1, probe_sampler), 0).x);
+    return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
+}";
+    let wgsl_header = "#import lodkit::combine::{combine_uv, combine_texel, combine_read_own, combine_cover_texel, combine_other_texel, combine_ray_offset, combine_displayed_word, combine_snap, COMBINE_BLOCK_REACH, COMBINE_COVER_REACH}
+#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth}
+#import lodkit::reproject::{reproject, reproject_base}
+#import lodkit::silhouette::silhouette_covers";
+    // Texels, flags and ids exact; colors are sums of at most four weighted texels (weights
+    // products of 1 - f and f): 1e-5 covers a few ulps of each.
+    let mut kinds = vec![Word::Float(1e-5); 4];
+    kinds.extend([Word::Exact; 2]);
+    kinds.extend([Word::Float(1e-5); 4]);
+    kinds.extend([Word::Exact; 6]);
+    kinds.push(Word::Float(1e-5));
+    kinds.push(Word::Exact);
+    kinds.extend([Word::Float(0.0); 2]);
+    // The fragment route on every device (GL 3.3 and WebGL2 class contexts have no compute), and
+    // the compute route where compute shaders work.
+    let mut routes = vec![Route::Fragment];
+    if gpu.capabilities().compute_shaders() {
+        routes.push(Route::Compute);
+    }
+    for (route, (language, header, body)) in routes.iter().flat_map(|&r| {
+        [
+            (SourceLanguage::Wgsl, wgsl_header, wgsl.as_str()),
+            (
+                SourceLanguage::Glsl(naga::ShaderStage::Compute),
+                glsl_header,
+                glsl.as_str(),
+            ),
+        ]
+        .map(|l| (r, l))
+    }) {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 9,
+            outputs: OUT,
+            texture: None,
+            rgba: &[(W, H, &colors), (W, H, &depths)],
+            urgba: &[(W, H, &ids), (s.data.width, s.data.height, &s.data.texels)],
+        };
+        let got = run_on(gpu, route, &probe, &inputs, language, &[]);
+        let who = format!("{route:?} {language:?}");
+        // The hand-made answers first: a change to a piece fails there, not only as a twin
+        // mismatch.
+        check_known(&got, &s, &who);
+        assert_twin(&got, &want, &kinds, &format!("{who} combine_coverage"));
+    }
+}

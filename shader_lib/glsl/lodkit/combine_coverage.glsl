@@ -1,0 +1,268 @@
+// lodkit::combine_coverage — frame-sequential LOD's combine with the older level's coverage
+// known (Scherzer & Wimmer 2008, sec. 3.4; sec. 4 estimates it from the older frame): where the
+// level not drawn this frame covers a pixel, by a route per t-instance given as data, and the
+// per-pixel entry a pass drawn over the levels' silhouettes calls.
+//
+// GLSL twin of shader_lib/wgsl/lodkit/combine_coverage.wgsl; same semantics, `lodkit_` prefix.
+// Routes: the older level's silhouette, an older-level depth pass the host draws, or the estimate
+// from last frame's picture. The data texture (a usampler2D, lodkit::combine_coverage::
+// CombineData in Rust) holds per id a record of LODKIT_COMBINE_RECORD texels at id * 6: the
+// columns of its new_to_old (f32 bits), its silhouette table, then (flags, older_tau bits, record
+// count, 0); record 0 is the frame's; the binned silhouettes follow.
+//
+// Exports:
+//   lodkit_CombineNewer { color, word, depth, motion, pattern, level_depth }   the pixel's newer
+//       texel as the engine read it, its object motion, the screen pattern there, the
+//       older-level depth pass there
+//   lodkit_CombineObject { new_to_old, silhouette, flags, older_tau }   one id's record
+//   LODKIT_COMBINE_RECORD, LODKIT_COMBINE_KNOWN, LODKIT_COMBINE_ANCHORED,
+//       LODKIT_COMBINE_ROUTE_SILHOUETTE, LODKIT_COMBINE_ROUTE_DEPTH_PASS,
+//       LODKIT_COMBINE_OBJECT_MOTION, LODKIT_COMBINE_LEVEL_DEPTH   the layout's flags
+//   lodkit_combine_object(id) -> lodkit_CombineObject   the record of id (unknown past the records)
+//   lodkit_combine_new_to_old(id) -> mat4   the matrix reprojecting a pixel holding id
+//   lodkit_combine_far_depth() -> float   the far clip depth (an older-level depth pass's clear)
+//   lodkit_combine_read_estimated(uv, depth, base, old, new_to_old, motion) -> lodkit_CombineRead
+//   lodkit_combine_read_level_depth(level, id, uv, depth, old, motion) -> lodkit_CombineRead
+//   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   the routes' reads
+//   lodkit_combine_read(newer, pixel, base, old, m) -> lodkit_CombineRead   by the route of what
+//       the pixel shows
+//   lodkit_combine_pixel(newer, pixel) -> vec4   the whole per-pixel combine
+// Hooks: the older buffer through lodkit/combine.glsl's (lodkit_combine_fetch_color, _word,
+//   _depth, _size), the data texture through lodkit/silhouette.glsl's lodkit_silhouette_fetch.
+// Shader defs:
+//   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z); off: 0 near.
+#ifndef LODKIT_COMBINE_COVERAGE_GLSL
+#define LODKIT_COMBINE_COVERAGE_GLSL
+
+#include "lodkit/combine.glsl"
+#include "lodkit/lod_buffer.glsl"
+#include "lodkit/reproject.glsl"
+#include "lodkit/silhouette.glsl"
+
+/// The newer buffer's texel at the pixel being combined, as the engine read it.
+struct lodkit_CombineNewer {
+    vec4 color;
+    /// Id word (lodkit/lod_buffer.glsl).
+    uint word;
+    /// Clip depth.
+    float depth;
+    /// Object motion in texture-space uv (0 without).
+    vec2 motion;
+    /// The visibility pattern at this pixel, anchored to the screen.
+    float pattern;
+    /// The older-level depth pass at this pixel (far where none).
+    float level_depth;
+};
+
+/// One id's record in the data texture.
+struct lodkit_CombineObject {
+    mat4 new_to_old;
+    /// The older level's silhouette table (lodkit_silhouette_covers).
+    uvec4 silhouette;
+    /// LODKIT_COMBINE_* flags (0: an id the combine does not know).
+    uint flags;
+    /// The threshold at which the older level is displayed this frame.
+    float older_tau;
+};
+
+/// Texels per id record in the data texture.
+const uint LODKIT_COMBINE_RECORD = 6u;
+/// Record flag: a t-instance the combine knows.
+const uint LODKIT_COMBINE_KNOWN = 1u;
+/// Record flag: its older level is displayed at older_tau with the screen-anchored pattern.
+const uint LODKIT_COMBINE_ANCHORED = 2u;
+/// Record flag: its older level's coverage is its silhouette.
+const uint LODKIT_COMBINE_ROUTE_SILHOUETTE = 4u;
+/// Record flag: its older level's coverage is the older-level depth pass.
+const uint LODKIT_COMBINE_ROUTE_DEPTH_PASS = 8u;
+/// Frame flag (record 0): lodkit_CombineNewer.motion is each pixel's object motion.
+const uint LODKIT_COMBINE_OBJECT_MOTION = 16u;
+/// Frame flag (record 0): lodkit_CombineNewer.level_depth holds the older-level depth pass.
+const uint LODKIT_COMBINE_LEVEL_DEPTH = 32u;
+
+/// The record of `id` in the data texture; past the records, the frame's matrix and no flags.
+lodkit_CombineObject lodkit_combine_object(uint id) {
+    uint slots = lodkit_silhouette_texel(5u).z;
+    uint k = id < slots ? id : 0u;
+    uint first = k * LODKIT_COMBINE_RECORD;
+    uvec4 record = lodkit_silhouette_texel(first + 5u);
+    mat4 m = mat4(
+        uintBitsToFloat(lodkit_silhouette_texel(first)),
+        uintBitsToFloat(lodkit_silhouette_texel(first + 1u)),
+        uintBitsToFloat(lodkit_silhouette_texel(first + 2u)),
+        uintBitsToFloat(lodkit_silhouette_texel(first + 3u)));
+    return lodkit_CombineObject(m, lodkit_silhouette_texel(first + 4u), k == id ? record.x : 0u, uintBitsToFloat(record.y));
+}
+
+/// The matrix that reprojects a pixel holding `id`: the camera's with
+/// LODKIT_COMBINE_OBJECT_MOTION, else the record's.
+mat4 lodkit_combine_new_to_old(uint id) {
+    lodkit_CombineObject frame = lodkit_combine_object(0u);
+    if ((frame.flags & LODKIT_COMBINE_OBJECT_MOTION) != 0u) {
+        return frame.new_to_old;
+    }
+    return lodkit_combine_object(id).new_to_old;
+}
+
+/// The far clip depth (what an older-level depth pass is cleared to).
+float lodkit_combine_far_depth() {
+#ifdef LODKIT_REVERSE_Z
+    return 0.0;
+#else
+    return 1.0;
+#endif
+}
+
+/// The estimated read of a pixel showing no known t-instance; a known t-instance's texel only
+/// where its route is the estimate and its sample lies on the pixel's ray under its own matrix.
+lodkit_CombineRead lodkit_combine_read_estimated(vec2 uv, float depth, vec4 base, vec3 old, mat4 new_to_old, vec2 motion) {
+    uvec2 size = lodkit_combine_fetch_size();
+    vec2 first = old.xy + motion;
+    vec2 refined = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(lodkit_combine_texel(first, size)), new_to_old).xy + motion;
+    uvec2 read = lodkit_combine_texel(lodkit_in_viewport(refined) ? refined : first, size);
+    uint g = lodkit_lod_buffer_id(lodkit_combine_fetch_word(read));
+    lodkit_CombineObject object = lodkit_combine_object(g);
+    if (g != 0u && (object.flags & LODKIT_COMBINE_KNOWN) != 0u) {
+        if ((object.flags & (LODKIT_COMBINE_ROUTE_SILHOUETTE | LODKIT_COMBINE_ROUTE_DEPTH_PASS)) != 0u) {
+            return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
+        }
+        mat4 m = object.new_to_old;
+        vec2 ray = lodkit_reproject_refine(lodkit_reproject_base(uv, m), depth, lodkit_combine_fetch_depth(read), m).xy;
+        if (lodkit_combine_ray_offset(ray, read, size) >= LODKIT_COMBINE_COVER_REACH) {
+            return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
+        }
+    }
+    return lodkit_CombineRead(read, lodkit_combine_fetch_color(read), true);
+}
+
+/// Whether `g` names a t-instance the combine knows.
+#define LODKIT_COMBINE_IS_KNOWN_(g) ((g) != 0u && (lodkit_combine_object(g).flags & LODKIT_COMBINE_KNOWN) != 0u)
+
+/// The read with the older-level depth pass (`level` at the pixel) for a pixel showing `id`:
+/// the level drawn there read where its surface was, else what lies behind `id`'s own level.
+lodkit_CombineRead lodkit_combine_read_level_depth(float level, uint id, vec2 uv, float depth, vec3 old, vec2 motion) {
+    uvec2 size = lodkit_combine_fetch_size();
+    bool covered = lodkit_depth_closer(level, lodkit_combine_far_depth());
+    uint owner = id;
+    if (covered && (id == 0u || lodkit_depth_closer(level, depth))) {
+        vec2 at = lodkit_reproject(uv, level, lodkit_combine_new_to_old(id)).xy + motion;
+        uvec2 read = lodkit_combine_texel(at, size);
+        uint g = lodkit_lod_buffer_id(lodkit_combine_fetch_word(read));
+        if (LODKIT_COMBINE_IS_KNOWN_(g)) {
+            owner = g;
+        } else if (id == 0u) {
+            uint o = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_other_texel(0u, read, at)));
+            owner = LODKIT_COMBINE_IS_KNOWN_(o) ? o : 0u;
+        }
+    }
+    if (owner == 0u) {
+        return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
+    }
+    if (covered) {
+        mat4 m = lodkit_combine_new_to_old(owner);
+        vec4 base = lodkit_reproject_base(uv, m);
+        vec2 at = lodkit_reproject_from_base(base, level, m).xy + motion;
+        uvec2 texel = lodkit_combine_texel(at, size);
+        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) != owner) {
+            texel = lodkit_combine_cover_texel(owner, texel, base, level, m, motion, LODKIT_COMBINE_BLOCK_REACH);
+        }
+        vec4 color = lodkit_combine_fetch_color(texel);
+        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == owner) {
+            color = lodkit_combine_own_color(owner, at, color);
+        }
+        return lodkit_CombineRead(texel, color, true);
+    }
+    vec2 at = old.xy + motion;
+    uvec2 texel = lodkit_combine_other_texel(owner, lodkit_combine_texel(at, size), at);
+    return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
+}
+
+/// For a pixel showing no t-instance: the read of the first t-instance whose older silhouette
+/// covers the pixel center `p` (on it: as last frame's picture has it); none: not found.
+lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p) {
+    uvec2 size = lodkit_combine_fetch_size();
+    uint slots = lodkit_silhouette_texel(5u).z;
+    uint wanted = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_SILHOUETTE;
+    for (uint g = 1u; g < slots; g++) {
+        if ((lodkit_silhouette_texel(g * LODKIT_COMBINE_RECORD + 5u).x & wanted) != wanted) {
+            continue;
+        }
+        int covers = lodkit_silhouette_covers(lodkit_silhouette_texel(g * LODKIT_COMBINE_RECORD + 4u), p);
+        if (covers == 0) {
+            continue;
+        }
+        mat4 m = lodkit_combine_object(g).new_to_old;
+        if (covers == LODKIT_SILHOUETTE_ON) {
+            vec2 at = lodkit_reproject(uv, depth, m).xy;
+            bool hit = lodkit_in_viewport(at) && lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(at, size))) == g;
+            covers = hit ? 1 : 0;
+        }
+        if (covers == 1) {
+            return lodkit_combine_read_own(g, uv, depth, m, vec2(0.0), LODKIT_COMBINE_BLOCK_REACH);
+        }
+    }
+    return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
+}
+
+/// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
+/// (estimated without one); else the depth pass's level, a covering silhouette, the estimate.
+lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, vec4 base, vec3 old, mat4 m) {
+    uvec2 size = lodkit_combine_fetch_size();
+    uint id = lodkit_lod_buffer_id(newer.word);
+    vec2 uv = lodkit_combine_uv(pixel, size);
+    vec2 p = vec2(pixel) + 0.5;
+    lodkit_CombineObject object = lodkit_combine_object(id);
+    uint silhouette = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_SILHOUETTE;
+    uint depth_pass = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_DEPTH_PASS;
+    if (id != 0u) {
+        if ((object.flags & silhouette) == silhouette) {
+            int own = lodkit_silhouette_covers(object.silhouette, p);
+            if (own == LODKIT_SILHOUETTE_ON) {
+                own = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(old.xy + newer.motion, size))) == id ? 1 : 0;
+            }
+            if (own == 1) {
+                return lodkit_combine_read_own(id, uv, newer.depth, m, newer.motion, LODKIT_COMBINE_BLOCK_REACH);
+            }
+            vec2 at = old.xy + newer.motion;
+            uvec2 texel = lodkit_combine_other_texel(id, lodkit_combine_texel(at, size), at);
+            return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
+        }
+        if ((object.flags & depth_pass) == depth_pass) {
+            return lodkit_combine_read_level_depth(newer.level_depth, id, uv, newer.depth, old, newer.motion);
+        }
+        return lodkit_combine_read_own(id, uv, newer.depth, m, newer.motion, LODKIT_COMBINE_COVER_REACH);
+    }
+    lodkit_CombineObject frame = lodkit_combine_object(0u);
+    if ((frame.flags & LODKIT_COMBINE_LEVEL_DEPTH) != 0u && lodkit_depth_closer(newer.level_depth, lodkit_combine_far_depth())) {
+        return lodkit_combine_read_level_depth(newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
+    }
+    lodkit_CombineRead r = lodkit_combine_read_silhouettes(uv, newer.depth, p);
+    if (r.found) {
+        return r;
+    }
+    return lodkit_combine_read_estimated(uv, newer.depth, base, old, m, newer.motion);
+}
+
+/// The per-pixel combine with the older level's coverage known, for a pass drawn over the
+/// levels' silhouettes: `newer` as read at `pixel`; the older buffer and the data texture through
+/// the hooks. No older level found: the newer color; else lodkit_combine_texels.
+vec4 lodkit_combine_pixel(lodkit_CombineNewer newer, uvec2 pixel) {
+    uvec2 size = lodkit_combine_fetch_size();
+    mat4 m = lodkit_combine_new_to_old(lodkit_lod_buffer_id(newer.word));
+    vec4 base = lodkit_reproject_base(lodkit_combine_uv(pixel, size), m);
+    vec3 old = lodkit_reproject_from_base(base, newer.depth, m);
+    if (!lodkit_in_viewport(old.xy)) {
+        return newer.color;
+    }
+    lodkit_CombineRead read = lodkit_combine_read(newer, pixel, base, old, m);
+    if (!read.found) {
+        return newer.color;
+    }
+    uint word = lodkit_combine_fetch_word(read.texel);
+    lodkit_CombineObject o = lodkit_combine_object(lodkit_lod_buffer_id(word));
+    uint anchored = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ANCHORED;
+    uint shown = lodkit_combine_displayed_word(word, (o.flags & anchored) == anchored, o.older_tau, newer.pattern);
+    return lodkit_combine_texels(newer.color, newer.word, old, read.color, shown, lodkit_combine_fetch_depth(read.texel));
+}
+
+#endif // LODKIT_COMBINE_COVERAGE_GLSL

@@ -1,0 +1,263 @@
+// lodkit::combine_coverage — frame-sequential LOD's combine with the older level's coverage
+// known (Scherzer & Wimmer 2008, sec. 3.4; sec. 4 estimates it from the older frame): where the
+// level not drawn this frame covers a pixel, by a route per t-instance given as data, and the
+// per-pixel entry a pass drawn over the levels' silhouettes calls.
+//
+// Routes: the older level's silhouette (its winding number, lodkit::silhouette), an older-level
+// depth pass the host draws, or the estimate from last frame's picture. The data texture
+// (texture_2d<u32>, lodkit::combine_coverage::CombineData in Rust; what GL 3.3 and WebGL2 read,
+// unlike a storage buffer) holds per id a record of COMBINE_RECORD texels at id * 6: the columns
+// of its new_to_old (f32 bits), its silhouette table (lodkit::silhouette::silhouette_covers),
+// then (flags, older_tau bits, record count, 0); record 0 is the frame's (the camera's matrix,
+// COMBINE_OBJECT_MOTION, COMBINE_LEVEL_DEPTH, the record count); the binned silhouettes follow.
+//
+// Exports:
+//   CombineNewer { color, word, depth, motion, pattern, level_depth }   the pixel's newer texel
+//       as the engine read it, its object motion, the screen pattern there, the older-level
+//       depth pass there
+//   CombineObject { new_to_old, silhouette, flags, older_tau }   one id's record
+//   COMBINE_RECORD, COMBINE_KNOWN, COMBINE_ANCHORED, COMBINE_ROUTE_SILHOUETTE,
+//       COMBINE_ROUTE_DEPTH_PASS, COMBINE_OBJECT_MOTION, COMBINE_LEVEL_DEPTH   the layout's flags
+//   combine_object(data, id) -> CombineObject   the record of id (unknown past the records)
+//   combine_new_to_old(data, id) -> mat4x4<f32>   the matrix reprojecting a pixel holding id
+//   combine_far_depth() -> f32   the far clip depth (an older-level depth pass's clear)
+//   combine_read_estimated(older_color, older_id, older_depth, data, uv, depth, base, old,
+//       new_to_old, motion) -> CombineRead   a pixel showing no known t-instance, estimated
+//   combine_read_level_depth(older_color, older_id, older_depth, data, level, id, uv, depth, old,
+//       motion) -> CombineRead   by the older-level depth pass
+//   combine_read_silhouettes(older_color, older_id, older_depth, data, uv, depth, p)
+//       -> CombineRead   a pixel showing no t-instance, covered by a level's silhouette
+//   combine_read(older_color, older_id, older_depth, data, newer, pixel, base, old, m)
+//       -> CombineRead   by the route of what the pixel shows
+//   combine_pixel(newer, pixel, older_color, older_id, older_depth, data) -> vec4<f32>   the
+//       whole per-pixel combine (older depth: the depth attachment as texture_2d<f32>)
+// Shader defs:
+//   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z); off: 0 near.
+#define_import_path lodkit::combine_coverage
+#import lodkit::combine::{CombineRead, COMBINE_COVER_REACH, COMBINE_BLOCK_REACH, combine_texel, combine_uv, combine_texels, combine_ray_offset, combine_cover_texel, combine_own_color, combine_other_texel, combine_read_own, combine_displayed_word, depth_closer}
+#import lodkit::lod_buffer::lod_buffer_id
+#import lodkit::reproject::{reproject, reproject_base, reproject_from_base, reproject_refine, in_viewport}
+#import lodkit::silhouette::{silhouette_texel, silhouette_covers, SILHOUETTE_ON}
+
+/// The newer buffer's texel at the pixel being combined, as the engine read it.
+struct CombineNewer {
+    color: vec4<f32>,
+    /// Id word (lodkit::lod_buffer).
+    word: u32,
+    /// Clip depth.
+    depth: f32,
+    /// Object motion in texture-space uv (0 without).
+    motion: vec2<f32>,
+    /// The visibility pattern at this pixel, anchored to the screen
+    /// (lodkit::visibility::visibility_screen_texel).
+    pattern: f32,
+    /// The older-level depth pass at this pixel (far where none; read with COMBINE_LEVEL_DEPTH).
+    level_depth: f32,
+}
+
+/// One id's record in the data texture.
+struct CombineObject {
+    new_to_old: mat4x4<f32>,
+    /// The older level's silhouette table (silhouette_covers).
+    silhouette: vec4<u32>,
+    /// COMBINE_* flags (0: an id the combine does not know).
+    flags: u32,
+    /// The threshold at which the older level is displayed this frame.
+    older_tau: f32,
+}
+
+/// Texels per id record in the data texture.
+const COMBINE_RECORD: u32 = 6u;
+/// Record flag: a t-instance the combine knows.
+const COMBINE_KNOWN: u32 = 1u;
+/// Record flag: its older level is displayed at older_tau with the screen-anchored pattern.
+const COMBINE_ANCHORED: u32 = 2u;
+/// Record flag: its older level's coverage is its silhouette.
+const COMBINE_ROUTE_SILHOUETTE: u32 = 4u;
+/// Record flag: its older level's coverage is the older-level depth pass.
+const COMBINE_ROUTE_DEPTH_PASS: u32 = 8u;
+/// Frame flag (record 0): CombineNewer.motion is each pixel's object motion.
+const COMBINE_OBJECT_MOTION: u32 = 16u;
+/// Frame flag (record 0): CombineNewer.level_depth holds the older-level depth pass.
+const COMBINE_LEVEL_DEPTH: u32 = 32u;
+
+/// The record of `id` in the data texture; past the records, the frame's matrix and no flags.
+fn combine_object(data: texture_2d<u32>, id: u32) -> CombineObject {
+    let slots = silhouette_texel(data, 5u).z;
+    let k = select(0u, id, id < slots);
+    let first = k * COMBINE_RECORD;
+    let record = silhouette_texel(data, first + 5u);
+    let m = mat4x4<f32>(
+        bitcast<vec4<f32>>(silhouette_texel(data, first)),
+        bitcast<vec4<f32>>(silhouette_texel(data, first + 1u)),
+        bitcast<vec4<f32>>(silhouette_texel(data, first + 2u)),
+        bitcast<vec4<f32>>(silhouette_texel(data, first + 3u)),
+    );
+    return CombineObject(m, silhouette_texel(data, first + 4u), select(0u, record.x, k == id), bitcast<f32>(record.y));
+}
+
+/// The matrix that reprojects a pixel holding `id`: the camera's with COMBINE_OBJECT_MOTION,
+/// else the record's.
+fn combine_new_to_old(data: texture_2d<u32>, id: u32) -> mat4x4<f32> {
+    let frame = combine_object(data, 0u);
+    if ((frame.flags & COMBINE_OBJECT_MOTION) != 0u) {
+        return frame.new_to_old;
+    }
+    return combine_object(data, id).new_to_old;
+}
+
+/// The far clip depth (what an older-level depth pass is cleared to).
+fn combine_far_depth() -> f32 {
+#ifdef LODKIT_REVERSE_Z
+    return 0.0;
+#else
+    return 1.0;
+#endif
+}
+
+/// The estimated read of a pixel showing no known t-instance; a known t-instance's texel only
+/// where its route is the estimate and its sample lies on the pixel's ray under its own matrix.
+fn combine_read_estimated(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, uv: vec2<f32>, depth: f32, base: vec4<f32>, old: vec3<f32>, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> CombineRead {
+    let size = textureDimensions(older_color, 0);
+    let first = old.xy + motion;
+    let refined = reproject_refine(base, depth, textureLoad(older_depth, combine_texel(first, size), 0).x, new_to_old).xy + motion;
+    let read = combine_texel(select(first, refined, in_viewport(refined)), size);
+    let g = lod_buffer_id(textureLoad(older_id, read, 0).x);
+    let object = combine_object(data, g);
+    if (g != 0u && (object.flags & COMBINE_KNOWN) != 0u) {
+        if ((object.flags & (COMBINE_ROUTE_SILHOUETTE | COMBINE_ROUTE_DEPTH_PASS)) != 0u) {
+            return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
+        }
+        let m = object.new_to_old;
+        let ray = reproject_refine(reproject_base(uv, m), depth, textureLoad(older_depth, read, 0).x, m).xy;
+        if (combine_ray_offset(ray, read, size) >= COMBINE_COVER_REACH) {
+            return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
+        }
+    }
+    return CombineRead(read, textureLoad(older_color, read, 0), true);
+}
+
+/// The read with the older-level depth pass (`level` at the pixel) for a pixel showing `id`:
+/// the level drawn there read where its surface was, else what lies behind `id`'s own level.
+fn combine_read_level_depth(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, level: f32, id: u32, uv: vec2<f32>, depth: f32, old: vec3<f32>, motion: vec2<f32>) -> CombineRead {
+    let size = textureDimensions(older_color, 0);
+    let covered = depth_closer(level, combine_far_depth());
+    var owner = id;
+    if (covered && (id == 0u || depth_closer(level, depth))) {
+        let at = reproject(uv, level, combine_new_to_old(data, id)).xy + motion;
+        let read = combine_texel(at, size);
+        let g = lod_buffer_id(textureLoad(older_id, read, 0).x);
+        if (g != 0u && (combine_object(data, g).flags & COMBINE_KNOWN) != 0u) {
+            owner = g;
+        } else if (id == 0u) {
+            let o = lod_buffer_id(textureLoad(older_id, combine_other_texel(older_id, 0u, read, at), 0).x);
+            owner = select(0u, o, o != 0u && (combine_object(data, o).flags & COMBINE_KNOWN) != 0u);
+        }
+    }
+    if (owner == 0u) {
+        return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
+    }
+    if (covered) {
+        let m = combine_new_to_old(data, owner);
+        let base = reproject_base(uv, m);
+        let at = reproject_from_base(base, level, m).xy + motion;
+        var texel = combine_texel(at, size);
+        if (lod_buffer_id(textureLoad(older_id, texel, 0).x) != owner) {
+            texel = combine_cover_texel(older_id, older_depth, owner, texel, base, level, m, motion, COMBINE_BLOCK_REACH);
+        }
+        var color = textureLoad(older_color, texel, 0);
+        if (lod_buffer_id(textureLoad(older_id, texel, 0).x) == owner) {
+            color = combine_own_color(older_color, older_id, owner, at, color);
+        }
+        return CombineRead(texel, color, true);
+    }
+    let at = old.xy + motion;
+    let texel = combine_other_texel(older_id, owner, combine_texel(at, size), at);
+    return CombineRead(texel, textureLoad(older_color, texel, 0), true);
+}
+
+/// For a pixel showing no t-instance: the read of the first t-instance whose older silhouette
+/// covers the pixel center `p` (on it: as last frame's picture has it); none: not found.
+fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, uv: vec2<f32>, depth: f32, p: vec2<f32>) -> CombineRead {
+    let size = textureDimensions(older_color, 0);
+    let slots = silhouette_texel(data, 5u).z;
+    let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
+    for (var g = 1u; g < slots; g++) {
+        if ((silhouette_texel(data, g * COMBINE_RECORD + 5u).x & wanted) != wanted) {
+            continue;
+        }
+        var covers = silhouette_covers(data, silhouette_texel(data, g * COMBINE_RECORD + 4u), p);
+        if (covers == 0) {
+            continue;
+        }
+        let m = combine_object(data, g).new_to_old;
+        if (covers == SILHOUETTE_ON) {
+            let at = reproject(uv, depth, m).xy;
+            let hit = in_viewport(at) && lod_buffer_id(textureLoad(older_id, combine_texel(at, size), 0).x) == g;
+            covers = select(0, 1, hit);
+        }
+        if (covers == 1) {
+            return combine_read_own(older_color, older_id, older_depth, g, uv, depth, m, vec2<f32>(0.0), COMBINE_BLOCK_REACH);
+        }
+    }
+    return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
+}
+
+/// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
+/// (estimated without one); else the depth pass's level, a covering silhouette, the estimate.
+fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, newer: CombineNewer, pixel: vec2<u32>, base: vec4<f32>, old: vec3<f32>, m: mat4x4<f32>) -> CombineRead {
+    let size = textureDimensions(older_color, 0);
+    let id = lod_buffer_id(newer.word);
+    let uv = combine_uv(pixel, size);
+    let p = vec2<f32>(pixel) + 0.5;
+    let object = combine_object(data, id);
+    if (id != 0u) {
+        if ((object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)) == (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)) {
+            var own = silhouette_covers(data, object.silhouette, p);
+            if (own == SILHOUETTE_ON) {
+                own = select(0, 1, lod_buffer_id(textureLoad(older_id, combine_texel(old.xy + newer.motion, size), 0).x) == id);
+            }
+            if (own == 1) {
+                return combine_read_own(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion, COMBINE_BLOCK_REACH);
+            }
+            let at = old.xy + newer.motion;
+            let texel = combine_other_texel(older_id, id, combine_texel(at, size), at);
+            return CombineRead(texel, textureLoad(older_color, texel, 0), true);
+        }
+        if ((object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) == (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) {
+            return combine_read_level_depth(older_color, older_id, older_depth, data, newer.level_depth, id, uv, newer.depth, old, newer.motion);
+        }
+        return combine_read_own(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion, COMBINE_COVER_REACH);
+    }
+    let frame = combine_object(data, 0u);
+    if ((frame.flags & COMBINE_LEVEL_DEPTH) != 0u && depth_closer(newer.level_depth, combine_far_depth())) {
+        return combine_read_level_depth(older_color, older_id, older_depth, data, newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
+    }
+    let r = combine_read_silhouettes(older_color, older_id, older_depth, data, uv, newer.depth, p);
+    if (r.found) {
+        return r;
+    }
+    return combine_read_estimated(older_color, older_id, older_depth, data, uv, newer.depth, base, old, m, newer.motion);
+}
+
+/// The per-pixel combine with the older level's coverage known, for a pass drawn over the
+/// levels' silhouettes: `newer` as read at `pixel`, the older color, id words and depth, the
+/// frame's `data`. No older level found: the newer color; else combine_texels.
+fn combine_pixel(newer: CombineNewer, pixel: vec2<u32>, older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>) -> vec4<f32> {
+    let size = textureDimensions(older_color, 0);
+    let m = combine_new_to_old(data, lod_buffer_id(newer.word));
+    let base = reproject_base(combine_uv(pixel, size), m);
+    let old = reproject_from_base(base, newer.depth, m);
+    if (!in_viewport(old.xy)) {
+        return newer.color;
+    }
+    let read = combine_read(older_color, older_id, older_depth, data, newer, pixel, base, old, m);
+    if (!read.found) {
+        return newer.color;
+    }
+    let word = textureLoad(older_id, read.texel, 0).x;
+    let o = combine_object(data, lod_buffer_id(word));
+    let anchored = (o.flags & (COMBINE_KNOWN | COMBINE_ANCHORED)) == (COMBINE_KNOWN | COMBINE_ANCHORED);
+    let shown = combine_displayed_word(word, anchored, o.older_tau, newer.pattern);
+    return combine_texels(newer.color, newer.word, old, read.color, shown, textureLoad(older_depth, read.texel, 0).x);
+}

@@ -1,0 +1,386 @@
+//! Frame-sequential LOD's combine with the older level's coverage known: Rust twins of
+//! `lodkit::combine_coverage` ([`combine_pixel`] and its routes), and the data texture the shader
+//! reads ([`CombineData`]).
+//!
+//! Where the level not drawn this frame covers a pixel is known per t-instance, by a
+//! [`CoverageRoute`] given as data: its silhouette's winding number
+//! ([`silhouette_covers`](crate::silhouette::silhouette_covers)), an older-level depth pass the
+//! host draws, or the estimate from last frame's picture alone (the paper's). A pass drawn over
+//! the levels' silhouettes ([`silhouette_hull`](crate::silhouette::silhouette_hull)) calls the
+//! shader's `combine_pixel` at each of its pixels.
+
+use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
+
+use crate::combine::older::{NOT_FOUND, depth_at, found, id_at, index_of, size_of};
+use crate::combine::{
+    COMBINE_BLOCK_REACH, COMBINE_COVER_REACH, CombineRead, DepthConvention, LodImage,
+    combine_cover_texel, combine_displayed_word, combine_other_texel, combine_own_color,
+    combine_ray_offset, combine_read_own, combine_texel, combine_texels, combine_uv, depth_closer,
+};
+use crate::lod_buffer::lod_buffer_id;
+use crate::reproject::{
+    in_viewport, reproject, reproject_base, reproject_from_base, reproject_refine,
+};
+use crate::silhouette::{SILHOUETTE_ON, silhouette_covers, silhouette_texel};
+
+mod data;
+pub use data::{
+    COMBINE_DATA_WIDTH, CombineData, CombineDataDescriptor, CombineDataError, CombineObjectData,
+    CoverageRoute,
+};
+
+/// Texels per id in the data texture ([`CombineData`]): the record of t-instance `id` starts at
+/// `id * 6`.
+pub const COMBINE_RECORD: u32 = 6;
+
+/// Record flag: the record describes a t-instance the combine knows (record 0, the frame's, has
+/// it too).
+pub const COMBINE_KNOWN: u32 = 1;
+/// Record flag: the older level is displayed at the record's `older_tau` with the visibility
+/// pattern anchored to the screen ([`combine_displayed_word`]).
+pub const COMBINE_ANCHORED: u32 = 2;
+/// Record flag: the older level's coverage is its silhouette (the record's table).
+pub const COMBINE_ROUTE_SILHOUETTE: u32 = 4;
+/// Record flag: the older level's coverage is the older-level depth pass.
+pub const COMBINE_ROUTE_DEPTH_PASS: u32 = 8;
+/// Frame flag (record 0): [`CombineNewer::motion`] is each pixel's object motion (a LOD pass's
+/// or an engine's motion vectors); without it each t-instance is reprojected with its record's
+/// matrix.
+pub const COMBINE_OBJECT_MOTION: u32 = 16;
+/// Frame flag (record 0): [`CombineNewer::level_depth`] holds the older-level depth pass.
+pub const COMBINE_LEVEL_DEPTH: u32 = 32;
+
+/// The newer buffer's texel at the pixel being combined, as the engine read it (mirror of WGSL
+/// `CombineNewer`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CombineNewer {
+    /// Color.
+    pub color: Vec4,
+    /// Id word (`lodkit::lod_buffer`: instance id and display flags).
+    pub word: u32,
+    /// Clip depth.
+    pub depth: f32,
+    /// Object motion in texture-space uv (0 where nothing moves by itself or without motion).
+    pub motion: Vec2,
+    /// The visibility pattern's value at this pixel, anchored to the screen
+    /// (`lodkit::visibility::visibility_screen_texel`): where the older level of an anchored
+    /// record is displayed.
+    pub pattern: f32,
+    /// The older-level depth pass at this pixel (its far depth where none is drawn; read only
+    /// with [`COMBINE_LEVEL_DEPTH`]).
+    pub level_depth: f32,
+}
+
+/// One id's record in the data texture (mirror of WGSL `CombineObject`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CombineObject {
+    /// This frame's clip space to last frame's for the id's points.
+    pub new_to_old: Mat4,
+    /// The older level's silhouette table (`lodkit::silhouette::bin_silhouette`).
+    pub silhouette: UVec4,
+    /// `COMBINE_*` flags.
+    pub flags: u32,
+    /// The threshold at which the older level is displayed this frame.
+    pub older_tau: f32,
+}
+
+/// The record of `id` in the data texture; for an id past the records, the frame's matrix with
+/// no flags (a t-instance the combine does not know).
+pub fn combine_object(data: &[[u32; 4]], id: u32) -> CombineObject {
+    let slots = silhouette_texel(data, 5).z;
+    let k = if id < slots { id } else { 0 };
+    let texel = |i: u32| silhouette_texel(data, k * COMBINE_RECORD + i);
+    let column = |i: u32| Vec4::from_array(texel(i).to_array().map(f32::from_bits));
+    let record = texel(5);
+    CombineObject {
+        new_to_old: Mat4::from_cols(column(0), column(1), column(2), column(3)),
+        silhouette: texel(4),
+        flags: if k == id { record.x } else { 0 },
+        older_tau: f32::from_bits(record.y),
+    }
+}
+
+/// The matrix that reprojects a pixel holding `id` (0: the camera's): the camera's where
+/// [`CombineNewer::motion`] is the object motion ([`COMBINE_OBJECT_MOTION`]), else the record's.
+pub fn combine_new_to_old(data: &[[u32; 4]], id: u32) -> Mat4 {
+    let frame = combine_object(data, 0);
+    if frame.flags & COMBINE_OBJECT_MOTION != 0 {
+        frame.new_to_old
+    } else {
+        combine_object(data, id).new_to_old
+    }
+}
+
+/// The far clip depth under the depth convention (what an older-level depth pass is cleared to).
+pub fn combine_far_depth(convention: DepthConvention) -> f32 {
+    match convention {
+        DepthConvention::Standard => 1.0,
+        DepthConvention::Reversed => 0.0,
+    }
+}
+
+/// The older read, estimated from last frame's picture, of a pixel that shows no t-instance the
+/// combine knows (`base` and `old`: the pixel's reprojection with `new_to_old`, moved by
+/// `motion`): refined at whatever older surface it finds. Where the read holds a t-instance whose
+/// coverage is known (silhouette or depth pass), that level does not cover the pixel: not found;
+/// where it holds an estimated one, it is taken only where its sample lies on the pixel's ray
+/// under that t-instance's own matrix (a group that moved away leaves no trace).
+#[allow(clippy::too_many_arguments)]
+pub fn combine_read_estimated(
+    older: &LodImage,
+    data: &[[u32; 4]],
+    uv: Vec2,
+    depth: f32,
+    base: Vec4,
+    old: Vec3,
+    new_to_old: &Mat4,
+    motion: Vec2,
+) -> CombineRead {
+    let size = size_of(older);
+    let first = old.truncate() + motion;
+    let first_depth = depth_at(older, combine_texel(first, size));
+    let refined = reproject_refine(base, depth, first_depth, new_to_old).truncate() + motion;
+    let read = combine_texel(if in_viewport(refined) { refined } else { first }, size);
+    let g = id_at(older, read);
+    let object = combine_object(data, g);
+    if g != 0 && object.flags & COMBINE_KNOWN != 0 {
+        if object.flags & (COMBINE_ROUTE_SILHOUETTE | COMBINE_ROUTE_DEPTH_PASS) != 0 {
+            return NOT_FOUND;
+        }
+        let m = object.new_to_old;
+        let ray = reproject_refine(reproject_base(uv, &m), depth, depth_at(older, read), &m);
+        if combine_ray_offset(ray.truncate(), read, size) >= COMBINE_COVER_REACH {
+            return NOT_FOUND;
+        }
+    }
+    found(older, read)
+}
+
+/// The older read with the older-level depth pass (`level`: its depth at the pixel, far where
+/// none): for a pixel showing `id` (0: none), its newer `depth`, the reprojection `old` of that
+/// depth and the object `motion`. Where a level is drawn, its owner is the pixel's own
+/// t-instance, or the t-instance the older buffer holds where that level's depth reprojects when
+/// it lies in front; read where its own surface was. Where none is, what lies behind the
+/// pixel's own older level.
+#[allow(clippy::too_many_arguments)]
+pub fn combine_read_level_depth(
+    older: &LodImage,
+    data: &[[u32; 4]],
+    level: f32,
+    id: u32,
+    uv: Vec2,
+    depth: f32,
+    old: Vec3,
+    motion: Vec2,
+    convention: DepthConvention,
+) -> CombineRead {
+    let size = size_of(older);
+    let covered = depth_closer(level, combine_far_depth(convention), convention);
+    let known = |g: u32| g != 0 && combine_object(data, g).flags & COMBINE_KNOWN != 0;
+    let mut owner = id;
+    if covered && (id == 0 || depth_closer(level, depth, convention)) {
+        let read_at = reproject(uv, level, &combine_new_to_old(data, id)).truncate() + motion;
+        let read = combine_texel(read_at, size);
+        if known(id_at(older, read)) {
+            owner = id_at(older, read);
+        } else if id == 0 {
+            let t = combine_other_texel(older, 0, read, read_at);
+            owner = if known(id_at(older, t)) {
+                id_at(older, t)
+            } else {
+                0
+            };
+        }
+    }
+    if owner == 0 {
+        return NOT_FOUND;
+    }
+    if covered {
+        let m = combine_new_to_old(data, owner);
+        let base = reproject_base(uv, &m);
+        let read_at = reproject_from_base(base, level, &m).truncate() + motion;
+        let read = combine_texel(read_at, size);
+        let mut texel = read;
+        if id_at(older, read) != owner {
+            texel = combine_cover_texel(
+                older,
+                owner,
+                read,
+                base,
+                level,
+                &m,
+                motion,
+                COMBINE_BLOCK_REACH,
+            );
+        }
+        let mut r = found(older, texel);
+        if id_at(older, texel) == owner {
+            r.color = combine_own_color(older, owner, read_at, r.color);
+        }
+        return r;
+    }
+    let read_at = old.truncate() + motion;
+    found(
+        older,
+        combine_other_texel(older, owner, combine_texel(read_at, size), read_at),
+    )
+}
+
+/// For a pixel that shows no t-instance: the older read of the first t-instance whose older
+/// level's silhouette covers the pixel center `p` (pixels), read with that t-instance's own matrix
+/// and no motion (such a pixel has none of its own); not found where none does. A center on a
+/// silhouette ([`SILHOUETTE_ON`]) is covered as last frame's picture has it.
+pub fn combine_read_silhouettes(
+    older: &LodImage,
+    data: &[[u32; 4]],
+    uv: Vec2,
+    depth: f32,
+    p: Vec2,
+) -> CombineRead {
+    let size = size_of(older);
+    let slots = silhouette_texel(data, 5).z;
+    let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
+    for g in 1..slots {
+        if silhouette_texel(data, g * COMBINE_RECORD + 5).x & wanted != wanted {
+            continue;
+        }
+        let table = silhouette_texel(data, g * COMBINE_RECORD + 4);
+        let mut covers = silhouette_covers(data, table, p);
+        if covers == 0 {
+            continue;
+        }
+        let m = combine_object(data, g).new_to_old;
+        if covers == SILHOUETTE_ON {
+            let read_at = reproject(uv, depth, &m).truncate();
+            let hit = in_viewport(read_at) && id_at(older, combine_texel(read_at, size)) == g;
+            covers = i32::from(hit);
+        }
+        if covers == 1 {
+            return combine_read_own(older, g, uv, depth, &m, Vec2::ZERO, COMBINE_BLOCK_REACH);
+        }
+    }
+    NOT_FOUND
+}
+
+/// The older read of the pixel `pixel` showing `newer`, by the coverage route of what it shows
+/// (`m`, `base`, `old`: its reprojection, [`combine_new_to_old`]): a t-instance's own older
+/// level by its record's route (its silhouette, the depth pass, or estimated; estimated for a
+/// t-instance without a record); for a pixel showing none, a level the depth pass drew there,
+/// else a level whose silhouette covers it, else the estimate.
+#[allow(clippy::too_many_arguments)]
+pub fn combine_read(
+    older: &LodImage,
+    data: &[[u32; 4]],
+    newer: &CombineNewer,
+    pixel: UVec2,
+    base: Vec4,
+    old: Vec3,
+    m: &Mat4,
+    convention: DepthConvention,
+) -> CombineRead {
+    let size = size_of(older);
+    let id = lod_buffer_id(newer.word);
+    let uv = combine_uv(pixel, size);
+    let p = pixel.as_vec2() + 0.5;
+    let depth = newer.depth;
+    let motion = newer.motion;
+    let object = combine_object(data, id);
+    if id != 0 {
+        if object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)
+            == COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE
+        {
+            let mut own = silhouette_covers(data, object.silhouette, p);
+            if own == SILHOUETTE_ON {
+                own = i32::from(id_at(older, combine_texel(old.truncate() + motion, size)) == id);
+            }
+            if own == 1 {
+                return combine_read_own(older, id, uv, depth, m, motion, COMBINE_BLOCK_REACH);
+            }
+            let read_at = old.truncate() + motion;
+            let texel = combine_other_texel(older, id, combine_texel(read_at, size), read_at);
+            return found(older, texel);
+        }
+        if object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)
+            == COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS
+        {
+            return combine_read_level_depth(
+                older,
+                data,
+                newer.level_depth,
+                id,
+                uv,
+                depth,
+                old,
+                motion,
+                convention,
+            );
+        }
+        return combine_read_own(older, id, uv, depth, m, motion, COMBINE_COVER_REACH);
+    }
+    let far = combine_far_depth(convention);
+    let frame = combine_object(data, 0);
+    if frame.flags & COMBINE_LEVEL_DEPTH != 0 && depth_closer(newer.level_depth, far, convention) {
+        return combine_read_level_depth(
+            older,
+            data,
+            newer.level_depth,
+            0,
+            uv,
+            depth,
+            old,
+            motion,
+            convention,
+        );
+    }
+    let r = combine_read_silhouettes(older, data, uv, depth, p);
+    if r.found {
+        return r;
+    }
+    combine_read_estimated(older, data, uv, depth, base, old, m, motion)
+}
+
+/// The whole per-pixel combine of frame-sequential LOD with the older level's coverage known
+/// (the Rust twin of `combine_pixel`): `newer` as read at `pixel`, the older buffer `older`
+/// (last frame's picture), the frame's data texture `data` ([`CombineData`](super::CombineData):
+/// the camera's matrix, per t-instance its matrix, display threshold and coverage route, the
+/// silhouettes). Outside the older view, or where no older level is found, the newer color;
+/// else [`combine_texels`] with the older word displayed at this frame's threshold
+/// ([`combine_displayed_word`]). `None` when `pixel` lies outside `older` or `older` lacks texels.
+pub fn combine_pixel(
+    newer: &CombineNewer,
+    pixel: UVec2,
+    older: &LodImage,
+    data: &[[u32; 4]],
+    convention: DepthConvention,
+) -> Option<Vec4> {
+    let n = older.width as usize * older.height as usize;
+    let complete = older.colors.len() == n && older.ids.len() == n && older.depths.len() == n;
+    if n == 0 || !complete || pixel.x >= older.width || pixel.y >= older.height {
+        return None;
+    }
+    let size = size_of(older);
+    let id = lod_buffer_id(newer.word);
+    let m = combine_new_to_old(data, id);
+    let base = reproject_base(combine_uv(pixel, size), &m);
+    let old = reproject_from_base(base, newer.depth, &m);
+    if !in_viewport(old.truncate()) {
+        return Some(newer.color);
+    }
+    let read = combine_read(older, data, newer, pixel, base, old, &m, convention);
+    if !read.found {
+        return Some(newer.color);
+    }
+    let word = older.word(index_of(older, read.texel));
+    let o = combine_object(data, lod_buffer_id(word));
+    let anchored = o.flags & (COMBINE_KNOWN | COMBINE_ANCHORED) == COMBINE_KNOWN | COMBINE_ANCHORED;
+    let shown = combine_displayed_word(word, anchored, o.older_tau, newer.pattern);
+    Some(combine_texels(
+        newer.color,
+        newer.word,
+        old,
+        read.color,
+        shown,
+        depth_at(older, read.texel),
+        convention,
+    ))
+}

@@ -1,0 +1,254 @@
+//! The combine's data texture: what `combine_pixel` knows of the frame and of each t-instance,
+//! in one `Rgba32Uint` texture any GPU can read in a fragment shader (GL 3.3 and WebGL2
+//! included: no storage buffer).
+//!
+//! Layout, texel `i` at `(i % width, i / width)`: per id `k` from 0 to the largest id given, a
+//! record of [`COMBINE_RECORD`] texels at `k * 6`: texels 0..3 the columns of its `new_to_old`
+//! (f32 bits), texel 4 its older level's silhouette table
+//! ([`bin_silhouette`]), texel 5 (flags, older_tau bits, record count, 0). Record 0 is the
+//! frame's: the camera's matrix, [`COMBINE_OBJECT_MOTION`] and [`COMBINE_LEVEL_DEPTH`], and the
+//! record count; an id between those given has the camera's matrix and no flags. The
+//! silhouettes' rows and segments follow the records.
+
+use glam::Mat4;
+use thiserror::Error;
+
+use super::{
+    COMBINE_ANCHORED, COMBINE_KNOWN, COMBINE_LEVEL_DEPTH, COMBINE_OBJECT_MOTION, COMBINE_RECORD,
+    COMBINE_ROUTE_DEPTH_PASS, COMBINE_ROUTE_SILHOUETTE,
+};
+use crate::lod_buffer::LOD_BUFFER_MAX_ID;
+use crate::silhouette::{Segment, bin_silhouette};
+
+/// The widest data texture [`CombineData::new`] lays out (a row of texels; narrower when there
+/// are fewer texels).
+pub const COMBINE_DATA_WIDTH: u32 = 1024;
+
+/// How the combine knows where a t-instance's older level (the one not drawn this frame)
+/// covers the screen.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum CoverageRoute<'a> {
+    /// Its silhouette under this frame's camera, in pixels
+    /// ([`Surface::silhouette`](crate::silhouette::Surface::silhouette)): exact, no pass; needs a
+    /// closed mesh on the CPU.
+    Silhouette(&'a [Segment]),
+    /// The older-level depth pass: the host draws the older levels depth only with this frame's
+    /// camera into a texture of the target's size, read at each pixel
+    /// ([`CombineNewer::level_depth`](super::CombineNewer::level_depth)): exact for any mesh,
+    /// for the cost of rasterizing them.
+    DepthPass,
+    /// From last frame's picture alone: no extra work, but a silhouette that moved by a
+    /// fraction of a texel shows the other level or the background every other frame.
+    #[default]
+    Estimate,
+}
+
+/// One t-instance as the combine knows it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CombineObjectData<'a> {
+    /// Its id (1 ..= `LOD_BUFFER_MAX_ID`, as in the LOD buffers' id words).
+    pub id: u32,
+    /// This frame's clip space to last frame's for its points: the camera's, with its own motion
+    /// where it moved ([`new_to_old_matrix`](crate::reproject::new_to_old_matrix) with the
+    /// previous view times the motion).
+    pub new_to_old: Mat4,
+    /// The threshold at which its older level is displayed this frame, when the visibility
+    /// pattern is anchored to the screen (the older level then shows exactly where the newer one
+    /// does not); `None` to keep the flags the older buffer holds.
+    pub older_tau: Option<f32>,
+    /// Where its older level covers the screen.
+    pub route: CoverageRoute<'a>,
+}
+
+/// What the combine knows this frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CombineDataDescriptor<'a> {
+    /// The camera's `new_to_old` (this frame's clip space to last frame's).
+    pub new_to_old: Mat4,
+    /// Whether each pixel's object motion is given (a LOD pass's motion target, an engine's
+    /// motion vectors); otherwise t-instances are reprojected with their own matrices.
+    pub object_motion: bool,
+    /// Whether the older-level depth pass is read.
+    pub level_depth: bool,
+    /// The target's height in pixels (silhouettes are binned by its rows).
+    pub height: u32,
+    /// The t-instances in transition.
+    pub objects: &'a [CombineObjectData<'a>],
+}
+
+impl Default for CombineDataDescriptor<'_> {
+    fn default() -> Self {
+        Self {
+            new_to_old: Mat4::IDENTITY,
+            object_motion: false,
+            level_depth: false,
+            height: 1,
+            objects: &[],
+        }
+    }
+}
+
+/// Why [`CombineData::new`] refused its objects.
+#[derive(Clone, Copy, Debug, Error, PartialEq)]
+pub enum CombineDataError {
+    /// Id 0 names n-instances (and record 0 is the frame's).
+    #[error("objects[{index}] has id 0, which names n-instances: t-instance ids start at 1")]
+    ZeroId {
+        /// Its index in the objects.
+        index: usize,
+    },
+    /// An id past the largest a LOD buffer's id word holds.
+    #[error("objects[{index}] has id {id}, past the largest LOD-buffer id {max}")]
+    IdTooLarge {
+        /// Its index in the objects.
+        index: usize,
+        /// The id.
+        id: u32,
+        /// `LOD_BUFFER_MAX_ID`.
+        max: u32,
+    },
+    /// Two objects with one id.
+    #[error("objects[{first}] and objects[{second}] both have id {id}")]
+    DuplicateId {
+        /// The id.
+        id: u32,
+        /// The first object with it.
+        first: usize,
+        /// The second.
+        second: usize,
+    },
+    /// A matrix, threshold or silhouette point that is NaN or infinite.
+    #[error("{what} is not finite")]
+    NotFinite {
+        /// What: the camera's matrix, or `objects[i]`'s matrix, threshold or silhouette.
+        what: &'static str,
+    },
+}
+
+/// The combine's data texture, laid out (see the module's docs): `width` x `height` texels, row
+/// after row, the last row padded with zeros.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CombineData {
+    /// The texels.
+    pub texels: Vec<[u32; 4]>,
+    /// Texels per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+}
+
+impl CombineData {
+    /// Lays out what the combine knows this frame.
+    ///
+    /// ```
+    /// # use lodkit::combine_coverage::*;
+    /// # use glam::{Mat4, Vec2};
+    /// let square = [[2.0, 2.0, 2.0, 6.0], [2.0, 6.0, 6.0, 6.0], [6.0, 6.0, 6.0, 2.0], [6.0, 2.0, 2.0, 2.0]];
+    /// let objects = [CombineObjectData { id: 3, new_to_old: Mat4::IDENTITY, older_tau: Some(0.4),
+    ///     route: CoverageRoute::Silhouette(&square) }];
+    /// let data = CombineData::new(&CombineDataDescriptor { height: 8, objects: &objects,
+    ///     ..Default::default() }).unwrap();
+    /// let o = combine_object(&data.texels, 3);
+    /// assert_eq!(o.flags, COMBINE_KNOWN | COMBINE_ANCHORED | COMBINE_ROUTE_SILHOUETTE);
+    /// assert_eq!(lodkit::silhouette::silhouette_covers(&data.texels, o.silhouette, Vec2::new(4.5, 4.5)), 1);
+    /// assert_eq!(combine_object(&data.texels, 2).flags, 0); // no record: unknown
+    /// ```
+    pub fn new(desc: &CombineDataDescriptor) -> Result<Self, CombineDataError> {
+        if !desc.new_to_old.is_finite() {
+            return Err(CombineDataError::NotFinite {
+                what: "the camera's new_to_old",
+            });
+        }
+        let mut slots = 1u32;
+        for (index, o) in desc.objects.iter().enumerate() {
+            if o.id == 0 {
+                return Err(CombineDataError::ZeroId { index });
+            }
+            if o.id > LOD_BUFFER_MAX_ID {
+                return Err(CombineDataError::IdTooLarge {
+                    index,
+                    id: o.id,
+                    max: LOD_BUFFER_MAX_ID,
+                });
+            }
+            if let Some(first) = desc.objects[..index].iter().position(|p| p.id == o.id) {
+                return Err(CombineDataError::DuplicateId {
+                    id: o.id,
+                    first,
+                    second: index,
+                });
+            }
+            let finite_segments = match o.route {
+                CoverageRoute::Silhouette(s) => s.iter().flatten().all(|v| v.is_finite()),
+                _ => true,
+            };
+            if !o.new_to_old.is_finite()
+                || !o.older_tau.is_none_or(f32::is_finite)
+                || !finite_segments
+            {
+                return Err(CombineDataError::NotFinite {
+                    what: "an object's matrix, older_tau or silhouette",
+                });
+            }
+            slots = slots.max(o.id + 1);
+        }
+        let matrix = |m: &Mat4| m.to_cols_array_2d().map(|c| c.map(f32::to_bits));
+        let camera = matrix(&desc.new_to_old);
+        let mut texels = Vec::with_capacity((slots * COMBINE_RECORD) as usize);
+        for k in 0..slots {
+            texels.extend(camera);
+            texels.push([0; 4]);
+            texels.push([if k == 0 { COMBINE_KNOWN } else { 0 }, 0, 0, 0]);
+        }
+        let frame_flags = COMBINE_KNOWN
+            | if desc.object_motion {
+                COMBINE_OBJECT_MOTION
+            } else {
+                0
+            }
+            | if desc.level_depth {
+                COMBINE_LEVEL_DEPTH
+            } else {
+                0
+            };
+        texels[5] = [frame_flags, 0, slots, 0];
+        for o in desc.objects {
+            let record = (o.id * COMBINE_RECORD) as usize;
+            texels[record..record + 4].copy_from_slice(&matrix(&o.new_to_old));
+            let route = match o.route {
+                CoverageRoute::Silhouette(segments) => {
+                    let table = bin_silhouette(segments, desc.height, &mut texels);
+                    texels[record + 4] = table.to_array();
+                    COMBINE_ROUTE_SILHOUETTE
+                }
+                CoverageRoute::DepthPass => COMBINE_ROUTE_DEPTH_PASS,
+                CoverageRoute::Estimate => 0,
+            };
+            let anchored = if o.older_tau.is_some() {
+                COMBINE_ANCHORED
+            } else {
+                0
+            };
+            let tau = o.older_tau.unwrap_or(0.0).to_bits();
+            texels[record + 5] = [COMBINE_KNOWN | anchored | route, tau, 0, 0];
+        }
+        let n = texels.len() as u32;
+        let width = n.min(COMBINE_DATA_WIDTH);
+        let height = n.div_ceil(width);
+        texels.resize((width * height) as usize, [0; 4]);
+        Ok(Self {
+            texels,
+            width,
+            height,
+        })
+    }
+
+    /// The texels as little-endian bytes, for an `Rgba32Uint` texture of `width` x `height`.
+    pub fn bytes(&self) -> Vec<u8> {
+        self.texels
+            .iter()
+            .flatten()
+            .flat_map(|w| w.to_le_bytes())
+            .collect()
+    }
+}
