@@ -9,7 +9,7 @@
 //! 2. `draw(key)` gives each instance this frame's LOD, id and visibility threshold tau; the
 //!    scene goes into LOD buffer `buffer_index()` (your forward pass writes color, id and depth;
 //!    `LodBufferRenderer` is lodkit's reference for it);
-//! 3. `CombinePass::encode_regions` merges that buffer with last frame's, reprojected through
+//! 3. `CombinePass::record` (with `CombineRegions::Only`) merges that buffer with last frame's, reprojected through
 //!    the camera motion (`new_to_old_matrix`), into the frame's target, only inside the screen
 //!    rectangles of the instances in transition; the rest of the frame is a copy.
 //!
@@ -23,7 +23,9 @@ use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::screen_rect;
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::GpuContext;
-use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::frame_sequential::{
+    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
+};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
@@ -59,7 +61,13 @@ fn main() -> Result<(), Box<dyn Error>> {
     let buffers = LodBuffers::without_motion(&gpu, w, h, FORMAT)?;
     let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 1);
     let renderer = LodBufferRenderer::new(&gpu, FORMAT, &vis, 0.25)?;
-    let combine = CombinePass::new(&gpu, FORMAT, false)?;
+    let combine = CombinePass::new(
+        &gpu,
+        &CombinePassDescriptor {
+            target_format: FORMAT,
+            ..Default::default()
+        },
+    )?;
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
         | wgpu::TextureUsages::COPY_SRC
         | wgpu::TextureUsages::COPY_DST;
@@ -178,16 +186,14 @@ fn main() -> Result<(), Box<dyn Error>> {
             .filter_map(|(_, &p)| screen_rect(unit_box, model(p), &views, SIZE, 2))
             .collect();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let (newer, out) = (index, &target_view);
-        combine.encode_regions(
-            &gpu,
-            &mut encoder,
-            &buffers,
-            newer,
+        let frame_to_combine = CombineFrame {
+            buffers: &buffers,
+            newer: index,
             new_to_old,
-            out,
-            &regions,
-        )?;
+            target: &target_view,
+            regions: CombineRegions::Only(&regions),
+        };
+        combine.record(&gpu, &mut encoder, &frame_to_combine)?;
         gpu.queue.submit([encoder.finish()]);
         previous_view = Some(view);
 

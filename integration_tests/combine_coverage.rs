@@ -384,7 +384,9 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     kinds.extend([Word::Exact; 6]);
     kinds.push(Word::Float(1e-5));
     kinds.push(Word::Exact);
-    kinds.extend([Word::Float(0.0); 2]);
+    // The snap passes its input through or rounds it; the input 1 - 0.02 p may be computed with
+    // a fused multiply-add on the GPU (an ulp apart, ~1.2e-7 near 1): 1e-6.
+    kinds.extend([Word::Float(1e-6); 2]);
     // The fragment route on every device (GL 3.3 and WebGL2 class contexts have no compute), and
     // the compute route where compute shaders work.
     let mut routes = vec![Route::Fragment];

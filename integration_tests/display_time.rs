@@ -6,7 +6,9 @@
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, LodSample, PixelSource, combine_shown};
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
-use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
+use lodkit::gpu::frame_sequential::{
+    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
+};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
@@ -515,7 +517,14 @@ impl SphereLods {
             lodkit::gpu::resources::texture_2d(gpu, (w, w), format, usage, "combined").unwrap();
         Self {
             renderer: LodBufferRenderer::new(gpu, format, &vis, 1.0).unwrap(),
-            combine: CombinePass::new(gpu, format, false).unwrap(),
+            combine: CombinePass::new(
+                gpu,
+                &CombinePassDescriptor {
+                    target_format: format,
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
             sphere: GpuMesh::new(gpu, &Mesh::sphere(24, 32)).unwrap(),
             colors: [Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 0.0, 1.0, 1.0)],
             proj: glam::camera::rh::proj::directx::perspective(0.9, 1.0, 0.1, 50.0),
@@ -540,16 +549,14 @@ impl SphereLods {
             .render(gpu, buffers, index, view, &[item], clear, None)
             .unwrap();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        self.combine
-            .encode(
-                gpu,
-                &mut encoder,
-                buffers,
-                index,
-                new_to_old,
-                &self.target_view,
-            )
-            .unwrap();
+        let frame = CombineFrame {
+            buffers,
+            newer: index,
+            new_to_old,
+            target: &self.target_view,
+            regions: CombineRegions::Everywhere,
+        };
+        self.combine.record(gpu, &mut encoder, &frame).unwrap();
         gpu.queue.submit([encoder.finish()]);
         read_texture_rgba8(gpu, &self.target).unwrap()
     }

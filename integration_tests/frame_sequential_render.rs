@@ -4,7 +4,9 @@
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, PixelSource, combine_images};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
-use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
+use lodkit::gpu::frame_sequential::{
+    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
+};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
@@ -42,8 +44,11 @@ fn combine_matches_the_cpu_rule(depth: DepthConvention, proj: Mat4) {
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
     let renderer = LodBufferRenderer::with_depth(gpu, format, &vis, 0.25, depth).unwrap();
     let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
-    let reversed = depth == DepthConvention::Reversed;
-    let combine = CombinePass::new(gpu, format, reversed).unwrap();
+    let descriptor = CombinePassDescriptor {
+        target_format: format,
+        depth,
+    };
+    let combine = CombinePass::new(gpu, &descriptor).unwrap();
     let sphere = GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap();
     let cube = GpuMesh::new(gpu, &Mesh::cube()).unwrap();
 
@@ -108,14 +113,12 @@ fn combine_matches_the_cpu_rule(depth: DepthConvention, proj: Mat4) {
     let target =
         lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, "combined").unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let target_view = target.create_view(&Default::default());
     combine
-        .encode(
+        .record(
             gpu,
             &mut encoder,
-            &buffers,
-            newer,
-            m,
-            &target.create_view(&Default::default()),
+            &everywhere(&buffers, newer, m, &target_view),
         )
         .unwrap();
     gpu.queue.submit([encoder.finish()]);
@@ -200,7 +203,7 @@ fn lod_buffers_without_motion_combine_a_moving_camera_like_with_it() {
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 3);
     let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.5).unwrap();
-    let combine = CombinePass::new(gpu, format, false).unwrap();
+    let combine = CombinePass::new(gpu, &combine_descriptor(format)).unwrap();
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let target = lodkit::gpu::resources::texture_2d(gpu, (W, H), format, usage, "t").unwrap();
     let view_of = target.create_view(&Default::default());
@@ -244,7 +247,7 @@ fn lod_buffers_without_motion_combine_a_moving_camera_like_with_it() {
         let m = new_to_old_matrix(&eye(0.3), &proj, &eye(0.0), &proj);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         combine
-            .encode(gpu, &mut encoder, buffers, 1, m, &view_of)
+            .record(gpu, &mut encoder, &everywhere(buffers, 1, m, &view_of))
             .unwrap();
         gpu.queue.submit([encoder.finish()]);
         read_texture_rgba8(gpu, &target).unwrap()
@@ -276,7 +279,7 @@ fn a_transition_may_begin_on_any_frame_without_the_object_dropping_out() {
     let format = wgpu::TextureFormat::Rgba8Unorm;
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 64, 1);
     let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.25).unwrap();
-    let combine = CombinePass::new(gpu, format, false).unwrap();
+    let combine = CombinePass::new(gpu, &combine_descriptor(format)).unwrap();
     let lods = [
         GpuMesh::new(gpu, &Mesh::sphere(16, 24)).unwrap(),
         GpuMesh::new(gpu, &Mesh::cube()).unwrap(),
@@ -311,7 +314,11 @@ fn a_transition_may_begin_on_any_frame_without_the_object_dropping_out() {
         };
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         combine
-            .encode(gpu, &mut encoder, buffers, index, m, &target_view)
+            .record(
+                gpu,
+                &mut encoder,
+                &everywhere(buffers, index, m, &target_view),
+            )
             .unwrap();
         gpu.queue.submit([encoder.finish()]);
         coverage(&read_texture_rgba8(gpu, &target).unwrap(), [0, 0, 0])
@@ -413,7 +420,7 @@ fn the_combine_over_the_t_instances_rectangles_equals_the_full_combine() {
     let vis = visibility_texture(VisibilityPattern::BlueNoise, 64, 3);
     let renderer = LodBufferRenderer::new(gpu, format, &vis, 0.5).unwrap();
     let buffers = LodBuffers::new(gpu, W, H, format).unwrap();
-    let combine = CombinePass::new(gpu, format, false).unwrap();
+    let combine = CombinePass::new(gpu, &combine_descriptor(format)).unwrap();
     let sphere_mesh = Mesh::sphere(16, 24);
     let bounds = sphere_mesh.bounds().unwrap();
     let sphere = GpuMesh::new(gpu, &sphere_mesh).unwrap();
@@ -475,23 +482,30 @@ fn the_combine_over_the_t_instances_rectangles_equals_the_full_combine() {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let view = |t: &wgpu::Texture| t.create_view(&Default::default());
     combine
-        .encode(gpu, &mut encoder, &buffers, newer, m, &view(&full))
+        .record(
+            gpu,
+            &mut encoder,
+            &everywhere(&buffers, newer, m, &view(&full)),
+        )
         .unwrap();
     gpu.queue.submit([encoder.finish()]);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let combined = combine
-        .encode_regions(
+        .record(
             gpu,
             &mut encoder,
-            &buffers,
-            newer,
-            m,
-            &view(&regions),
-            &[rect, rect],
+            &only(
+                everywhere(&buffers, newer, m, &view(&regions)),
+                &[rect, rect],
+            ),
         )
         .unwrap();
     let skipped = combine
-        .encode_regions(gpu, &mut encoder, &buffers, newer, m, &view(&none), &[])
+        .record(
+            gpu,
+            &mut encoder,
+            &only(everywhere(&buffers, newer, m, &view(&none)), &[]),
+        )
         .unwrap();
     gpu.queue.submit([encoder.finish()]);
     let read = |t: &wgpu::Texture| read_texture_rgba8(gpu, t).unwrap();
@@ -531,17 +545,78 @@ fn the_combine_over_the_t_instances_rectangles_equals_the_full_combine() {
     .unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let err = combine
-        .encode_regions(
+        .record(
             gpu,
             &mut encoder,
-            &buffers,
-            newer,
-            m,
-            &view(&plain),
-            &[rect],
+            &only(everywhere(&buffers, newer, m, &view(&plain)), &[rect]),
         )
         .unwrap_err();
     assert!(err.to_string().contains("COPY_DST"), "{err}");
+
+    // Two recordings in one encoder with different matrices: each equals the same recording
+    // made alone (each carries its own parameters; a shared uniform written on the queue would
+    // give both the last matrix).
+    let (alone, first, second) = (texture("alone"), texture("first"), texture("second"));
+    let no_history = CombinePass::NO_HISTORY;
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let target = view(&alone);
+    let frame = everywhere(&buffers, newer, no_history, &target);
+    combine.record(gpu, &mut encoder, &frame).unwrap();
+    gpu.queue.submit([encoder.finish()]);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let target = view(&first);
+    let frame = everywhere(&buffers, newer, no_history, &target);
+    combine.record(gpu, &mut encoder, &frame).unwrap();
+    combine
+        .record(
+            gpu,
+            &mut encoder,
+            &everywhere(&buffers, newer, m, &view(&second)),
+        )
+        .unwrap();
+    gpu.queue.submit([encoder.finish()]);
+    assert_ne!(
+        read(&alone),
+        read(&full),
+        "the two matrices give two images"
+    );
+    assert_eq!(read(&first), read(&alone), "the first recording's matrix");
+    assert_eq!(read(&second), read(&full), "the second recording's matrix");
+}
+
+/// The combine's descriptor for targets of `format`, standard depth.
+fn combine_descriptor(format: wgpu::TextureFormat) -> CombinePassDescriptor {
+    CombinePassDescriptor {
+        target_format: format,
+        ..Default::default()
+    }
+}
+
+/// A recording of the combine over the whole target.
+fn everywhere<'a>(
+    buffers: &'a LodBuffers,
+    newer: usize,
+    new_to_old: Mat4,
+    target: &'a wgpu::TextureView,
+) -> CombineFrame<'a> {
+    CombineFrame {
+        buffers,
+        newer,
+        new_to_old,
+        target,
+        regions: CombineRegions::Everywhere,
+    }
+}
+
+/// `frame` inside `regions` only.
+fn only<'a>(
+    frame: CombineFrame<'a>,
+    regions: &'a [lodkit::combine::ScreenRect],
+) -> CombineFrame<'a> {
+    CombineFrame {
+        regions: CombineRegions::Only(regions),
+        ..frame
+    }
 }
 
 #[test]

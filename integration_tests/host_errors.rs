@@ -9,7 +9,10 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use glam::Mat4;
-use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
+use lodkit::combine::DepthConvention;
+use lodkit::gpu::frame_sequential::{
+    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
+};
 use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
     UpsampleSettings,
@@ -287,10 +290,7 @@ fn formats_the_passes_cannot_use_are_named() {
                 "LowResBuffer::new",
                 LowResBuffer::new(gpu, 8, 8, format).map(drop),
             ),
-            (
-                "CombinePass::new",
-                CombinePass::new(gpu, format, false).map(drop),
-            ),
+            ("CombinePass::new", combine_pass(gpu, format).map(drop)),
             (
                 "UpsamplePass::new",
                 UpsamplePass::new(
@@ -328,7 +328,11 @@ fn formats_the_passes_cannot_use_are_named() {
     // A floating-point format other than the default works everywhere.
     LodBuffers::new(gpu, 8, 8, F::Rgba16Float).unwrap();
     LowResBuffer::new(gpu, 8, 8, F::Rgba16Float).unwrap();
-    CombinePass::new(gpu, F::Rgba16Float, true).unwrap();
+    let descriptor = CombinePassDescriptor {
+        target_format: F::Rgba16Float,
+        depth: DepthConvention::Reversed,
+    };
+    CombinePass::new(gpu, &descriptor).unwrap();
     let r = EdgeScene::new(gpu, RGBA8, f32::NAN);
     assert!(
         matches!(
@@ -381,21 +385,25 @@ fn passes_given_mismatched_inputs_name_both() {
     };
     // Combine: target of another size, then of another format.
     let buffers = LodBuffers::new(gpu, 32, 24, RGBA8).unwrap();
-    let combine = CombinePass::new(gpu, RGBA8, false).unwrap();
+    let combine = combine_pass(gpu, RGBA8).unwrap();
     let small = target(16, 24, RGBA8);
-    let r = no_panic("CombinePass::encode", || {
-        combine.encode(gpu, &mut encoder(), &buffers, 0, Mat4::ZERO, &small)
+    let r = no_panic("CombinePass::record", || {
+        combine
+            .record(gpu, &mut encoder(), &whole(&buffers, 0, &small))
+            .map(drop)
     });
     mismatch(r, "target", "16 x 24", "32 x 24");
     let other = target(32, 24, wgpu::TextureFormat::Rgba16Float);
-    let r = no_panic("CombinePass::encode", || {
-        combine.encode(gpu, &mut encoder(), &buffers, 0, Mat4::ZERO, &other)
+    let r = no_panic("CombinePass::record", || {
+        combine
+            .record(gpu, &mut encoder(), &whole(&buffers, 0, &other))
+            .map(drop)
     });
     mismatch(r, "target", "Rgba16Float", "Rgba8Unorm");
     let right = target(32, 24, RGBA8);
     let mut e = encoder();
     combine
-        .encode(gpu, &mut e, &buffers, 1, Mat4::ZERO, &right)
+        .record(gpu, &mut e, &whole(&buffers, 1, &right))
         .unwrap();
     gpu.queue.submit([e.finish()]);
 
@@ -566,7 +574,7 @@ fn a_lost_device_is_an_error_and_a_new_context_recovers() {
     let Some(gpu) = own_gpu() else { return };
     let gpu = &gpu;
     let buffers = LodBuffers::new(gpu, 16, 16, RGBA8).unwrap();
-    let combine = CombinePass::new(gpu, RGBA8, false).unwrap();
+    let combine = combine_pass(gpu, RGBA8).unwrap();
     let target = RenderTarget::new(gpu, 16, 16).unwrap();
     let view = target.color.create_view(&Default::default());
     // Stands in for a driver reset.
@@ -587,13 +595,15 @@ fn a_lost_device_is_an_error_and_a_new_context_recovers() {
     );
     lost(
         "CombinePass::new",
-        no_panic("combine", || CombinePass::new(gpu, RGBA8, false).map(drop)),
+        no_panic("combine", || combine_pass(gpu, RGBA8).map(drop)),
     );
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     lost(
-        "CombinePass::encode",
-        no_panic("encode", || {
-            combine.encode(gpu, &mut encoder, &b, 0, Mat4::ZERO, &view)
+        "CombinePass::record",
+        no_panic("record", || {
+            combine
+                .record(gpu, &mut encoder, &whole(&b, 0, &view))
+                .map(drop)
         }),
     );
     lost(
@@ -612,15 +622,39 @@ fn a_lost_device_is_an_error_and_a_new_context_recovers() {
     let mut buffers = LodBuffers::new(&gpu, 16, 16, RGBA8).unwrap();
     buffers.resize(&gpu, 24, 16).unwrap();
     let target = RenderTarget::new(&gpu, 24, 16).unwrap();
-    let combine = CombinePass::new(&gpu, RGBA8, false).unwrap();
+    let combine = combine_pass(&gpu, RGBA8).unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let view = target.color.create_view(&Default::default());
     combine
-        .encode(&gpu, &mut encoder, &buffers, 0, Mat4::ZERO, &view)
+        .record(&gpu, &mut encoder, &whole(&buffers, 0, &view))
         .unwrap();
     gpu.queue.submit([encoder.finish()]);
     assert_eq!(
         read_texture_rgba8(&gpu, &target.color).unwrap().len(),
         24 * 16 * 4
     );
+}
+
+/// The combine for targets of `format`, standard depth.
+fn combine_pass(gpu: &GpuContext, format: wgpu::TextureFormat) -> Result<CombinePass, GpuError> {
+    let descriptor = CombinePassDescriptor {
+        target_format: format,
+        ..Default::default()
+    };
+    CombinePass::new(gpu, &descriptor)
+}
+
+/// A recording of the combine over the whole `target` with no history.
+fn whole<'a>(
+    buffers: &'a LodBuffers,
+    newer: usize,
+    target: &'a wgpu::TextureView,
+) -> CombineFrame<'a> {
+    CombineFrame {
+        buffers,
+        newer,
+        new_to_old: CombinePass::NO_HISTORY,
+        target,
+        regions: CombineRegions::Everywhere,
+    }
 }

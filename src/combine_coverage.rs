@@ -25,8 +25,8 @@ use crate::silhouette::{SILHOUETTE_ON, silhouette_covers, silhouette_texel};
 
 mod data;
 pub use data::{
-    COMBINE_DATA_WIDTH, CombineData, CombineDataDescriptor, CombineDataError, CombineObjectData,
-    CoverageRoute,
+    COMBINE_DATA_WIDTH, COMBINE_MAX_HEIGHT, COMBINE_MAX_ID, CombineData, CombineDataDescriptor,
+    CombineDataError, CombineObjectData, CoverageRoute,
 };
 
 /// Texels per id in the data texture ([`CombineData`]): the record of t-instance `id` starts at

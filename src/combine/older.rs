@@ -57,21 +57,28 @@ pub(crate) fn size_of(older: &LodImage) -> UVec2 {
 }
 
 pub(crate) fn index_of(older: &LodImage, t: UVec2) -> usize {
-    (t.y * older.width + t.x) as usize
+    t.y as usize * older.width as usize + t.x as usize
 }
 
+// An image shorter than `width` x `height` (a malformed `LodImage`) reads as empty past its end:
+// id 0, depth 0, a zero color, so no piece panics on it.
+
 pub(crate) fn id_at(older: &LodImage, t: UVec2) -> u32 {
-    older.ids[index_of(older, t)]
+    older.ids.get(index_of(older, t)).copied().unwrap_or(0)
 }
 
 pub(crate) fn depth_at(older: &LodImage, t: UVec2) -> f32 {
-    older.depths[index_of(older, t)]
+    older.depths.get(index_of(older, t)).copied().unwrap_or(0.0)
 }
 
 pub(crate) fn found(older: &LodImage, texel: UVec2) -> CombineRead {
     CombineRead {
         texel,
-        color: older.colors[index_of(older, texel)],
+        color: older
+            .colors
+            .get(index_of(older, texel))
+            .copied()
+            .unwrap_or_default(),
         found: true,
     }
 }

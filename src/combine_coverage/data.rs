@@ -17,12 +17,20 @@ use super::{
     COMBINE_ANCHORED, COMBINE_KNOWN, COMBINE_LEVEL_DEPTH, COMBINE_OBJECT_MOTION, COMBINE_RECORD,
     COMBINE_ROUTE_DEPTH_PASS, COMBINE_ROUTE_SILHOUETTE,
 };
-use crate::lod_buffer::LOD_BUFFER_MAX_ID;
 use crate::silhouette::{Segment, bin_silhouette};
 
 /// The widest data texture [`CombineData::new`] lays out (a row of texels; narrower when there
 /// are fewer texels).
 pub const COMBINE_DATA_WIDTH: u32 = 1024;
+
+/// The largest t-instance id [`CombineData`] holds: records are indexed by id, so 65,536
+/// records of [`COMBINE_RECORD`](super::COMBINE_RECORD) texels take 384 rows of
+/// [`COMBINE_DATA_WIDTH`], leaving room for silhouettes within [`COMBINE_MAX_HEIGHT`].
+pub const COMBINE_MAX_ID: u32 = 65_535;
+
+/// The most rows the data texture may have: 2048, the texture size WebGL2 and GLES 3.0
+/// guarantee.
+pub const COMBINE_MAX_HEIGHT: u32 = 2048;
 
 /// How the combine knows where a t-instance's older level (the one not drawn this frame)
 /// covers the screen.
@@ -46,7 +54,7 @@ pub enum CoverageRoute<'a> {
 /// One t-instance as the combine knows it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CombineObjectData<'a> {
-    /// Its id (1 ..= `LOD_BUFFER_MAX_ID`, as in the LOD buffers' id words).
+    /// Its id (1 ..= [`COMBINE_MAX_ID`], as in the LOD buffers' id words).
     pub id: u32,
     /// This frame's clip space to last frame's for its points: the camera's, with its own motion
     /// where it moved ([`new_to_old_matrix`](crate::reproject::new_to_old_matrix) with the
@@ -97,14 +105,22 @@ pub enum CombineDataError {
         /// Its index in the objects.
         index: usize,
     },
-    /// An id past the largest a LOD buffer's id word holds.
-    #[error("objects[{index}] has id {id}, past the largest LOD-buffer id {max}")]
+    /// An id past [`COMBINE_MAX_ID`] (records are indexed by id).
+    #[error("objects[{index}] has id {id}, past the largest id the combine's data holds ({max})")]
     IdTooLarge {
         /// Its index in the objects.
         index: usize,
         /// The id.
         id: u32,
-        /// `LOD_BUFFER_MAX_ID`.
+        /// [`COMBINE_MAX_ID`].
+        max: u32,
+    },
+    /// Records and silhouettes that need more rows than a texture every GPU takes.
+    #[error("the combine's data needs {height} rows of texels, past {max}")]
+    TooLarge {
+        /// Rows needed.
+        height: u32,
+        /// [`COMBINE_MAX_HEIGHT`].
         max: u32,
     },
     /// Two objects with one id.
@@ -164,11 +180,11 @@ impl CombineData {
             if o.id == 0 {
                 return Err(CombineDataError::ZeroId { index });
             }
-            if o.id > LOD_BUFFER_MAX_ID {
+            if o.id > COMBINE_MAX_ID {
                 return Err(CombineDataError::IdTooLarge {
                     index,
                     id: o.id,
-                    max: LOD_BUFFER_MAX_ID,
+                    max: COMBINE_MAX_ID,
                 });
             }
             if let Some(first) = desc.objects[..index].iter().position(|p| p.id == o.id) {
@@ -235,6 +251,12 @@ impl CombineData {
         let n = texels.len() as u32;
         let width = n.min(COMBINE_DATA_WIDTH);
         let height = n.div_ceil(width);
+        if height > COMBINE_MAX_HEIGHT {
+            return Err(CombineDataError::TooLarge {
+                height,
+                max: COMBINE_MAX_HEIGHT,
+            });
+        }
         texels.resize((width * height) as usize, [0; 4]);
         Ok(Self {
             texels,
@@ -250,5 +272,41 @@ impl CombineData {
             .flatten()
             .flat_map(|w| w.to_le_bytes())
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ids_past_the_records_are_refused_and_the_largest_fits() {
+        let object = |id| CombineObjectData {
+            id,
+            new_to_old: Mat4::IDENTITY,
+            older_tau: None,
+            route: CoverageRoute::Estimate,
+        };
+        let data = |objects: &[CombineObjectData]| {
+            CombineData::new(&CombineDataDescriptor {
+                objects,
+                ..Default::default()
+            })
+        };
+        let largest = data(&[object(COMBINE_MAX_ID)]).unwrap();
+        // 65,536 records of 6 texels in rows of 1024: 384 rows.
+        assert_eq!((largest.width, largest.height), (1024, 384));
+        assert_eq!(
+            data(&[object(COMBINE_MAX_ID + 1)]).unwrap_err(),
+            CombineDataError::IdTooLarge {
+                index: 0,
+                id: COMBINE_MAX_ID + 1,
+                max: COMBINE_MAX_ID,
+            }
+        );
+        assert!(matches!(
+            data(&[object(u32::MAX)]),
+            Err(CombineDataError::IdTooLarge { .. })
+        ));
     }
 }

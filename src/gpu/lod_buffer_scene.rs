@@ -172,8 +172,9 @@ impl LodBufferRenderer {
     }
 
     /// [`new`](Self::new) for the depth convention `depth`: reversed Z tests `Greater` and clears
-    /// the depth buffer and the stored depth to 0 (pair it with `CombinePass::new(.., true)` and a
-    /// reversed, possibly infinite-far, projection).
+    /// the depth buffer and the stored depth to 0 (pair it with a `CombinePass` whose
+    /// `CombinePassDescriptor::depth` is `Reversed` and a reversed, possibly infinite-far,
+    /// projection).
     pub fn with_depth(
         gpu: &GpuContext,
         color_format: wgpu::TextureFormat,

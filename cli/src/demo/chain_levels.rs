@@ -17,7 +17,8 @@ pub const CAMERA: PixelErrorCamera = PixelErrorCamera {
     hysteresis: 0.0,
 };
 
-/// The base mesh: a unit sphere of 16 x 32 quads with smooth bumps, and its normals.
+/// The base mesh: a unit UV sphere of 16 rings and 32 segments (960 triangles) with smooth
+/// bumps, and its normals.
 fn base() -> (Vec<[f32; 3]>, Vec<u32>, Vec<[f32; 3]>) {
     let (mut positions, indices) = uv_sphere(16, 32);
     for p in &mut positions {

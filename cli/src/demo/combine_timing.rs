@@ -7,7 +7,9 @@ use glam::{Mat4, Vec3, Vec4};
 use super::clock::{Record, Timer, interleaved};
 use super::reads::{Reads, Texels};
 use super::timing::{FORMAT, PassRatio, plain_pass_with, record_fullscreen};
-use lodkit::gpu::frame_sequential::{CombinePass, LOD_DEPTH_FORMAT, LodBuffers};
+use lodkit::gpu::frame_sequential::{
+    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LOD_DEPTH_FORMAT, LodBuffers,
+};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::{one_group_layout, texture_2d, textures_and_uniform};
 use lodkit::gpu::scene::{GpuMesh, Mesh};
@@ -149,7 +151,11 @@ pub fn combine_vs_copy(
         "target",
     )?;
     let target_view = target.create_view(&Default::default());
-    let combine = CombinePass::new(gpu, FORMAT, false)?;
+    let descriptor = CombinePassDescriptor {
+        target_format: FORMAT,
+        ..Default::default()
+    };
+    let combine = CombinePass::new(gpu, &descriptor)?;
     let m = new_to_old_matrix(&views[1], &proj, &views[0], &proj);
     let mut entries = CombinePass::buffer_layout_entries(0);
     entries.push(CombinePass::motion_layout_entry(6));
@@ -165,7 +171,14 @@ pub fn combine_vs_copy(
     textures.extend(buffers.motion());
     let group = || textures_and_uniform(gpu, &layout, &textures, None, "copy7");
     let run = |encoder: &mut wgpu::CommandEncoder, buffers: &LodBuffers| {
-        combine.encode(gpu, encoder, buffers, 1, m, &target_view)
+        let frame = CombineFrame {
+            buffers,
+            newer: 1,
+            new_to_old: m,
+            target: &target_view,
+            regions: CombineRegions::Everywhere,
+        };
+        combine.record(gpu, encoder, &frame).map(drop)
     };
     let run_combine = |e: &mut wgpu::CommandEncoder| run(e, &buffers);
     let run_still = |e: &mut wgpu::CommandEncoder| run(e, &still);

@@ -11,7 +11,9 @@ use lodkit::combine::{
 };
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::counters::FragmentCounter;
-use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers, read_lod_image};
+use lodkit::gpu::frame_sequential::{
+    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
+};
 use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
@@ -181,7 +183,13 @@ impl<'a> SceneRenderer<'a> {
             target: RenderTarget::new(gpu, size.0, size.1)?,
             lod_buffer,
             buffers: LodBuffers::new(gpu, size.0, size.1, FORMAT)?,
-            combine: CombinePass::new(gpu, FORMAT, false)?,
+            combine: CombinePass::new(
+                gpu,
+                &CombinePassDescriptor {
+                    target_format: FORMAT,
+                    ..Default::default()
+                },
+            )?,
             combined: texture_2d(gpu, size, FORMAT, usage, "combined")?,
             counter: FragmentCounter::new(gpu)?,
             outside_rects: Default::default(),
@@ -483,15 +491,14 @@ impl<'a> SceneRenderer<'a> {
             }
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             let target = self.combined.create_view(&Default::default());
-            let combined = self.combine.encode_regions(
-                gpu,
-                &mut encoder,
-                &self.buffers,
-                index,
-                m,
-                &target,
-                &regions,
-            )?;
+            let recording = CombineFrame {
+                buffers: &self.buffers,
+                newer: index,
+                new_to_old: m,
+                target: &target,
+                regions: CombineRegions::Only(&regions),
+            };
+            let combined = self.combine.record(gpu, &mut encoder, &recording)?;
             gpu.queue.submit([encoder.finish()]);
             if let Some(f) = on_sources.as_mut().filter(|_| frame == middle) {
                 let sources = combine_images(&newer, &older, &m, DepthConvention::Standard);

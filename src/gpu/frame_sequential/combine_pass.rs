@@ -1,0 +1,296 @@
+//! [`CombinePass`]: the combine (`passes/combine.wgsl`) built from a [`CombinePassDescriptor`]
+//! and recorded with a [`CombineFrame`].
+
+use glam::Mat4;
+
+use super::LodBuffers;
+use crate::combine::{DepthConvention, ScreenRect, merge_rects};
+use crate::gpu::checks::{check_color_format, has_usage, texture_matches};
+use crate::gpu::resources::{
+    RecordedUniform, begin_color_pass, begin_load_pass, fullscreen_pipeline_with, one_group_layout,
+    texture_2d, texture_entry, textures_and_uniform, uniform_entry,
+};
+use crate::gpu::{GpuContext, GpuError};
+use crate::lod_buffer::MOTION_FORMAT;
+
+/// Rust mirror of `CombineParams` in `passes/combine.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CombineParams {
+    /// P_old V_old V_new^-1 P_new^-1, column-major.
+    pub new_to_old: [[f32; 4]; 4],
+}
+
+/// How a [`CombinePass`] is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CombinePassDescriptor {
+    /// Format of the targets it writes: a floating-point color format the device can render
+    /// to (default `Rgba16Float`).
+    pub target_format: wgpu::TextureFormat,
+    /// Depth convention of the LOD buffers' depth (default [`DepthConvention::Standard`];
+    /// `Reversed` is the shader def `LODKIT_REVERSE_Z`).
+    pub depth: DepthConvention,
+}
+
+impl Default for CombinePassDescriptor {
+    /// `Rgba16Float` targets, standard depth.
+    fn default() -> Self {
+        Self {
+            target_format: wgpu::TextureFormat::Rgba16Float,
+            depth: DepthConvention::Standard,
+        }
+    }
+}
+
+/// Where a recording combines.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CombineRegions<'a> {
+    /// Every pixel of the target (default).
+    #[default]
+    Everywhere,
+    /// Only inside these screen rectangles: the newer buffer's color is copied into the target
+    /// first (which then needs `COPY_DST`) and the combine runs only inside the rectangles,
+    /// those of the t-instances ([`screen_rect`](crate::combine::screen_rect)), clipped to the
+    /// target and merged ([`merge_rects`]). With none the frame is the copy: no combine, no read
+    /// of the older buffer. An engine that can show the newer buffer's color directly skips the
+    /// copy as well (docs/frame-sequential.md).
+    Only(&'a [ScreenRect]),
+}
+
+/// One recording of a [`CombinePass`]: what it reads, where it writes, its parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct CombineFrame<'a> {
+    /// The LOD buffer pair.
+    pub buffers: &'a LodBuffers,
+    /// The buffer rendered this frame (`TransitionScheduler::buffer_index`); the other holds
+    /// the older frame.
+    pub newer: usize,
+    /// This frame's clip space to the older frame's
+    /// ([`new_to_old_matrix`](crate::reproject::new_to_old_matrix)), or
+    /// [`CombinePass::NO_HISTORY`].
+    pub new_to_old: Mat4,
+    /// The target: the pass's format and the buffers' size.
+    pub target: &'a wgpu::TextureView,
+    /// Where to combine (default everywhere).
+    pub regions: CombineRegions<'a>,
+}
+
+/// The combine pass (`passes/combine.wgsl`) as a ready object: build once per target format,
+/// record once or more per frame. Buffers with an object motion target are combined with
+/// `combine_at_moved`; buffers without one ([`LodBuffers::without_motion`]) with `combine_at`
+/// (`LODKIT_COMBINE_STILL`), which reads no motion and whose 3x3 search the driver's compiler
+/// removes (the motion is a constant 0). Each recording carries its own parameters
+/// ([`RecordedUniform`]): several recordings in one encoder each read their own.
+#[derive(Debug)]
+pub struct CombinePass {
+    pipeline: wgpu::RenderPipeline,
+    /// The pipeline for buffers without object motion (`LODKIT_COMBINE_STILL`).
+    still_pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    params: RecordedUniform,
+    /// 1x1, zero: bound at the motion binding for buffers without a motion target.
+    still: wgpu::Texture,
+    target_format: wgpu::TextureFormat,
+}
+
+impl CombinePass {
+    /// The `new_to_old` matrix for a frame with no usable older buffer (the first frame, after a
+    /// resize or a camera cut): every pixel reprojects behind the older camera, so the newer
+    /// buffer is shown as it is.
+    pub const NO_HISTORY: Mat4 = Mat4::ZERO;
+
+    /// Builds the pass as `descriptor` says ([`GpuError::UnsupportedFormat`] for a target
+    /// format the pass cannot write).
+    pub fn new(gpu: &GpuContext, descriptor: &CombinePassDescriptor) -> Result<Self, GpuError> {
+        const CALL: &str = "CombinePass::new";
+        let target_format = descriptor.target_format;
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        check_color_format(gpu, CALL, "target_format", target_format, usage)?;
+        let reverse = (descriptor.depth == DepthConvention::Reversed).then_some("LODKIT_REVERSE_Z");
+        gpu.guarded(CALL, || {
+            let size = std::mem::size_of::<CombineParams>();
+            let mut entries = Self::buffer_layout_entries(0);
+            entries.push(Self::motion_layout_entry(6));
+            entries.push(uniform_entry(7, false));
+            let (group, layout) = one_group_layout(gpu, &entries, "lodkit combine");
+            let pipeline = |still: bool| {
+                let defs: Vec<&str> = reverse
+                    .into_iter()
+                    .chain(still.then_some("LODKIT_COMBINE_STILL"))
+                    .collect();
+                let module = gpu.pass_module("combine", &defs)?;
+                fullscreen_pipeline_with(
+                    gpu,
+                    &module,
+                    target_format,
+                    Some(&layout),
+                    "lodkit combine",
+                )
+            };
+            Ok(Self {
+                pipeline: pipeline(false)?,
+                still_pipeline: pipeline(true)?,
+                layout: group,
+                params: RecordedUniform::new(gpu, size, "combine params")?,
+                still: texture_2d(
+                    gpu,
+                    (1, 1),
+                    MOTION_FORMAT,
+                    wgpu::TextureUsages::TEXTURE_BINDING,
+                    "combine: no object motion",
+                )?,
+                target_format,
+            })
+        })
+    }
+
+    /// Bind group layout entries of the six LOD buffer textures the combine reads, from binding
+    /// `first`: color, id and depth of the newer buffer, then of the older one. The depth
+    /// attachments bind as unfilterable float textures (`texture_2d<f32>`), as
+    /// `lodkit::combine::combine_at` reads them; a full-screen pass of the engine's that calls
+    /// `combine_at` needs these (`combine_at_moved` also the motion, see
+    /// [`motion_layout_entry`](Self::motion_layout_entry)).
+    pub fn buffer_layout_entries(first: u32) -> Vec<wgpu::BindGroupLayoutEntry> {
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let uint = wgpu::TextureSampleType::Uint;
+        [float, uint, float, float, uint, float]
+            .into_iter()
+            .zip(first..)
+            .map(|(t, binding)| texture_entry(binding, t))
+            .collect()
+    }
+
+    /// Bind group layout entry of the object motion texture (`LodBuffers::motion`) at
+    /// `binding`, read as an unfilterable float texture, for a pass of the engine's that calls
+    /// `lodkit::combine::combine_at_moved`.
+    pub fn motion_layout_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+        texture_entry(
+            binding,
+            wgpu::TextureSampleType::Float { filterable: false },
+        )
+    }
+
+    /// Records the combination of buffer `frame.newer` with the other one (reprojected through
+    /// `frame.new_to_old`) into `frame.target`, everywhere or inside `frame.regions`. The
+    /// target must have the format the pass was built for and the size of the buffers, and
+    /// `COPY_DST` for [`CombineRegions::Only`] with a color format the buffers' copies into
+    /// ([`GpuError::Mismatch`] otherwise). Returns the pixels combined.
+    pub fn record(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &CombineFrame,
+    ) -> Result<u64, GpuError> {
+        const CALL: &str = "CombinePass::record";
+        let (buffers, target) = (frame.buffers, frame.target);
+        texture_matches(
+            CALL,
+            "target",
+            target.texture(),
+            buffers.size(),
+            self.target_format,
+            "the pass (built for its format, drawing the LOD buffers' size)",
+        )?;
+        let (w, h) = buffers.size();
+        let CombineRegions::Only(regions) = frame.regions else {
+            self.draw(gpu, encoder, frame, None)?;
+            return Ok(u64::from(w) * u64::from(h));
+        };
+        let usage = target.texture().usage();
+        let copy = wgpu::TextureUsages::COPY_DST;
+        has_usage(CALL, "target", usage, usage.contains(copy), "COPY_DST")?;
+        let (found, expected) = (buffers.color_format(), self.target_format);
+        if found.remove_srgb_suffix() != expected.remove_srgb_suffix() {
+            return Err(GpuError::Mismatch {
+                call: CALL,
+                parameter: "buffers",
+                found: format!("{found:?} color"),
+                expected: format!(
+                    "{expected:?}, the target's format (the rest of the frame is a copy)"
+                ),
+            });
+        }
+        let clipped: Vec<ScreenRect> = regions
+            .iter()
+            .filter_map(|r| {
+                let (x1, y1) = (
+                    r.x.saturating_add(r.width).min(w),
+                    r.y.saturating_add(r.height).min(h),
+                );
+                (r.x < x1 && r.y < y1).then(|| ScreenRect {
+                    x: r.x,
+                    y: r.y,
+                    width: x1 - r.x,
+                    height: y1 - r.y,
+                })
+            })
+            .collect();
+        let merged = merge_rects(&clipped);
+        gpu.guarded(CALL, || {
+            encoder.copy_texture_to_texture(
+                buffers.color(frame.newer).as_image_copy(),
+                target.texture().as_image_copy(),
+                target.texture().size(),
+            );
+            Ok(())
+        })?;
+        if !merged.is_empty() {
+            self.draw(gpu, encoder, frame, Some(&merged))?;
+        }
+        Ok(merged.iter().map(ScreenRect::area).sum())
+    }
+
+    /// Draws the combine over the whole target, or inside `rects` over what is there (the
+    /// target already checked).
+    fn draw(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &CombineFrame,
+        rects: Option<&[ScreenRect]>,
+    ) -> Result<(), GpuError> {
+        let (buffers, newer) = (frame.buffers, frame.newer);
+        gpu.guarded("CombinePass::record", || {
+            let params = CombineParams {
+                new_to_old: frame.new_to_old.to_cols_array_2d(),
+            };
+            self.params.write(encoder, &params)?;
+            let textures = [
+                buffers.color(newer),
+                buffers.id(newer),
+                buffers.depth(newer),
+                buffers.color(newer + 1),
+                buffers.id(newer + 1),
+                buffers.depth(newer + 1),
+                buffers.motion().unwrap_or(&self.still),
+            ];
+            let bind_group = textures_and_uniform(
+                gpu,
+                &self.layout,
+                &textures,
+                Some(self.params.buffer()),
+                "lodkit combine",
+            )?;
+            let label = "lodkit combine";
+            let mut pass = match rects {
+                None => begin_color_pass(encoder, frame.target, wgpu::Color::BLACK, label),
+                Some(_) => begin_load_pass(encoder, frame.target, label),
+            };
+            pass.set_pipeline(match buffers.motion() {
+                Some(_) => &self.pipeline,
+                None => &self.still_pipeline,
+            });
+            pass.set_bind_group(0, &bind_group, &[]);
+            match rects {
+                None => pass.draw(0..3, 0..1),
+                Some(rects) => {
+                    for r in rects {
+                        pass.set_scissor_rect(r.x, r.y, r.width, r.height);
+                        pass.draw(0..3, 0..1);
+                    }
+                }
+            }
+            Ok(())
+        })
+    }
+}
