@@ -216,9 +216,21 @@ fn every_pass_composes_validates_and_exports() {
 }
 
 fn glsl_harness(twin: &ModuleInfo) -> String {
+    // A twin's hook functions (under `LODKIT_<TOPIC>_HOOKS`) are switched on: every function is
+    // compiled, its hooks declared and not called.
+    let include = twin.include_path.as_deref().unwrap();
+    let topic = include
+        .trim_start_matches("lodkit/")
+        .trim_end_matches(".glsl")
+        .to_ascii_uppercase();
+    let hooks = format!("LODKIT_{topic}_HOOKS");
+    let switch = if twin.source.contains(&format!("#ifdef {hooks}")) {
+        format!("#define {hooks}\n")
+    } else {
+        String::new()
+    };
     format!(
-        "#version 450\n#extension GL_GOOGLE_include_directive : require\n#include \"{}\"\nlayout(location = 0) out vec4 lodkit_color;\nvoid main() {{ lodkit_color = vec4(0.0); }}\n",
-        twin.include_path.as_deref().unwrap()
+        "#version 450\n#extension GL_GOOGLE_include_directive : require\n{switch}#include \"{include}\"\nlayout(location = 0) out vec4 lodkit_color;\nvoid main() {{ lodkit_color = vec4(0.0); }}\n",
     )
 }
 

@@ -213,9 +213,14 @@ fn describe(path: &'static str, source: &'static str) -> ModuleInfo {
         })
         .unwrap_or_default();
     let guard = format!("LODKIT_{}_GLSL", stem.to_ascii_uppercase());
+    // A GLSL twin's include guard, and the switches of its hooks (`LODKIT_<TOPIC>_HOOKS`: the
+    // functions that read a texture through a function the includer defines), are GLSL's own,
+    // not shader defs of the module.
+    let is_hook_switch =
+        |d: &str| language == Language::Glsl && d.starts_with("LODKIT_") && d.ends_with("_HOOKS");
     let shader_defs = used_shader_defs(source, language)
         .into_iter()
-        .filter(|d| *d != guard)
+        .filter(|d| *d != guard && !is_hook_switch(d))
         .map(|name| ShaderDefInfo {
             doc: header_def_doc(&header, &name),
             name,

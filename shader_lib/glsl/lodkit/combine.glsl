@@ -46,8 +46,11 @@
 //   lodkit_combine_own_color(id, at, fallback) -> vec4   the blend of the texels around at holding id
 //   lodkit_combine_other_texel(id, read, at) -> uvec2   the nearest texel not holding id
 //   lodkit_combine_read_own(owner, uv, depth, new_to_old, motion, reach) -> lodkit_CombineRead
-// Hooks (GLSL cannot pass a texture to a function on every target, so these call functions the
-// includer defines, after its samplers, only if it calls them; texel = uvec2):
+// Hooks (GLSL cannot pass a texture to a function on every target, so the four functions above
+// that read the older buffer call functions the includer defines, after its samplers; they are
+// compiled only where LODKIT_COMBINE_HOOKS is defined before the first include, as
+// lodkit/combine_coverage.glsl does; an undefined prototype would otherwise reach the driver as
+// an empty function through naga's GLSL front end; texel = uvec2):
 //   vec4 lodkit_combine_fetch_color(uvec2 texel)   the older buffer's color
 //   uint lodkit_combine_fetch_word(uvec2 texel)   its id word
 //   float lodkit_combine_fetch_depth(uvec2 texel)   its clip depth (the depth attachment)
@@ -271,6 +274,7 @@ const float LODKIT_COMBINE_BLOCK_REACH = 1.5;
 /// Bilinear fractions within this of 0 or 1 are taken as that.
 const float LODKIT_COMBINE_SNAP = 0.01;
 
+#ifdef LODKIT_COMBINE_HOOKS
 /// Hook: the older buffer's color at `texel` (defined by the includer).
 vec4 lodkit_combine_fetch_color(uvec2 texel);
 /// Hook: the older buffer's id word at `texel`.
@@ -279,6 +283,7 @@ uint lodkit_combine_fetch_word(uvec2 texel);
 float lodkit_combine_fetch_depth(uvec2 texel);
 /// Hook: the older buffer's size.
 uvec2 lodkit_combine_fetch_size();
+#endif // LODKIT_COMBINE_HOOKS
 
 /// Clip position of a combine region's vertex at `pixel` (pixels, top-left origin).
 vec4 lodkit_combine_region_position(vec2 pixel, vec2 size) {
@@ -301,6 +306,7 @@ float lodkit_combine_ray_offset(vec2 at, uvec2 texel, uvec2 size) {
     return max(offset.x, offset.y);
 }
 
+#ifdef LODKIT_COMBINE_HOOKS
 /// The texel of the 3x3 block around `read` holding `id` whose older sample lies nearest the
 /// pixel's ray (from `base`, moved by `motion`), if within `reach` texels; else `read`.
 uvec2 lodkit_combine_cover_texel(uint id, uvec2 read, vec4 base, float depth, mat4 new_to_old, vec2 motion, float reach) {
@@ -320,6 +326,7 @@ uvec2 lodkit_combine_cover_texel(uint id, uvec2 read, vec4 base, float depth, ma
     }
     return best;
 }
+#endif // LODKIT_COMBINE_HOOKS
 
 /// Bilinear fractions with a value within LODKIT_COMBINE_SNAP of 0 or 1 taken as that.
 vec2 lodkit_combine_snap(vec2 fraction) {
@@ -328,6 +335,7 @@ vec2 lodkit_combine_snap(vec2 fraction) {
     return vec2(off.x < LODKIT_COMBINE_SNAP ? near.x : fraction.x, off.y < LODKIT_COMBINE_SNAP ? near.y : fraction.y);
 }
 
+#ifdef LODKIT_COMBINE_HOOKS
 /// The bilinear blend (lodkit_combine_snap) of the 2x2 older texels around `at` holding `id`,
 /// renormalized; `fallback` where none does.
 vec4 lodkit_combine_own_color(uint id, vec2 at, vec4 fallback) {
@@ -399,5 +407,7 @@ lodkit_CombineRead lodkit_combine_read_own(uint owner, vec2 uv, float depth, mat
     }
     return lodkit_CombineRead(texel, color, true);
 }
+
+#endif // LODKIT_COMBINE_HOOKS
 
 #endif // LODKIT_COMBINE_GLSL

@@ -34,6 +34,10 @@
 #ifndef LODKIT_COMBINE_COVERAGE_GLSL
 #define LODKIT_COMBINE_COVERAGE_GLSL
 
+// The hook functions of lodkit/combine.glsl and lodkit/silhouette.glsl (defined before either
+// is first included).
+#define LODKIT_COMBINE_HOOKS
+#define LODKIT_SILHOUETTE_HOOKS
 #include "lodkit/combine.glsl"
 #include "lodkit/lod_buffer.glsl"
 #include "lodkit/reproject.glsl"

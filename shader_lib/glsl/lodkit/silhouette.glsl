@@ -21,7 +21,9 @@
 //       winding number other than 0 around p, 0 where it has 0, LODKIT_SILHOUETTE_ON within
 //       LODKIT_SILHOUETTE_TIE of a segment
 // Hooks (GLSL cannot pass a texture to a function on every target, so the functions that read
-// one call a function the includer defines, after its sampler, only if it calls them):
+// one call a function the includer defines, after its sampler; they are compiled only where
+// LODKIT_SILHOUETTE_HOOKS is defined before the first include, as lodkit/combine_coverage.glsl
+// does):
 //   uvec4 lodkit_silhouette_fetch(uint index)   texel `index` of the data texture, e.g.
 //       texelFetch(data, ivec2(index % width, index / width), 0)
 // Shader defs: none.
@@ -34,9 +36,6 @@ const float LODKIT_SILHOUETTE_TIE = 0.001;
 
 /// What lodkit_silhouette_covers answers for a point within LODKIT_SILHOUETTE_TIE of the outline.
 const int LODKIT_SILHOUETTE_ON = -1;
-
-/// Hook: texel `index` of the data texture (defined by the includer).
-uvec4 lodkit_silhouette_fetch(uint index);
 
 /// The winding number contribution of the segment from `a` to `b` around the point `p`: +1 where
 /// it crosses p's horizontal line upwards with p on its left, -1 downwards with p on its right,
@@ -55,6 +54,10 @@ float lodkit_silhouette_distance(vec2 p, vec2 a, vec2 b) {
     float along = clamp(dot(p - a, ab) / max(dot(ab, ab), 1.0e-12), 0.0, 1.0);
     return length(p - (a + along * ab));
 }
+
+#ifdef LODKIT_SILHOUETTE_HOOKS
+/// Hook: texel `index` of the data texture (defined by the includer).
+uvec4 lodkit_silhouette_fetch(uint index);
 
 /// Texel `index` of the data texture (row after row), through the includer's hook.
 uvec4 lodkit_silhouette_texel(uint index) {
@@ -84,5 +87,7 @@ int lodkit_silhouette_covers(uvec4 table, vec2 p) {
     }
     return winding != 0 ? 1 : 0;
 }
+
+#endif // LODKIT_SILHOUETTE_HOOKS
 
 #endif // LODKIT_SILHOUETTE_GLSL
