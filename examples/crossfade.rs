@@ -19,7 +19,7 @@ use std::error::Error;
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::gpu::transition_scene::{SingleFrameTechnique, transition_items};
 use lodkit::screen_door::DitherPattern;
 use lodkit::select::{LodCamera, LodGroup, LodSettings, LodState, TransitionMode};
@@ -121,7 +121,17 @@ fn main() -> Result<(), Box<dyn Error>> {
                 a: 1.0,
             };
             let light = Vec3::new(0.4, 0.8, 0.6);
-            renderer.render(&gpu, &target, clear, proj * view, light, &items, None)?;
+            renderer.render(
+                &gpu,
+                &target,
+                &MeshFrame {
+                    clear,
+                    view_proj: proj * view,
+                    light_dir: light,
+                    items: &items,
+                    ..Default::default()
+                },
+            )?;
             if selection.next.is_some() {
                 transition_frames.push(frame);
                 rows[row].push(read_texture_rgba8(&gpu, &target.color)?);

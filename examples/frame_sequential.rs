@@ -26,7 +26,7 @@ use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
@@ -166,8 +166,17 @@ fn main() -> Result<(), Box<dyn Error>> {
             view_proj: views[0],
             prev_view_proj: views[1],
         };
-        let (triangles, _) =
-            renderer.render(&gpu, &buffers, index, lod_view, &items, clear, None)?;
+        let (triangles, _) = renderer.render(
+            &gpu,
+            &buffers,
+            &LodBufferFrame {
+                index,
+                view: lod_view,
+                items: &items,
+                clear,
+                ..Default::default()
+            },
+        )?;
         if keys.iter().any(|key| scheduler.in_transition(*key)) {
             (drawn, hard) = (drawn + triangles, hard + hard_frame);
             per_frame.push(triangles);

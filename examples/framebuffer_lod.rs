@@ -25,7 +25,7 @@ use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
     UpsampleSettings,
 };
-use lodkit::gpu::gbuffer_scene::{GBufferRenderer, GDrawItem, ShadingTerm};
+use lodkit::gpu::gbuffer_scene::{GBufferFrame, GBufferRenderer, GDrawItem, ShadingTerm};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
@@ -113,12 +113,21 @@ fn main() -> Result<(), Box<dyn Error>> {
         b: 0.15,
         a: 1.0,
     };
+    // The scene at full resolution (r = 1): the prepass's draw, and the shading's at each r.
+    let scene = GBufferFrame {
+        view,
+        proj,
+        items: &items,
+        clear,
+        far_view_depth: FAR,
+        ..Default::default()
+    };
 
     // One frame at resize factor r; returns its time in milliseconds.
     let frame = |r: f32| -> Result<f32, Box<dyn Error>> {
         let start = Instant::now();
-        prepass_pass.render(&gpu, &prepass, 1.0, view, proj, &items, clear, FAR)?;
-        shading.render(&gpu, &low, r, view, proj, &items, clear, FAR)?;
+        prepass_pass.render(&gpu, &prepass, &scene)?;
+        shading.render(&gpu, &low, &GBufferFrame { r, ..scene })?;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let sigmas = RangeSigmas {
             depth: SIGMA_Z,
@@ -138,7 +147,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     };
 
     // The full-resolution frame, for the picture and to set a budget it cannot meet.
-    shading.render(&gpu, &low, 1.0, view, proj, &items, clear, FAR)?;
+    shading.render(&gpu, &low, &scene)?;
     let reference = read_texture_rgba8(&gpu, low.color())?;
     let full_ms = (0..3).map(|_| frame(1.0)).collect::<Result<Vec<_>, _>>()?;
     let full_ms = full_ms.iter().copied().fold(f32::INFINITY, f32::min);

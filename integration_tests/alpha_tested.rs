@@ -5,9 +5,9 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use lodkit::alpha_mask::{AlphaMask, alpha_mask_keep, alpha_mask_rect};
 use lodkit::gpu::frame_sequential::{LodBuffers, read_lod_image};
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::unpopping::LodRenderState;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
@@ -68,7 +68,17 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
     let light = Vec3::Z;
     let black = wgpu::Color::BLACK;
     single
-        .render(gpu, &target, black, view_proj, light, &[item], None)
+        .render(
+            gpu,
+            &target,
+            &MeshFrame {
+                clear: black,
+                view_proj,
+                light_dir: light,
+                items: &[item],
+                ..Default::default()
+            },
+        )
         .unwrap();
     let pixels = read_texture_rgba8(gpu, &target.color).unwrap();
     let single_got: Vec<bool> = pixels.chunks(4).map(|p| p[0] > 8).collect();
@@ -90,8 +100,18 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
         prev_sway_phase: 0.0,
         alpha_rect: rect,
     };
-    lod.render(gpu, &buffers, 0, view_proj, &[item], black, None)
-        .unwrap();
+    lod.render(
+        gpu,
+        &buffers,
+        &LodBufferFrame {
+            index: 0,
+            view: view_proj.into(),
+            items: &[item],
+            clear: black,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let lod_got: Vec<bool> = read_lod_image(gpu, &buffers, 0)
         .unwrap()
         .ids
@@ -106,8 +126,18 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
     // Without the rect the card is whole.
     let mut whole = item;
     whole.alpha_rect = Vec4::ZERO;
-    lod.render(gpu, &buffers, 0, view_proj, &[whole], black, None)
-        .unwrap();
+    lod.render(
+        gpu,
+        &buffers,
+        &LodBufferFrame {
+            index: 0,
+            view: view_proj.into(),
+            items: &[whole],
+            clear: black,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let ids = read_lod_image(gpu, &buffers, 0).unwrap().ids;
     assert_eq!(ids.iter().filter(|&&id| id == 3).count(), (W * W) as usize);
     say(&format!(
@@ -149,7 +179,17 @@ fn a_bad_alpha_mask_is_refused_and_the_old_one_kept() {
     let view_proj = head_on();
     let black = wgpu::Color::BLACK;
     single
-        .render(gpu, &target, black, view_proj, Vec3::Z, &[item], None)
+        .render(
+            gpu,
+            &target,
+            &MeshFrame {
+                clear: black,
+                view_proj,
+                light_dir: Vec3::Z,
+                items: &[item],
+                ..Default::default()
+            },
+        )
         .unwrap();
     let lit = read_texture_rgba8(gpu, &target.color).unwrap();
     assert!(

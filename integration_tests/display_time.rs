@@ -9,7 +9,7 @@ use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::lod_buffer::{
@@ -546,7 +546,17 @@ impl SphereLods {
     ) -> Vec<u8> {
         let clear = wgpu::Color::BLACK;
         self.renderer
-            .render(gpu, buffers, index, view, &[item], clear, None)
+            .render(
+                gpu,
+                buffers,
+                &LodBufferFrame {
+                    index,
+                    view: view.into(),
+                    items: &[item],
+                    clear,
+                    ..Default::default()
+                },
+            )
             .unwrap();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let frame = CombineFrame {

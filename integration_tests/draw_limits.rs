@@ -5,10 +5,10 @@ use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::GpuError;
 use lodkit::gpu::frame_sequential::LodBuffers;
 use lodkit::gpu::framebuffer_lod::LowResBuffer;
-use lodkit::gpu::gbuffer_scene::{GBufferRenderer, GDrawItem, ShadingTerm};
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::gbuffer_scene::{GBufferFrame, GBufferRenderer, GDrawItem, ShadingTerm};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::DrawUniforms;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::unpopping::LodRenderState;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
@@ -48,7 +48,17 @@ fn more_draws_than_a_renderer_takes_is_an_error_naming_the_limit() {
     let render = |n: usize| {
         let items = vec![item; n];
         let clear = wgpu::Color::BLACK;
-        renderer.render(gpu, &buffers, 0, Mat4::IDENTITY, &items, clear, None)
+        renderer.render(
+            gpu,
+            &buffers,
+            &LodBufferFrame {
+                index: 0,
+                view: Mat4::IDENTITY.into(),
+                items: &items,
+                clear,
+                ..Default::default()
+            },
+        )
     };
     // Every one of MAX_DRAWS items is drawn; one more is refused, not cut off.
     assert_eq!(render(max).unwrap().0, max as u64 * 12);
@@ -70,7 +80,17 @@ fn more_draws_than_a_renderer_takes_is_an_error_naming_the_limit() {
     let r = {
         let light = Vec3::Y;
         let clear = wgpu::Color::BLACK;
-        mesh_renderer.render(gpu, &target, clear, Mat4::IDENTITY, light, &items, None)
+        mesh_renderer.render(
+            gpu,
+            &target,
+            &MeshFrame {
+                clear,
+                view_proj: Mat4::IDENTITY,
+                light_dir: light,
+                items: &items,
+                ..Default::default()
+            },
+        )
     };
     too_many("MeshRenderer::render", max, r.map(drop));
 
@@ -85,7 +105,18 @@ fn more_draws_than_a_renderer_takes_is_an_error_naming_the_limit() {
     let items = vec![item; max + 1];
     let r = {
         let (view, proj) = (Mat4::IDENTITY, Mat4::IDENTITY);
-        g.render(gpu, &low, 1.0, view, proj, &items, wgpu::Color::BLACK, 1.0)
+        g.render(
+            gpu,
+            &low,
+            &GBufferFrame {
+                r: 1.0,
+                view,
+                proj,
+                items: &items,
+                clear: wgpu::Color::BLACK,
+                far_view_depth: 1.0,
+            },
+        )
     };
     too_many("GBufferRenderer::render", max, r);
     // The 1024 draws may still be running: a process that exits under them crashes in the

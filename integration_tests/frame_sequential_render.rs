@@ -7,7 +7,7 @@ use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::reproject::new_to_old_matrix;
@@ -94,16 +94,18 @@ fn combine_matches_the_cpu_rule(depth: DepthConvention, proj: Mat4) {
             .render(
                 gpu,
                 &buffers,
-                scheduler.buffer_index(),
-                proj * *view,
-                &items,
-                wgpu::Color {
-                    r: 0.05,
-                    g: 0.05,
-                    b: 0.1,
-                    a: 1.0,
+                &LodBufferFrame {
+                    index: scheduler.buffer_index(),
+                    view: (proj * *view).into(),
+                    items: &items,
+                    clear: wgpu::Color {
+                        r: 0.05,
+                        g: 0.05,
+                        b: 0.1,
+                        a: 1.0,
+                    },
+                    ..Default::default()
                 },
-                None,
             )
             .unwrap();
     }
@@ -241,7 +243,17 @@ fn lod_buffers_without_motion_combine_a_moving_camera_like_with_it() {
             };
             let clear = wgpu::Color::BLACK;
             renderer
-                .render(gpu, buffers, i, view, &items, clear, None)
+                .render(
+                    gpu,
+                    buffers,
+                    &LodBufferFrame {
+                        index: i,
+                        view,
+                        items: &items,
+                        clear,
+                        ..Default::default()
+                    },
+                )
                 .unwrap();
         }
         let m = new_to_old_matrix(&eye(0.3), &proj, &eye(0.0), &proj);
@@ -305,7 +317,17 @@ fn a_transition_may_begin_on_any_frame_without_the_object_dropping_out() {
         let index = scheduler.buffer_index();
         let vp = proj * view;
         renderer
-            .render(gpu, buffers, index, vp, &[item], clear, None)
+            .render(
+                gpu,
+                buffers,
+                &LodBufferFrame {
+                    index,
+                    view: vp.into(),
+                    items: &[item],
+                    clear,
+                    ..Default::default()
+                },
+            )
             .unwrap();
         let m = if first {
             CombinePass::NO_HISTORY
@@ -392,7 +414,17 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
     let render = |items: &[LodDrawItem]| {
         let clear = wgpu::Color::BLACK;
         let (triangles, _) = renderer
-            .render(gpu, &buffers, 0, proj * view, items, clear, None)
+            .render(
+                gpu,
+                &buffers,
+                &LodBufferFrame {
+                    index: 0,
+                    view: (proj * view).into(),
+                    items,
+                    clear,
+                    ..Default::default()
+                },
+            )
             .unwrap();
         (triangles, read_lod_image(gpu, &buffers, 0).unwrap())
     };
@@ -455,11 +487,13 @@ fn the_combine_over_the_t_instances_rectangles_equals_the_full_combine() {
             .render(
                 gpu,
                 &buffers,
-                s.buffer_index(),
-                proj * *view,
-                &items,
-                clear,
-                None,
+                &LodBufferFrame {
+                    index: s.buffer_index(),
+                    view: (proj * *view).into(),
+                    items: &items,
+                    clear,
+                    ..Default::default()
+                },
             )
             .unwrap();
     }
@@ -644,7 +678,17 @@ fn a_swaying_lod_moves_with_its_phase() {
         };
         let clear = wgpu::Color::BLACK;
         renderer
-            .render(gpu, &buffers, 0, proj * view, &[item], clear, None)
+            .render(
+                gpu,
+                &buffers,
+                &LodBufferFrame {
+                    index: 0,
+                    view: (proj * view).into(),
+                    items: &[item],
+                    clear,
+                    ..Default::default()
+                },
+            )
             .unwrap();
         read_lod_image(gpu, &buffers, 0).unwrap()
     };

@@ -8,7 +8,6 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use glam::Mat4;
 use lodkit::combine::DepthConvention;
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
@@ -17,8 +16,8 @@ use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
     UpsampleSettings,
 };
-use lodkit::gpu::gbuffer_scene::{EdgeScene, GBufferRenderer, ShadingTerm};
-use lodkit::gpu::lod_buffer_scene::LodBufferRenderer;
+use lodkit::gpu::gbuffer_scene::{EdgeScene, GBufferFrame, GBufferRenderer, ShadingTerm};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer};
 use lodkit::gpu::readback::{read_buffer, read_texture, read_texture_rgba8};
 use lodkit::gpu::resources::{DrawUniforms, r32float_texture, texture_2d, uniform_buffer};
 use lodkit::gpu::scene::{GpuMesh, Mesh, MeshRenderer, RenderTarget};
@@ -477,28 +476,11 @@ fn passes_given_mismatched_inputs_name_both() {
     let vis = visibility_texture(VisibilityPattern::WhiteNoise, 8, 1);
     let renderer = LodBufferRenderer::new(gpu, RGBA8, &vis, 1.0).unwrap();
     let float_buffers = LodBuffers::new(gpu, 8, 8, wgpu::TextureFormat::Rgba16Float).unwrap();
-    let r = renderer.render(
-        gpu,
-        &float_buffers,
-        0,
-        Mat4::IDENTITY,
-        &[],
-        wgpu::Color::BLACK,
-        None,
-    );
+    let r = renderer.render(gpu, &float_buffers, &LodBufferFrame::default());
     mismatch(r.map(drop), "buffers", "Rgba16Float", "Rgba8Unorm");
     let g = GBufferRenderer::new(gpu, RGBA8, ShadingTerm::Full).unwrap();
     let float_low = LowResBuffer::new(gpu, 8, 8, wgpu::TextureFormat::Rgba16Float).unwrap();
-    let r = g.render(
-        gpu,
-        &float_low,
-        1.0,
-        Mat4::IDENTITY,
-        Mat4::IDENTITY,
-        &[],
-        wgpu::Color::BLACK,
-        1.0,
-    );
+    let r = g.render(gpu, &float_low, &GBufferFrame::default());
     mismatch(r, "target", "Rgba16Float", "Rgba8Unorm");
 
     // Readback: wrong texel size, no COPY_SRC, a LOD image of another format, too many bytes.

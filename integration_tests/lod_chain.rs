@@ -8,7 +8,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::lod_chain::{LodChain, LodChainDescriptor, MeshData, PixelErrorCamera};
 use lodkit::unpopping::LodRenderState;
 
@@ -162,7 +162,17 @@ fn coverage(
     };
     let clear = wgpu::Color::TRANSPARENT;
     renderer
-        .render(gpu, target, clear, proj * view, Vec3::Y, &[item], None)
+        .render(
+            gpu,
+            target,
+            &MeshFrame {
+                clear,
+                view_proj: proj * view,
+                light_dir: Vec3::Y,
+                items: &[item],
+                ..Default::default()
+            },
+        )
         .unwrap();
     let rgba = read_texture_rgba8(gpu, &target.color).unwrap();
     rgba.chunks_exact(4).map(|p| p[3] > 0).collect()

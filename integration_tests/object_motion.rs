@@ -7,7 +7,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use lodkit::combine::combine_object_motion;
 use lodkit::frame_sequential::{Drive, FrameDraw, InstanceKey, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
-use lodkit::gpu::lod_buffer_scene::{LodDrawItem, LodView};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture;
 use lodkit::lod_buffer::{lod_buffer_motion, lod_buffer_output_motion};
 use lodkit::reproject::new_to_old_matrix;
@@ -288,11 +288,13 @@ fn coverage(
         .render(
             gpu,
             scratch,
-            0,
-            view_proj,
-            &[whole],
-            wgpu::Color::BLACK,
-            None,
+            &LodBufferFrame {
+                index: 0,
+                view: view_proj.into(),
+                items: &[whole],
+                clear: wgpu::Color::BLACK,
+                ..Default::default()
+            },
         )
         .unwrap();
     read_texture(gpu, scratch.id(0), 4)

@@ -93,6 +93,8 @@ pub fn bilateral_weight(
 /// let v = bilateral_upsample(Vec2::new(0.5, 0.5), &values, Vec4::new(2.0, 9.0, 2.0, 9.0), &flat, 2.0, Vec3::Z, 0.1, 0.5);
 /// assert!(v.x < 1e-6);
 /// ```
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn bilateral_upsample(
     f: Vec2,
@@ -119,6 +121,8 @@ pub fn bilateral_upsample(
 /// [`bilateral_upsample`] with the samples' and the pixel's normals given through the
 /// foreshortening map (`projected`, `here`: [`foreshortened_normal`] of each), as the packed
 /// layout stores them.
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn bilateral_upsample_projected(
     f: Vec2,
@@ -220,6 +224,8 @@ pub fn bilateral_cell_texel(
 }
 
 /// Eq. 1 from four fetched L texels: `colors` and `geometry` (gbuffer layout).
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn bilateral_upsample_texels(
     f: Vec2,
@@ -268,6 +274,8 @@ impl<T: Copy> Image<'_, T> {
 
 /// The whole lookup on the CPU, as `bilateral_upsample_at` does on the GPU: the 2x2 L texels of
 /// the full-res pixel at `frag_coord` from `low_color` and `low_geometry`, then eq. 1.
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn bilateral_upsample_at(
     low_color: Image,
@@ -336,6 +344,8 @@ pub fn bilateral_upsample_packed(
 /// let c = bilateral_upsample_packed_at(low, viewport, full, Vec2::new(2.5, 0.5), 9.0, Vec3::Z, 0.1, 0.5);
 /// assert_eq!(c, Vec4::new(0.0, 0.0, 1.0, 1.0));
 /// ```
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn bilateral_upsample_packed_at(
     low: Image<UVec4>,

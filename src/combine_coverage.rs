@@ -84,12 +84,18 @@ pub struct CombineObject {
     pub older_tau: f32,
 }
 
+/// Texel `i` of record `id`; the index wraps as the shader's u32 arithmetic does (data that is not
+/// [`CombineData`]'s reads as zeros or other records, never panics).
+fn record_texel(data: &[[u32; 4]], id: u32, i: u32) -> UVec4 {
+    silhouette_texel(data, id.wrapping_mul(COMBINE_RECORD).wrapping_add(i))
+}
+
 /// The record of `id` in the data texture; for an id past the records, the frame's matrix with
 /// no flags (a t-instance the combine does not know).
 pub fn combine_object(data: &[[u32; 4]], id: u32) -> CombineObject {
     let slots = silhouette_texel(data, 5).z;
     let k = if id < slots { id } else { 0 };
-    let texel = |i: u32| silhouette_texel(data, k * COMBINE_RECORD + i);
+    let texel = |i: u32| record_texel(data, k, i);
     let column = |i: u32| Vec4::from_array(texel(i).to_array().map(f32::from_bits));
     let record = texel(5);
     CombineObject {
@@ -125,6 +131,8 @@ pub fn combine_far_depth(convention: DepthConvention) -> f32 {
 /// coverage is known (silhouette or depth pass), that level does not cover the pixel: not found;
 /// where it holds an estimated one, it is taken only where its sample lies on the pixel's ray
 /// under that t-instance's own matrix (a group that moved away leaves no trace).
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn combine_read_estimated(
     older: &LodImage,
@@ -162,6 +170,8 @@ pub fn combine_read_estimated(
 /// t-instance, or the t-instance the older buffer holds where that level's depth reprojects when
 /// it lies in front; read where its own surface was. Where none is, what lies behind the
 /// pixel's own older level.
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn combine_read_level_depth(
     older: &LodImage,
@@ -241,10 +251,10 @@ pub fn combine_read_silhouettes(
     let slots = silhouette_texel(data, 5).z;
     let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
     for g in 1..slots {
-        if silhouette_texel(data, g * COMBINE_RECORD + 5).x & wanted != wanted {
+        if record_texel(data, g, 5).x & wanted != wanted {
             continue;
         }
-        let table = silhouette_texel(data, g * COMBINE_RECORD + 4);
+        let table = record_texel(data, g, 4);
         let mut covers = silhouette_covers(data, table, p);
         if covers == 0 {
             continue;
@@ -267,6 +277,8 @@ pub fn combine_read_silhouettes(
 /// level by its record's route (its silhouette, the depth pass, or estimated; estimated for a
 /// t-instance without a record); for a pixel showing none, a level the depth pass drew there,
 /// else a level whose silhouette covers it, else the estimate.
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn combine_read(
     older: &LodImage,

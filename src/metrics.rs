@@ -16,7 +16,7 @@
 //!   scores a low pop); this does.
 //! - [`see_through`] and [`ghosts`]: pixels both levels cover where a frame shows the
 //!   background, and pixels neither covers where it shows an object.
-//! - [`psnr_rgba8`] and [`median`].
+//! - [`psnr_rgba8`], [`ssim_rgba8`] and [`median`].
 //!
 //! ```
 //! use lodkit::metrics::{FlickerMeter, pop, transition_change};
@@ -316,6 +316,66 @@ pub fn median(values: &[f64]) -> f64 {
     } else {
         (v[n / 2 - 1] + v[n / 2]) / 2.0
     }
+}
+
+/// Mean structural similarity (SSIM, Wang et al. 2004) of two RGBA8 images of `width` pixels per
+/// row, on luma (Rec. 601) over 8x8 windows every 4 pixels, with the usual constants
+/// (K1 = 0.01, K2 = 0.03, L = 255): 1 for equal images, lower as structure differs. NaN when
+/// the sizes differ or the images are smaller than one window. The windows are uniform (not
+/// Gaussian) and use population variances, so figures differ slightly from reference
+/// implementations with an 11x11 Gaussian.
+///
+/// ```
+/// # use lodkit::metrics::ssim_rgba8;
+/// let a: Vec<u8> = (0..16 * 16).flat_map(|i| [(i * 7 % 256) as u8, 0, 0, 255]).collect();
+/// assert!((ssim_rgba8(&a, &a, 16) - 1.0).abs() < 1e-6);
+/// let flat = vec![128u8; a.len()];
+/// assert!(ssim_rgba8(&a, &flat, 16) < 0.2);
+/// // Two flat grays: no structure, only the luminance term (2 ma mb + C1) / (ma^2 + mb^2 + C1).
+/// let (g100, g150) = (vec![100u8; 16 * 16 * 4], vec![150u8; 16 * 16 * 4]);
+/// let c1 = (0.01f64 * 255.0).powi(2);
+/// let expected = (2.0 * 100.0 * 150.0 + c1) / (100.0f64.powi(2) + 150.0f64.powi(2) + c1);
+/// assert!((f64::from(ssim_rgba8(&g100, &g150, 16)) - expected).abs() < 1e-4);
+/// ```
+pub fn ssim_rgba8(a: &[u8], b: &[u8], width: u32) -> f32 {
+    const WIN: usize = 8;
+    let w = width as usize;
+    if a.len() != b.len() || w < WIN || !a.len().is_multiple_of(4 * w) || a.len() / (4 * w) < WIN {
+        return f32::NAN;
+    }
+    let h = a.len() / (4 * w);
+    let luma = |img: &[u8]| -> Vec<f64> {
+        img.chunks_exact(4)
+            .map(|p| 0.299 * f64::from(p[0]) + 0.587 * f64::from(p[1]) + 0.114 * f64::from(p[2]))
+            .collect()
+    };
+    let (la, lb) = (luma(a), luma(b));
+    let (c1, c2) = ((0.01f64 * 255.0).powi(2), (0.03f64 * 255.0).powi(2));
+    let (mut sum, mut windows) = (0.0f64, 0usize);
+    for y0 in (0..=h - WIN).step_by(4) {
+        for x0 in (0..=w - WIN).step_by(4) {
+            let (mut sa, mut sb, mut saa, mut sbb, mut sab) = (0.0, 0.0, 0.0, 0.0, 0.0);
+            for y in y0..y0 + WIN {
+                for x in x0..x0 + WIN {
+                    let (p, q) = (la[y * w + x], lb[y * w + x]);
+                    sa += p;
+                    sb += q;
+                    saa += p * p;
+                    sbb += q * q;
+                    sab += p * q;
+                }
+            }
+            let n = (WIN * WIN) as f64;
+            let (ma, mb) = (sa / n, sb / n);
+            let va = saa / n - ma * ma;
+            let vb = sbb / n - mb * mb;
+            let cov = sab / n - ma * mb;
+            sum += ((2.0 * ma * mb + c1) * (2.0 * cov + c2))
+                / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+            windows += 1;
+        }
+    }
+    (sum / windows as f64) as f32
 }
 
 #[cfg(test)]

@@ -289,7 +289,7 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
     ));
     let code = match lodkit_cli::demo::run(&options) {
         Ok(report) => {
-            out.println(&lodkit_cli::demo::report::summary(&report));
+            out.println(&lodkit_cli::demo::terminal::summary(&report));
             out.println(&format!(
                 "open {}",
                 options.out.join("index.html").display()

@@ -34,6 +34,7 @@ fn the_combine_rectangles_hold_every_pixel_of_the_swaying_tree() {
             technique,
             moving,
             transition: true,
+            hold_level: 0,
             background: Background::Scene,
         };
         renderer

@@ -204,7 +204,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     let report = run_on(gpu, &options, &scenes).unwrap();
     for t in &report.transitions {
         say(&format!(
-            "demo figure {} {}: pop {:.3}/{:.3} flicker {:.2}/{:.2} reversals {}/{} see-through {:.4} silhouette {:.4} outside {}",
+            "demo figure {} {}: pop {:.3}/{:.3} flicker {:.2}/{:.2} reversals {}/{} vs coarse {:.2}/{:.2} reversals {}/{} see-through {:.4} silhouette {:.4} ({} / {} px) outside {}",
             t.scene,
             t.technique,
             t.pop_static,
@@ -213,8 +213,14 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             t.flicker_moving,
             t.reversals_static,
             t.reversals_moving,
+            t.flicker_static_coarse,
+            t.flicker_moving_coarse,
+            t.reversals_static_coarse,
+            t.reversals_moving_coarse,
             t.see_through,
             t.silhouette_error,
+            t.see_through_pixels_moving,
+            t.ghosts_moving,
             t.outside_rects
         ));
     }
@@ -288,6 +294,12 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
                 "a hard switch in {}",
                 scene.name
             );
+            assert_eq!(
+                (hard.flicker_static_coarse, hard.reversals_static_coarse),
+                (1.0, 0),
+                "a hard switch against the coarse level in {}",
+                scene.name
+            );
         }
         assert_eq!(hard.triangles, expected_triangles(scene, frames, false));
         let fade = row("cross-fade");
@@ -298,6 +310,20 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             fade.silhouette_error > 0.3,
             "cross-fade: silhouette error {}",
             fade.silhouette_error
+        );
+        // The silhouette error's parts: the cross-fade's is see-through.
+        assert!(
+            fade.see_through_pixels_moving > 0,
+            "cross-fade: no see-through pixel"
+        );
+        // Flicker against the coarse level's run is its own figure: a reference that fell back
+        // to the fine level would repeat the fine figures exactly.
+        let seq = row("frame-seq-complementary");
+        assert_ne!(
+            (seq.flicker_moving, seq.reversals_moving),
+            (seq.flicker_moving_coarse, seq.reversals_moving_coarse),
+            "frame-seq-complementary in {}: the coarse reference repeats the fine one",
+            scene.name
         );
         assert_eq!(fade.fragments_vs_hard.is_some(), counts, "fragment counts");
         if let Some(f) = fade.fragments_vs_hard {

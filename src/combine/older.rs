@@ -148,6 +148,8 @@ pub fn combine_ray_offset(at: Vec2, texel: UVec2, size: UVec2) -> f32 {
 /// `base` = `reproject_base(uv, new_to_old)` and moved by `motion`), if nearer than `reach`
 /// texels; else `read`. A neighbour whose sample lies farther is not shown here: where the
 /// older level does not cover the pixel, it shows what the read holds.
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn combine_cover_texel(
     older: &LodImage,
@@ -252,6 +254,8 @@ pub fn combine_other_texel(older: &LodImage, id: u32, read: UVec2, at: Vec2) -> 
 /// or the clear depth, would move the read by that surface's parallax, off the level); where
 /// the read holds something else, [`combine_cover_texel`] within `reach`, read at its sample;
 /// the color [`combine_own_color`].
+///
+/// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn combine_read_own(
     older: &LodImage,

@@ -133,11 +133,25 @@ pub enum CombineDataError {
         /// The second.
         second: usize,
     },
-    /// A matrix, threshold or silhouette point that is NaN or infinite.
-    #[error("{what} is not finite")]
+    /// The camera's matrix holds a NaN or an infinity.
+    #[error("the camera's new_to_old is not finite")]
+    CameraNotFinite,
+    /// An object's matrix, threshold or silhouette point is NaN or infinite.
+    #[error("objects[{index}]'s {what} is not finite")]
     NotFinite {
-        /// What: the camera's matrix, or `objects[i]`'s matrix, threshold or silhouette.
+        /// Its index in the objects.
+        index: usize,
+        /// What: `new_to_old`, `older_tau` or `silhouette`.
         what: &'static str,
+    },
+    /// An object asks for the older-level depth pass, which the descriptor says is not read.
+    #[error(
+        "objects[{index}] takes its coverage from the depth pass, but the descriptor's level_depth \
+         is false: draw the older levels' depth pass and set level_depth, or choose another route"
+    )]
+    NoDepthPass {
+        /// Its index in the objects.
+        index: usize,
     },
 }
 
@@ -171,9 +185,7 @@ impl CombineData {
     /// ```
     pub fn new(desc: &CombineDataDescriptor) -> Result<Self, CombineDataError> {
         if !desc.new_to_old.is_finite() {
-            return Err(CombineDataError::NotFinite {
-                what: "the camera's new_to_old",
-            });
+            return Err(CombineDataError::CameraNotFinite);
         }
         let mut slots = 1u32;
         for (index, o) in desc.objects.iter().enumerate() {
@@ -198,13 +210,20 @@ impl CombineData {
                 CoverageRoute::Silhouette(s) => s.iter().flatten().all(|v| v.is_finite()),
                 _ => true,
             };
-            if !o.new_to_old.is_finite()
-                || !o.older_tau.is_none_or(f32::is_finite)
-                || !finite_segments
-            {
-                return Err(CombineDataError::NotFinite {
-                    what: "an object's matrix, older_tau or silhouette",
-                });
+            let not_finite = if !o.new_to_old.is_finite() {
+                Some("new_to_old")
+            } else if !o.older_tau.is_none_or(f32::is_finite) {
+                Some("older_tau")
+            } else if !finite_segments {
+                Some("silhouette")
+            } else {
+                None
+            };
+            if let Some(what) = not_finite {
+                return Err(CombineDataError::NotFinite { index, what });
+            }
+            if o.route == CoverageRoute::DepthPass && !desc.level_depth {
+                return Err(CombineDataError::NoDepthPass { index });
             }
             slots = slots.max(o.id + 1);
         }
@@ -308,5 +327,81 @@ mod tests {
             data(&[object(u32::MAX)]),
             Err(CombineDataError::IdTooLarge { .. })
         ));
+    }
+
+    #[test]
+    fn each_bad_object_is_named_by_its_index_and_what_is_wrong() {
+        let good = CombineObjectData {
+            id: 1,
+            new_to_old: Mat4::IDENTITY,
+            older_tau: Some(0.5),
+            route: CoverageRoute::Estimate,
+        };
+        let nan = [[0.0, 0.0, f32::NAN, 1.0]];
+        let bad = [
+            CombineObjectData {
+                new_to_old: Mat4::from_cols_array(&[f32::INFINITY; 16]),
+                ..good
+            },
+            CombineObjectData {
+                older_tau: Some(f32::NAN),
+                ..good
+            },
+            CombineObjectData {
+                route: CoverageRoute::Silhouette(&nan),
+                ..good
+            },
+        ];
+        for (o, what) in bad.iter().zip(["new_to_old", "older_tau", "silhouette"]) {
+            let objects = [good, CombineObjectData { id: 2, ..*o }];
+            let e = CombineData::new(&CombineDataDescriptor {
+                objects: &objects,
+                ..Default::default()
+            })
+            .unwrap_err();
+            assert_eq!(e, CombineDataError::NotFinite { index: 1, what });
+            assert!(e.to_string().contains("objects[1]'s"), "{e}");
+        }
+        let e = CombineData::new(&CombineDataDescriptor {
+            new_to_old: Mat4::from_cols_array(&[f32::NAN; 16]),
+            ..Default::default()
+        });
+        assert_eq!(e.unwrap_err(), CombineDataError::CameraNotFinite);
+    }
+
+    #[test]
+    fn a_depth_pass_object_needs_the_depth_pass() {
+        let objects = [CombineObjectData {
+            id: 4,
+            route: CoverageRoute::DepthPass,
+            ..Default::default()
+        }];
+        let desc = CombineDataDescriptor {
+            objects: &objects,
+            ..Default::default()
+        };
+        let e = CombineData::new(&desc).unwrap_err();
+        assert_eq!(e, CombineDataError::NoDepthPass { index: 0 });
+        assert!(e.to_string().contains("level_depth"), "{e}");
+        let with_pass = CombineDataDescriptor {
+            level_depth: true,
+            ..desc
+        };
+        let data = CombineData::new(&with_pass).unwrap();
+        let o = crate::combine_coverage::combine_object(&data.texels, 4);
+        assert_eq!(o.flags & COMBINE_ROUTE_DEPTH_PASS, COMBINE_ROUTE_DEPTH_PASS);
+    }
+
+    #[test]
+    fn data_that_is_not_combine_datas_reads_without_a_panic() {
+        // Record counts and texel indices near u32::MAX wrap as the shader's u32 arithmetic does
+        // (a debug build panics on an unchecked overflow); what such data reads is unspecified.
+        let mut texels = vec![[0; 4]; 12];
+        texels[5] = [COMBINE_KNOWN, 0, u32::MAX, 0];
+        let _ = crate::combine_coverage::combine_object(&texels, u32::MAX - 1);
+        // Row 1 of a table at u32::MAX wraps to texel 0, whose entry starts at u32::MAX again.
+        let data = [[u32::MAX, 2, 0, 0]];
+        let table = glam::UVec4::new(u32::MAX, 0, 4, 0xffff_0000);
+        let _ = crate::silhouette::silhouette_covers(&data, table, glam::Vec2::new(1.5, 1.5));
     }
 }

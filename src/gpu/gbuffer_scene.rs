@@ -36,6 +36,36 @@ pub struct GDrawUniform {
     pub color: [f32; 4],
 }
 
+/// One [`GBufferRenderer::render`]: at which resize factor, from where, what, and the clear.
+#[derive(Clone, Copy, Debug)]
+pub struct GBufferFrame<'a> {
+    /// Resize factor r (the viewport is the target's size over r). Default: 1.
+    pub r: f32,
+    /// View matrix (the geometry's normals and depths are in view space). Default: identity.
+    pub view: Mat4,
+    /// Projection. Default: identity.
+    pub proj: Mat4,
+    /// The draws, in order. Default: none.
+    pub items: &'a [GDrawItem<'a>],
+    /// The color's clear color. Default: black.
+    pub clear: wgpu::Color,
+    /// The view depth the geometry is cleared to (the background's). Default: 1000.
+    pub far_view_depth: f32,
+}
+
+impl Default for GBufferFrame<'_> {
+    fn default() -> Self {
+        Self {
+            r: 1.0,
+            view: Mat4::IDENTITY,
+            proj: Mat4::IDENTITY,
+            items: &[],
+            clear: wgpu::Color::BLACK,
+            far_view_depth: 1000.0,
+        }
+    }
+}
+
 /// One draw: mesh, transform, base color.
 #[derive(Clone, Copy, Debug)]
 pub struct GDrawItem<'a> {
@@ -155,40 +185,39 @@ impl GBufferRenderer {
         self.shading_work = n;
     }
 
-    /// Renders `items` (at most [`Self::MAX_DRAWS`]: more is [`GpuError::TooManyDraws`]) into
-    /// `target` at resize factor `r` (the viewport shrinks with r; the
-    /// textures do not change), cleared to `clear` with geometry (`far_view_depth`, +z).
+    /// Renders `frame.items` (at most [`Self::MAX_DRAWS`]: more is [`GpuError::TooManyDraws`])
+    /// into `target` at resize factor `frame.r` (the viewport shrinks with r; the textures do
+    /// not change), cleared to `frame.clear` with geometry (`frame.far_view_depth`, +z).
     /// `target` must have the color format the renderer was built for.
-    #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
         gpu: &GpuContext,
         target: &LowResBuffer,
-        r: f32,
-        view: Mat4,
-        proj: Mat4,
-        items: &[GDrawItem],
-        clear: wgpu::Color,
-        far_view_depth: f32,
+        frame: &GBufferFrame,
     ) -> Result<(), GpuError> {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let draw = (view, proj, items, clear, far_view_depth);
-        self.record(gpu, &mut encoder, target, r, draw)?;
+        self.record(gpu, &mut encoder, target, frame)?;
         gpu.queue.submit([encoder.finish()]);
         Ok(())
     }
 
     /// [`render`](Self::render) recorded into `encoder` (its uniforms written to the queue, so
-    /// every recording until the submission draws the last ones written): `draw` is (view,
-    /// projection, items, clear color, far view depth).
+    /// every recording until the submission draws the last ones written).
     pub fn record(
         &self,
         gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         target: &LowResBuffer,
-        r: f32,
-        (view, proj, items, clear, far_view_depth): (Mat4, Mat4, &[GDrawItem], wgpu::Color, f32),
+        frame: &GBufferFrame,
     ) -> Result<(), GpuError> {
+        let GBufferFrame {
+            r,
+            view,
+            proj,
+            items,
+            clear,
+            far_view_depth,
+        } = *frame;
         const CALL: &str = "GBufferRenderer::render";
         same_color_format(CALL, "target", target.color_format(), self.color_format)?;
         self.draws.check_count(CALL, items.len())?;
@@ -386,7 +415,14 @@ impl EdgeScene {
             ShadingTerm::Lighting => (&renderers[1], wgpu::Color::WHITE),
             ShadingTerm::Albedo => (&renderers[2], clear),
         };
-        let draw = (view, proj, &items[..], clear, Self::FAR_VIEW_DEPTH);
-        renderer.record(gpu, encoder, target, r, draw)
+        let frame = GBufferFrame {
+            r,
+            view,
+            proj,
+            items: &items,
+            clear,
+            far_view_depth: Self::FAR_VIEW_DEPTH,
+        };
+        renderer.record(gpu, encoder, target, &frame)
     }
 }

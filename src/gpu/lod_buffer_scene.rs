@@ -80,6 +80,35 @@ impl From<Mat4> for LodView {
     }
 }
 
+/// One [`LodBufferRenderer::render`]: which buffer, from where, what, and whether its fragments
+/// are counted.
+#[derive(Clone, Copy, Debug)]
+pub struct LodBufferFrame<'a> {
+    /// The LOD buffer drawn into ([`LodBuffers`] holds two). Default: 0.
+    pub index: usize,
+    /// This frame's and the previous frame's projection x view (`Mat4::into()` for a frame with
+    /// no previous one). Default: identity, no previous frame.
+    pub view: LodView,
+    /// The draws, in order. Default: none.
+    pub items: &'a [LodDrawItem<'a>],
+    /// The color buffer's clear color. Default: black.
+    pub clear: wgpu::Color,
+    /// Counts the pass's fragment-shader invocations. Default: none.
+    pub counter: Option<&'a FragmentCounter>,
+}
+
+impl Default for LodBufferFrame<'_> {
+    fn default() -> Self {
+        Self {
+            index: 0,
+            view: Mat4::IDENTITY.into(),
+            items: &[],
+            clear: wgpu::Color::BLACK,
+            counter: None,
+        }
+    }
+}
+
 /// One draw into a LOD buffer.
 #[derive(Clone, Copy, Debug)]
 pub struct LodDrawItem<'a> {
@@ -271,32 +300,33 @@ impl LodBufferRenderer {
         self.space = space;
     }
 
-    /// Renders `items` (at most [`Self::MAX_DRAWS`]: more is [`GpuError::TooManyDraws`] and
-    /// draws nothing) into buffer `index` of `buffers` seen by
-    /// `view`, cleared to `clear`, counting the pass's fragments with `counter` if given. Pass a
-    /// [`LodView`] with the previous frame's view-projection whenever the camera or an object
-    /// moves: the screen-anchored pattern predicts from it where each fragment is displayed next
-    /// frame, and moving objects get their object motion from it. A `Mat4` view-projection means
-    /// no previous frame (a still camera, the first frame, a cut).
-    /// Returns the triangles drawn and the count (0 without a counter). A t-instance item shown in neither this frame
-    /// nor the next (tau and tau_next 0 or NaN: visibility texels lie strictly between 0 and 1)
-    /// is not submitted. Every fragment of a t-instance is kept and flagged (see
-    /// `passes/lod_buffer_mesh.wgsl`).
-    #[allow(clippy::too_many_arguments)]
+    /// Renders `frame.items` (at most [`Self::MAX_DRAWS`]: more is [`GpuError::TooManyDraws`]
+    /// and draws nothing) into buffer `frame.index` of `buffers` seen by `frame.view`, cleared to
+    /// `frame.clear`, counting the pass's fragments with `frame.counter` if given. Give the view
+    /// the previous frame's view-projection whenever the camera or an object moves: the
+    /// screen-anchored pattern predicts from it where each fragment is displayed next frame, and
+    /// moving objects get their object motion from it. A view from a `Mat4` alone means no
+    /// previous frame (a still camera, the first frame, a cut).
+    /// Returns the triangles drawn and the count (0 without a counter). A t-instance item shown
+    /// in neither this frame nor the next (tau and tau_next 0 or NaN: visibility texels lie
+    /// strictly between 0 and 1) is not submitted. Every fragment of a t-instance is kept and
+    /// flagged (see `passes/lod_buffer_mesh.wgsl`).
     pub fn render(
         &self,
         gpu: &GpuContext,
         buffers: &LodBuffers,
-        index: usize,
-        view: impl Into<LodView>,
-        items: &[LodDrawItem],
-        clear: wgpu::Color,
-        counter: Option<&FragmentCounter>,
+        frame: &LodBufferFrame,
     ) -> Result<(u64, u64), GpuError> {
+        let LodBufferFrame {
+            index,
+            view,
+            items,
+            clear,
+            counter,
+        } = *frame;
         const CALL: &str = "LodBufferRenderer::render";
         same_color_format(CALL, "buffers", buffers.color_format(), self.color_format)?;
         self.draws.check_count(CALL, items.len())?;
-        let view = view.into();
         gpu.guarded(CALL, || {
             let camera = LodCameraUniform {
                 view_proj: view.view_proj.to_cols_array_2d(),

@@ -214,6 +214,34 @@ pub struct DrawUniform {
     pub alpha_rect: [f32; 4],
 }
 
+/// One [`MeshRenderer::render`]: what it draws, from where, and whether its fragments are
+/// counted.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshFrame<'a> {
+    /// The target's clear color. Default: black.
+    pub clear: wgpu::Color,
+    /// Projection x view. Default: identity.
+    pub view_proj: Mat4,
+    /// Direction towards the light (world space). Default: +z.
+    pub light_dir: Vec3,
+    /// The draws, in order. Default: none.
+    pub items: &'a [DrawItem<'a>],
+    /// Counts the pass's fragment-shader invocations. Default: none.
+    pub counter: Option<&'a FragmentCounter>,
+}
+
+impl Default for MeshFrame<'_> {
+    fn default() -> Self {
+        Self {
+            clear: wgpu::Color::BLACK,
+            view_proj: Mat4::IDENTITY,
+            light_dir: Vec3::Z,
+            items: &[],
+            counter: None,
+        }
+    }
+}
+
 /// One draw: a mesh, where, its color, and how it takes part in a transition.
 #[derive(Clone, Copy, Debug)]
 pub struct DrawItem<'a> {
@@ -342,22 +370,24 @@ impl MeshRenderer {
         Ok(())
     }
 
-    /// Clears `target` to `clear` and draws `items` in order (at most [`Self::MAX_DRAWS`]: more is
-    /// [`GpuError::TooManyDraws`] and draws nothing), lit from `light_dir`, counting the pass's fragments with `counter` if
-    /// given. Returns the count (0 without a counter).
+    /// Clears `target` to `frame.clear` and draws `frame.items` in order (at most
+    /// [`Self::MAX_DRAWS`]: more is [`GpuError::TooManyDraws`] and draws nothing), counting the
+    /// pass's fragments with `frame.counter` if given. Returns the count (0 without a counter).
     ///
     /// The meshes and the counter must come from `gpu`'s device.
-    #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
         gpu: &GpuContext,
         target: &RenderTarget,
-        clear: wgpu::Color,
-        view_proj: Mat4,
-        light_dir: Vec3,
-        items: &[DrawItem],
-        counter: Option<&FragmentCounter>,
+        frame: &MeshFrame,
     ) -> Result<u64, GpuError> {
+        let MeshFrame {
+            clear,
+            view_proj,
+            light_dir,
+            items,
+            counter,
+        } = *frame;
         const CALL: &str = "MeshRenderer::render";
         self.draws.check_count(CALL, items.len())?;
         gpu.guarded(CALL, || {

@@ -21,7 +21,7 @@
 //! let mut selector = GpuLodSelector::new(&gpu, &GpuLodSelectorDescriptor {
 //!     groups: &groups,
 //!     settings: LodSettings { hysteresis: 4.0, ..Default::default() },
-//!     meshes: &[],
+//!     ..Default::default() // no meshes: read the counts only
 //! })?;
 //! selector.set_instances(&gpu, &[GpuLodInstance::new(glam::Vec3::ZERO, 1.0, 1.0, 0)])?;
 //! let view = selector.add_view(&gpu)?;

@@ -5,7 +5,7 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::readback::read_texture_rgba8;
-use super::scene::{DrawItem, GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use super::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use super::{GpuContext, GpuError};
 use crate::screen_door::DitherPattern;
 use crate::select::LodSelection;
@@ -169,11 +169,13 @@ impl TransitionScene {
             renderer.render(
                 gpu,
                 &self.target,
-                clear,
-                self.view_proj(),
-                Vec3::new(0.4, 0.8, 0.6),
-                &items,
-                None,
+                &MeshFrame {
+                    clear,
+                    view_proj: self.view_proj(),
+                    light_dir: Vec3::new(0.4, 0.8, 0.6),
+                    items: &items,
+                    ..Default::default()
+                },
             )?;
             read_texture_rgba8(gpu, &self.target.color)
         })

@@ -116,11 +116,11 @@ pub fn silhouette_covers(data: &[[u32; 4]], table: UVec4, p: Vec2) -> i32 {
     if row < 0.0 || row >= table.z as f32 || p.x < x0 || p.x > x1 {
         return 0;
     }
-    let entry = silhouette_texel(data, table.x + row as u32);
+    let entry = silhouette_texel(data, table.x.wrapping_add(row as u32));
     let mut winding = 0;
     let mut on = false;
     for k in 0..entry.y {
-        let s = silhouette_texel(data, entry.x + k);
+        let s = silhouette_texel(data, entry.x.wrapping_add(k));
         let (a, b) = (
             Vec2::new(f32::from_bits(s.x), f32::from_bits(s.y)),
             Vec2::new(f32::from_bits(s.z), f32::from_bits(s.w)),

@@ -10,7 +10,7 @@ use super::timing::{FORMAT, PassRatio, plain_pass_with, record_fullscreen};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LOD_DEPTH_FORMAT, LodBuffers,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::{one_group_layout, texture_2d, textures_and_uniform};
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::gpu::{GpuContext, GpuError};
@@ -135,11 +135,13 @@ pub fn combine_vs_copy(
             renderer.render(
                 gpu,
                 buffers,
-                i,
-                proj * *view,
-                &items,
-                wgpu::Color::BLACK,
-                None,
+                &LodBufferFrame {
+                    index: i,
+                    view: (proj * *view).into(),
+                    items: &items,
+                    clear: wgpu::Color::BLACK,
+                    ..Default::default()
+                },
             )?;
         }
     }

@@ -4,7 +4,7 @@
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::alpha_mask::AlphaMask;
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshRenderer, RenderTarget};
+use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::unpopping::LodRenderState;
 
@@ -44,7 +44,17 @@ pub fn bake(
         alpha_rect: Vec4::ZERO,
     };
     let black = wgpu::Color::BLACK;
-    renderer.render(gpu, &target, black, proj * view, Vec3::Z, &[item], None)?;
+    renderer.render(
+        gpu,
+        &target,
+        &MeshFrame {
+            clear: black,
+            view_proj: proj * view,
+            light_dir: Vec3::Z,
+            items: &[item],
+            ..Default::default()
+        },
+    )?;
     // Lit white with an ambient term: every covered texel is well above black.
     let texels = read_texture_rgba8(gpu, &target.color)?
         .chunks(4)

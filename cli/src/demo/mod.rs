@@ -6,7 +6,7 @@
 //! ```no_run
 //! let options = lodkit_cli::demo::DemoOptions::default();
 //! let report = lodkit_cli::demo::run(&options)?;
-//! println!("{}", lodkit_cli::demo::report::summary(&report));
+//! println!("{}", lodkit_cli::demo::terminal::summary(&report));
 //! # Ok::<(), lodkit_cli::demo::DemoError>(())
 //! ```
 
@@ -30,6 +30,7 @@ pub mod scene;
 pub mod selection;
 pub mod table;
 pub mod technique;
+pub mod terminal;
 pub mod timing;
 pub mod transitions;
 pub mod upsampling;

@@ -14,10 +14,10 @@ use lodkit::gpu::counters::FragmentCounter;
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferRenderer, LodDrawItem, LodView};
+use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshRenderer, RenderTarget};
+use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::gpu::transition_scene::{SingleFrameTechnique, transition_items};
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::reproject::new_to_old_matrix;
@@ -55,9 +55,12 @@ pub struct RunSpec {
     pub technique: Technique,
     /// Whether the camera moves from `eye` to `moving_eye`.
     pub moving: bool,
-    /// Whether the transitioning objects transition (false: they stay at the fine LOD, the
+    /// Whether the transitioning objects transition (false: they stay at `hold_level`, a
     /// reference that camera motion is measured against).
     pub transition: bool,
+    /// The level the transitioning objects stay at when they do not transition: 0 the fine
+    /// one (where a transition starts), 1 the coarse one (where it ends).
+    pub hold_level: usize,
     /// Background.
     pub background: Background,
 }
@@ -324,14 +327,19 @@ impl<'a> SceneRenderer<'a> {
             let model = self.scene.model(i);
             let fine = (&self.meshes[i][0], self.object_color(i, 0, spec.background));
             if !(o.transition && spec.transition) {
+                let held = if o.transition {
+                    spec.hold_level.min(1)
+                } else {
+                    0
+                };
                 items.push(DrawItem {
-                    mesh: fine.0,
+                    mesh: &self.meshes[i][held],
                     model,
-                    color: fine.1,
+                    color: self.object_color(i, held, spec.background),
                     state: LodRenderState::OPAQUE,
                     dither_alpha: None,
                     sway: self.sway(i, frame),
-                    alpha_rect: self.alpha_rects[i][0],
+                    alpha_rect: self.alpha_rects[i][held],
                 });
                 continue;
             }
@@ -364,11 +372,13 @@ impl<'a> SceneRenderer<'a> {
         let fragments = self.single[usize::from(blue)].render(
             gpu,
             &self.target,
-            color(clear),
-            proj * view,
-            LIGHT,
-            &items,
-            Some(&self.counter),
+            &MeshFrame {
+                clear: color(clear),
+                view_proj: proj * view,
+                light_dir: LIGHT,
+                items: &items,
+                counter: Some(&self.counter),
+            },
         )?;
         Ok(Frame {
             pixels: read_texture_rgba8(gpu, &self.target.color)?,
@@ -396,7 +406,10 @@ impl<'a> SceneRenderer<'a> {
             .scene
             .objects
             .iter()
-            .map(|_| scheduler.insert(0))
+            .map(|o| match o.transition && !spec.transition {
+                true => scheduler.insert(u8::from(spec.hold_level > 0)),
+                false => scheduler.insert(0),
+            })
             .collect();
         let clear = match spec.background {
             Background::Scene => CLEAR,
@@ -450,11 +463,13 @@ impl<'a> SceneRenderer<'a> {
             let (triangles, fragments) = renderer.render(
                 gpu,
                 &self.buffers,
-                index,
-                lod_view,
-                &items,
-                color(clear),
-                Some(&self.counter),
+                &LodBufferFrame {
+                    index,
+                    view: lod_view,
+                    items: &items,
+                    clear: color(clear),
+                    counter: Some(&self.counter),
+                },
             )?;
             let m = previous.map_or(CombinePass::NO_HISTORY, |old| {
                 new_to_old_matrix(&view, &proj, &old, &proj)
@@ -550,11 +565,13 @@ impl<'a> SceneRenderer<'a> {
             self.single[0].render(
                 gpu,
                 &self.target,
-                wgpu::Color::BLACK,
-                proj * view,
-                LIGHT,
-                &items,
-                None,
+                &MeshFrame {
+                    clear: wgpu::Color::BLACK,
+                    view_proj: proj * view,
+                    light_dir: LIGHT,
+                    items: &items,
+                    ..Default::default()
+                },
             )?;
             Ok(read_texture_rgba8(gpu, &self.target.color)?
                 .chunks(4)

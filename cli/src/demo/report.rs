@@ -1,12 +1,11 @@
-//! The demo's outputs from a [`DemoReport`]: PNG plots, `report.json`, `index.html`, the two
-//! generated docs pages and the terminal summary.
+//! The demo's outputs from a [`DemoReport`]: PNG plots, `report.json`, `index.html` and the two
+//! generated docs pages (the terminal summary is in [`terminal`](super::terminal)).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use super::plots::{Chart, Series, line_chart};
-use super::reads::Reads;
-use super::table::{Table, esc, img, pct, times};
+use super::table::{Table, esc, img, pct, reads, times};
 use super::upsampling::{
     CONTROLLER_SEEDS, METHODS, ROUTES, SHADING_WORK, SIGMA_N, SIGMA_Z, TARGET_MS,
 };
@@ -161,6 +160,9 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                 "silhouette error (moving)",
                 "flicker (static)",
                 "flicker (moving)",
+                "flicker vs coarse (static)",
+                "flicker vs coarse (moving)",
+                "see-through / ghosts (moving, px)",
             ],
             rows: rows
                 .map(|t| {
@@ -172,6 +174,15 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                         pct(t.silhouette_error),
                         format!("{:.2} ({} rev.)", t.flicker_static, t.reversals_static),
                         format!("{:.2} ({} rev.)", t.flicker_moving, t.reversals_moving),
+                        format!(
+                            "{:.2} ({} rev.)",
+                            t.flicker_static_coarse, t.reversals_static_coarse
+                        ),
+                        format!(
+                            "{:.2} ({} rev.)",
+                            t.flicker_moving_coarse, t.reversals_moving_coarse
+                        ),
+                        format!("{} / {}", t.see_through_pixels_moving, t.ghosts_moving),
                     ]
                 })
                 .collect(),
@@ -267,17 +278,6 @@ pub(super) fn ratio_table(ratios: &[super::timing::PassRatio]) -> Table {
                 ]
             })
             .collect(),
-    }
-}
-
-fn reads(r: &Reads) -> String {
-    let always = format!("{} / {} / {} B", r.fetches, r.texels, r.bytes);
-    match r.conditional_fetches {
-        0 => always,
-        _ => format!(
-            "{always} (+ at most {} / {} / {} B under branches)",
-            r.conditional_fetches, r.conditional_texels, r.conditional_bytes
-        ),
     }
 }
 
@@ -523,73 +523,4 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
     ));
     h.push_str("</body></html>\n");
     write(&out.join("index.html"), &h)
-}
-
-/// The summary table printed on the terminal.
-pub fn summary(report: &DemoReport) -> String {
-    let mut s = format!(
-        "adapter: {}\nclock: {}\n{}x{}, transitions of {} frames, {:.0} s\n",
-        report.adapter,
-        report.clock.label(),
-        report.size.0,
-        report.size.1,
-        report.frames,
-        report.seconds
-    );
-    for scene in &report.scenes {
-        let _ = writeln!(
-            s,
-            "\n{scene:<24} {:>8} {:>8} {:>8} {:>8} {:>12} {:>8} {:>10} {:>10} {:>10}",
-            "pop",
-            "pop mov",
-            "flicker",
-            "flk mov",
-            "see-through",
-            "sil mov",
-            "tris",
-            "frags",
-            "idle"
-        );
-        for t in report.transitions.iter().filter(|t| &t.scene == scene) {
-            let _ = writeln!(
-                s,
-                "  {:<22} {:>8.3} {:>8.3} {:>8.2} {:>8.2} {:>12} {:>8} {:>9.3}x {:>10} {:>10}",
-                t.technique,
-                t.pop_static,
-                t.pop_moving,
-                t.flicker_static,
-                t.flicker_moving,
-                pct(t.see_through),
-                pct(t.silhouette_error),
-                t.triangles_vs_hard,
-                times(t.fragments_vs_hard),
-                times(t.idle_fragments_vs_hard)
-            );
-        }
-    }
-    let _ = writeln!(
-        s,
-        "\n{:<6} {:>10} {:>10} {:>12} {:>10}",
-        "r", "bilinear", "bilateral", "fine-grained", "speed-up"
-    );
-    for u in &report.upsampling {
-        let _ = writeln!(
-            s,
-            "{:<6} {:>7.2} dB {:>7.2} dB {:>9.2} dB {:>9.2}x",
-            u.r, u.psnr[0], u.psnr[1], u.psnr[2], u.speedup[0]
-        );
-    }
-    s.push('\n');
-    for p in &report.pass_ratios {
-        let _ = writeln!(
-            s,
-            "{} / {}: {:.3}x ({} vs {} per pixel)",
-            p.pass,
-            p.baseline,
-            p.ratio,
-            reads(&p.pass_reads),
-            reads(&p.baseline_reads)
-        );
-    }
-    s
 }

@@ -3,6 +3,8 @@
 
 use std::fmt::Write as _;
 
+use super::reads::Reads;
+
 /// Escapes text for HTML.
 pub(super) fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -61,5 +63,17 @@ impl Table {
         }
         s.push_str("</table>\n");
         s
+    }
+}
+
+/// A pass's reads per pixel (fetches / texels / bytes, and those under branches).
+pub(super) fn reads(r: &Reads) -> String {
+    let always = format!("{} / {} / {} B", r.fetches, r.texels, r.bytes);
+    match r.conditional_fetches {
+        0 => always,
+        _ => format!(
+            "{always} (+ at most {} / {} / {} B under branches)",
+            r.conditional_fetches, r.conditional_texels, r.conditional_bytes
+        ),
     }
 }

@@ -36,6 +36,16 @@ pub struct TransitionMetrics {
     pub reversals_static: u64,
     /// The same with the moving camera.
     pub reversals_moving: u64,
+    /// Flicker with the static camera measured against the coarse level's reference run (the
+    /// fields above: against the fine level's). A technique that flickers less against one
+    /// reference only has not shown less flicker.
+    pub flicker_static_coarse: f64,
+    /// The same with the moving camera.
+    pub flicker_moving_coarse: f64,
+    /// Reversals with the static camera against the coarse level's reference.
+    pub reversals_static_coarse: u64,
+    /// The same with the moving camera.
+    pub reversals_moving_coarse: u64,
     /// Share of the transitioning objects' interior (pixels both LODs cover) where the
     /// background contributes to the middle frame.
     pub see_through: f32,
@@ -43,6 +53,12 @@ pub struct TransitionMetrics {
     /// show the background, plus pixels neither covers that show a transitioning object, as a
     /// share of the pixels either covers.
     pub silhouette_error: f32,
+    /// Of the silhouette error, the pixels both LODs cover that show the background
+    /// (`lodkit::metrics::see_through`, moving camera, middle frame).
+    pub see_through_pixels_moving: usize,
+    /// Of the silhouette error, the pixels neither LOD covers that show a transitioning object
+    /// (`lodkit::metrics::ghosts`, moving camera, middle frame).
+    pub ghosts_moving: usize,
     /// Pixels of objects in transition, in either LOD buffer, outside the combine pass's
     /// rectangles, summed over the frames of both runs (frame-sequential; 0 otherwise). Pixels
     /// there show the newer buffer alone, so the see-through figure holds only when this is 0.
@@ -91,11 +107,13 @@ fn reference_run(
     renderer: &SceneRenderer,
     technique: Technique,
     moving: bool,
+    hold_level: usize,
 ) -> Result<Vec<Vec<u8>>, GpuError> {
     let spec = RunSpec {
         technique,
         moving,
         transition: false,
+        hold_level,
         background: Background::Scene,
     };
     let animated = renderer.animated();
@@ -108,7 +126,8 @@ fn reference_run(
 /// What one transition run measured.
 struct TransitionRun {
     change: Vec<f32>,
-    flicker: Flicker,
+    /// Against the fine level's reference and against the coarse level's.
+    flicker: [Flicker; 2],
     triangles: u64,
     fragments: u64,
     idle_fragments: u64,
@@ -116,29 +135,32 @@ struct TransitionRun {
     sources: Option<Vec<PixelSource>>,
 }
 
-/// Runs `technique` with the static or moving camera against `reference` (see
-/// [`reference_run`]), streaming: the per-frame change, triangles and fragments over the
+/// Runs `technique` with the static or moving camera against `references` (the fine and the
+/// coarse level's, see [`reference_run`]), streaming: the per-frame change, triangles and fragments over the
 /// transition, the strip, and for frame-sequential the combine rule of the middle frame.
 fn transition_run(
     gpu: &GpuContext,
     renderer: &SceneRenderer,
     technique: Technique,
     moving: bool,
-    reference: &[Vec<u8>],
+    references: [&[Vec<u8>]; 2],
     size: (u32, u32),
 ) -> Result<TransitionRun, DemoError> {
     let spec = RunSpec {
         technique,
         moving,
         transition: true,
+        hold_level: 0,
         background: Background::Scene,
     };
+    let [reference, coarse_reference] = references;
     let reference_at = |f: usize| reference.get(f).or(reference.last());
+    let coarse_at = |f: usize| coarse_reference.get(f).or(coarse_reference.last());
     let span = LEAD_FRAMES..=LEAD_FRAMES + renderer.transition_frames();
     let strip_at = strip_frames(renderer);
     let mut run = TransitionRun {
         change: Vec::new(),
-        flicker: Flicker::default(),
+        flicker: [Flicker::default(); 2],
         triangles: 0,
         fragments: 0,
         idle_fragments: 0,
@@ -147,6 +169,7 @@ fn transition_run(
     };
     let mut previous: Option<Vec<u8>> = None;
     let mut meter = FlickerMeter::default();
+    let mut coarse_meter = FlickerMeter::default();
     let mut failed = None;
     let mut sources = None;
     let mut on_sources = |s| sources = Some(s);
@@ -164,10 +187,15 @@ fn transition_run(
                 run.change
                     .push(transition_change(prev, &frame.pixels, r0, r1) as f32);
             }
-            if let Some(r) = reference_at(f)
-                && let Err(e) = meter.push(&frame.pixels, r)
-            {
-                failed = Some(DemoError::Internal(e.to_string()));
+            for (meter, r) in [
+                (&mut meter, reference_at(f)),
+                (&mut coarse_meter, coarse_at(f)),
+            ] {
+                if let Some(r) = r
+                    && let Err(e) = meter.push(&frame.pixels, r)
+                {
+                    failed = Some(DemoError::Internal(e.to_string()));
+                }
             }
             if span.contains(&f) {
                 run.triangles += frame.triangles;
@@ -191,7 +219,7 @@ fn transition_run(
         (frame_sequential && moving).then_some(&mut on_sources as &mut dyn FnMut(Vec<PixelSource>)),
     )?;
     run.sources = sources;
-    run.flicker = meter.finish();
+    run.flicker = [meter.finish(), coarse_meter.finish()];
     match failed {
         Some(e) => Err(e),
         None => Ok(run),
@@ -217,6 +245,7 @@ fn over_black_and_white(
             technique,
             moving,
             transition: true,
+            hold_level: 0,
             background: Background::Flat(*flat),
         };
         renderer.run(
@@ -274,7 +303,7 @@ fn silhouette_error(
     renderer: &SceneRenderer,
     technique: Technique,
     masks: &[Vec<bool>; 2],
-) -> Result<f32, DemoError> {
+) -> Result<SilhouetteError, DemoError> {
     let over = over_black_and_white(gpu, renderer, technique, true)?;
     let n = masks[0].len().min(masks[1].len()).min(over[0].len() / 4);
     let (fine, coarse) = (&masks[0][..n], &masks[1][..n]);
@@ -288,7 +317,21 @@ fn silhouette_error(
     let internal = |e: lodkit::metrics::MetricsError| DemoError::Internal(e.to_string());
     let holes = lodkit::metrics::see_through(fine, coarse, &opaque).map_err(internal)?;
     let ghosts = lodkit::metrics::ghosts(fine, coarse, &lit).map_err(internal)?;
-    Ok(share(holes + ghosts, union))
+    Ok(SilhouetteError {
+        share: share(holes + ghosts, union),
+        holes,
+        ghosts,
+    })
+}
+
+/// [`silhouette_error`]'s figures.
+struct SilhouetteError {
+    /// Holes and ghosts over the pixels either LOD covers.
+    share: f32,
+    /// Pixels both LODs cover that show the background.
+    holes: usize,
+    /// Pixels neither covers that show a transitioning object.
+    ghosts: usize,
 }
 
 fn share(part: usize, whole: usize) -> f32 {
@@ -366,15 +409,19 @@ pub fn measure_scene(
     let counts = renderer.counter().kind().is_count();
     let mut rows: Vec<TransitionMetrics> = Vec::new();
     // Reference runs of the current technique family (single-frame or frame-sequential),
-    // static and moving camera.
-    let mut references: Option<(bool, [Vec<Vec<u8>>; 2])> = None;
+    // static and moving camera, each with the fine level and with the coarse level alone.
+    type References = [[Vec<Vec<u8>>; 2]; 2];
+    let mut references: Option<(bool, References)> = None;
     let mut static_strips = Vec::new();
     for technique in Technique::ALL {
         let name = technique.name();
         let family = matches!(technique, Technique::FrameSequential(..));
         if references.as_ref().is_none_or(|(f, _)| *f != family) {
             drop(references.take()); // frees the other family's frames first
-            let run = |moving| reference_run(gpu, renderer, technique, moving);
+            let run = |moving| -> Result<[Vec<Vec<u8>>; 2], GpuError> {
+                let level = |hold| reference_run(gpu, renderer, technique, moving, hold);
+                Ok([level(0)?, level(1)?])
+            };
             references = Some((family, [run(false)?, run(true)?]));
         }
         let Some((_, reference)) = &references else {
@@ -385,6 +432,7 @@ pub fn measure_scene(
         let mut cost = (0, 0, 0);
         renderer.take_outside_rects(); // the reference runs' count is not this technique's
         for (moving, reference) in [false, true].into_iter().zip(reference) {
+            let reference = [&reference[0][..], &reference[1][..]];
             let run = transition_run(gpu, renderer, technique, moving, reference, size)?;
             let camera = if moving { "moving" } else { "static" };
             super::save(
@@ -409,6 +457,8 @@ pub fn measure_scene(
         let moving_change = changes.pop().unwrap_or_default();
         let static_change = changes.pop().unwrap_or_default();
         let [still, moved] = [0, 1].map(|k| flickers.get(k).copied().unwrap_or_default());
+        let [still, still_coarse] = still;
+        let [moved, moved_coarse] = moved;
         let as_f64 = |c: &[f32]| c.iter().map(|&v| f64::from(v)).collect::<Vec<f64>>();
         rows.push(TransitionMetrics {
             scene: scene.to_owned(),
@@ -419,9 +469,15 @@ pub fn measure_scene(
             flicker_moving: moved.ratio(),
             reversals_static: still.reversals,
             reversals_moving: moved.reversals,
+            flicker_static_coarse: still_coarse.ratio(),
+            flicker_moving_coarse: moved_coarse.ratio(),
+            reversals_static_coarse: still_coarse.reversals,
+            reversals_moving_coarse: moved_coarse.reversals,
             see_through: share,
             outside_rects,
-            silhouette_error: silhouette,
+            silhouette_error: silhouette.share,
+            see_through_pixels_moving: silhouette.holes,
+            ghosts_moving: silhouette.ghosts,
             triangles_vs_hard: 0.0,
             fragments_vs_hard: None,
             idle_fragments_vs_hard: None,

@@ -72,53 +72,53 @@ pub fn still_flicker(
     metrics::flicker(&masked, &reference)
 }
 
-/// Per frame of `frames`: the pixels where `counts(shown, fine, coarse)` holds, each argument
-/// whether that frame covers the pixel (shows something other than `background`).
-fn count_pixels(
+/// Per pixel of `frame`: whether it covers it (shows something other than `background`).
+fn mask(frame: &Frame, background: [u8; 3]) -> Vec<bool> {
+    frame.pixels().map(|p| !is_background(p, background)).collect()
+}
+
+/// Per frame of `frames`: `measure(fine, coarse, shown)` of the three coverage masks
+/// (`lodkit::metrics::see_through` or `ghosts`).
+fn per_frame(
     frames: &[Frame],
     fine: &[Frame],
     coarse: &[Frame],
     background: [u8; 3],
-    counts: impl Fn(bool, bool, bool) -> bool,
+    measure: fn(&[bool], &[bool], &[bool]) -> Result<usize, MetricsError>,
 ) -> Vec<usize> {
-    let covers = |p| !is_background(p, background);
     frames
         .iter()
         .zip(fine.iter().zip(coarse))
         .map(|(f, (a, b))| {
-            f.pixels()
-                .zip(a.pixels().zip(b.pixels()))
-                .filter(|&(p, (pa, pb))| counts(covers(p), covers(pa), covers(pb)))
-                .count()
+            let [shown, a, b] = [f, a, b].map(|x| mask(x, background));
+            // The three frames come from one app at one size; a mismatch would be a bug here.
+            measure(&a, &b, &shown).expect("frames of one size")
         })
         .collect()
 }
 
 /// Per frame of `frames`: pixels both references (the finest and the coarsest level alone)
-/// cover, where the frame shows the `background`: the object's silhouette seen through.
+/// cover, where the frame shows the `background`: the object's silhouette seen through
+/// (`lodkit::metrics::see_through`).
 pub fn see_through(
     frames: &[Frame],
     fine: &[Frame],
     coarse: &[Frame],
     background: [u8; 3],
 ) -> Vec<usize> {
-    count_pixels(frames, fine, coarse, background, |shown, a, b| {
-        a && b && !shown
-    })
+    per_frame(frames, fine, coarse, background, metrics::see_through)
 }
 
 /// Per frame of `frames`: pixels neither reference covers, where the frame shows something other
 /// than the `background`: an object drawn where no level of it is (e.g. a moving object's last
-/// position left behind), the mirror of [`see_through`].
+/// position left behind), the mirror of [`see_through`] (`lodkit::metrics::ghosts`).
 pub fn ghosts(
     frames: &[Frame],
     fine: &[Frame],
     coarse: &[Frame],
     background: [u8; 3],
 ) -> Vec<usize> {
-    count_pixels(frames, fine, coarse, background, |shown, a, b| {
-        !a && !b && shown
-    })
+    per_frame(frames, fine, coarse, background, metrics::ghosts)
 }
 
 /// Per frame: the share of the pixels both references cover that the frame covers (1: the
@@ -130,9 +130,11 @@ pub fn coverage(
     background: [u8; 3],
 ) -> Vec<f64> {
     let holes = see_through(frames, fine, coarse, background);
-    let both = count_pixels(fine, fine, coarse, background, |_, a, b| a && b);
-    both.into_iter()
-        .zip(holes)
+    let both = fine.iter().zip(coarse).map(|(a, b)| {
+        let [a, b] = [a, b].map(|x| mask(x, background));
+        a.iter().zip(&b).filter(|&(a, b)| *a && *b).count()
+    });
+    both.zip(holes)
         .map(|(both, hole)| {
             if both == 0 {
                 1.0

@@ -111,6 +111,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             let name = c.name;
             let p = pop(&run.frames, &fine.frames);
             let f = flicker(&run.frames, &fine.frames).map_err(|e| Failure(1, e.to_string()))?;
+            // Against the coarse level's frames too: a verdict that turns with the reference
+            // does not show less flicker.
+            let fc =
+                flicker(&run.frames, &coarse.frames).map_err(|e| Failure(1, e.to_string()))?;
             let holes = see_through(&run.frames, &fine.frames, &coarse.frames, background);
             let shown = coverage(&run.frames, &fine.frames, &coarse.frames, background);
             let window: Vec<usize> = (0..FRAMES).filter(|&f| run.in_transition[f]).collect();
@@ -130,11 +134,13 @@ pub fn run(args: &Args) -> Result<(), Failure> {
                 *t += ms;
             }
             println!(
-                "{name:30} {path:6}: pop {p:.3}, flicker {:.2} ({} reversals), see-through {seen} \
-                 px, ghosts {ghosted} px, fragments {:.0} (prepass {:.0}, opaque {:.0}, older depth \
-                 {:.0}, combine {:.0})",
+                "{name:30} {path:6}: pop {p:.3}, flicker {:.2} ({} reversals; vs coarse {:.2}, {} \
+                 reversals), see-through {seen} px, ghosts {ghosted} px, fragments {:.0} (prepass \
+                 {:.0}, opaque {:.0}, older depth {:.0}, combine {:.0})",
                 f.ratio(),
                 f.reversals,
+                fc.ratio(),
+                fc.reversals,
                 fragments.iter().sum::<f64>(),
                 fragments[0],
                 fragments[1],
@@ -153,6 +159,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             report.insert(format!("pop_{name}_{path}"), p.into());
             report.insert(format!("flicker_{name}_{path}"), f.ratio().into());
             report.insert(format!("reversals_{name}_{path}"), f.reversals.into());
+            report.insert(format!("flicker_{name}_{path}_coarse"), fc.ratio().into());
+            report.insert(format!("reversals_{name}_{path}_coarse"), fc.reversals.into());
             // The silhouettes' CPU time per frame, over the frames that found any (the first
             // of a mesh builds its surface too).
             let times: Vec<f64> = run

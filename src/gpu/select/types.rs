@@ -124,7 +124,7 @@ pub struct LevelMesh {
 }
 
 /// How to build a [`GpuLodSelector`].
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct GpuLodSelectorDescriptor<'a> {
     /// The groups, at most [`SELECT_MAX_LEVELS`] levels each.
     pub groups: &'a [LodGroup],

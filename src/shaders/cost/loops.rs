@@ -111,49 +111,58 @@ pub(super) fn trip_count(
             }
         },
     };
+    let counter = Counter {
+        step,
+        op,
+        bound,
+        stay_when,
+        test_first: test_at.is_some(),
+        tests_old,
+        ty,
+    };
     let mut trips = 0;
     for start in start_values(module, f, var, place)? {
-        let n = simulate(
-            start,
-            step,
-            op,
-            bound,
-            stay_when,
-            test_at.is_some(),
-            tests_old,
-            ty,
-        )?;
-        trips = trips.max(n);
+        trips = trips.max(counter.simulate(start)?);
     }
     Some(Trips { trips, test_at })
 }
 
-/// Runs the counter: the trips before the test leaves, or `None` past [`MAX_TRIPS`].
-#[allow(clippy::too_many_arguments)]
-fn simulate(
-    start: i128,
+/// A loop's counter as the loop steps and tests it.
+struct Counter {
+    /// Added to the counter each trip.
     step: i128,
+    /// The test's comparison: `counter op bound`.
     op: BinaryOperator,
     bound: i128,
+    /// The test's value that keeps the loop going.
     stay_when: bool,
+    /// Tested as a trip starts (a `for`'s or `while`'s test); else after the step (`break if`).
     test_first: bool,
+    /// A test after the step reads the value from before it.
     tests_old: bool,
     ty: CounterType,
-) -> Option<u64> {
-    let (mut i, bound, mut trips) = (ty.wrap(start), ty.wrap(bound), 0u64);
-    loop {
-        if test_first && holds(op, i, bound)? != stay_when {
-            return Some(trips);
-        }
-        trips += 1;
-        if trips > MAX_TRIPS {
-            return None;
-        }
-        let old = i;
-        i = ty.wrap(i + step);
-        let tested = if tests_old { old } else { i };
-        if !test_first && holds(op, tested, bound)? != stay_when {
-            return Some(trips);
+}
+
+impl Counter {
+    /// Runs the counter from `start`: the trips before the test leaves, or `None` past
+    /// [`MAX_TRIPS`].
+    fn simulate(&self, start: i128) -> Option<u64> {
+        let ty = self.ty;
+        let (mut i, bound, mut trips) = (ty.wrap(start), ty.wrap(self.bound), 0u64);
+        loop {
+            if self.test_first && holds(self.op, i, bound)? != self.stay_when {
+                return Some(trips);
+            }
+            trips += 1;
+            if trips > MAX_TRIPS {
+                return None;
+            }
+            let old = i;
+            i = ty.wrap(i + self.step);
+            let tested = if self.tests_old { old } else { i };
+            if !self.test_first && holds(self.op, tested, bound)? != self.stay_when {
+                return Some(trips);
+            }
         }
     }
 }

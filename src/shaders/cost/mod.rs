@@ -152,7 +152,13 @@ pub fn entry_point_costs(module: &Module) -> Vec<EntryCost> {
                 module,
                 unknown_loops_in: Vec::new(),
             };
-            let tally = walker.block(&ep.function, &ep.name, &ep.function.body, &[], 0, None);
+            let entry = Walked {
+                f: &ep.function,
+                name: &ep.name,
+                args: &[],
+                depth: 0,
+            };
+            let tally = walker.block(entry, &ep.function.body, None);
             let mut resources: Vec<ResourceFetches> = tally
                 .fetches
                 .iter()
@@ -249,34 +255,40 @@ struct Walker<'a> {
 /// or a storage pointer handed down by the caller).
 type Args = [Option<Handle<naga::GlobalVariable>>];
 
+/// A function as the walk reaches it.
+#[derive(Clone, Copy)]
+struct Walked<'a> {
+    f: &'a Function,
+    /// Its name (an entry point's, or the function's).
+    name: &'a str,
+    /// What its arguments pass on.
+    args: &'a Args,
+    /// Calls from the entry point down to it.
+    depth: usize,
+}
+
 impl Walker<'_> {
-    /// The tally of `stmts`, statements of `f` (named `name`); `outer` is where the block sits
-    /// (`None` for a function's body), for what a loop counter holds when its loop starts.
-    fn block(
-        &mut self,
-        f: &Function,
-        name: &str,
-        stmts: &[Statement],
-        args: &Args,
-        depth: usize,
-        outer: Option<&Place<'_>>,
-    ) -> Tally {
-        self.block_in(f, name, stmts, args, depth, outer, None)
+    /// The tally of `stmts`, statements of `fun`; `outer` is where the block sits (`None` for a
+    /// function's body), for what a loop counter holds when its loop starts.
+    fn block(&mut self, fun: Walked<'_>, stmts: &[Statement], outer: Option<&Place<'_>>) -> Tally {
+        self.block_in(fun, stmts, outer, None)
     }
 
     /// [`block`](Self::block) for a loop's body or continuing block (`in_loop`: the loop's
     /// body and continuing block).
-    #[allow(clippy::too_many_arguments)]
     fn block_in(
         &mut self,
-        f: &Function,
-        name: &str,
+        fun: Walked<'_>,
         stmts: &[Statement],
-        args: &Args,
-        depth: usize,
         outer: Option<&Place<'_>>,
         in_loop: Option<(&Block, &Block)>,
     ) -> Tally {
+        let Walked {
+            f,
+            name,
+            args,
+            depth,
+        } = fun;
         let mut t = Tally::default();
         for (i, stmt) in stmts.iter().enumerate() {
             let here = Place {
@@ -291,18 +303,18 @@ impl Walker<'_> {
                         self.expression(f, h, args, &mut t);
                     }
                 }
-                Statement::Block(b) => t.add(&self.block(f, name, b, args, depth, inner)),
+                Statement::Block(b) => t.add(&self.block(fun, b, inner)),
                 Statement::If { accept, reject, .. } => {
                     let branches = [
-                        self.block(f, name, accept, args, depth, inner),
-                        self.block(f, name, reject, args, depth, inner),
+                        self.block(fun, accept, inner),
+                        self.block(fun, reject, inner),
                     ];
                     t.branch(&branches);
                 }
                 Statement::Switch { cases, .. } => {
                     let bodies: Vec<Tally> = cases
                         .iter()
-                        .map(|c| self.block(f, name, &c.body, args, depth, inner))
+                        .map(|c| self.block(fun, &c.body, inner))
                         .collect();
                     // A path starts at a case and runs on through the cases it falls into.
                     let mut paths = bodies.clone();
@@ -320,9 +332,8 @@ impl Walker<'_> {
                     break_if,
                 } => {
                     let inside = Some((body, continuing));
-                    let walk = |s: &mut Self, part: &[Statement]| {
-                        s.block_in(f, name, part, args, depth, inner, inside)
-                    };
+                    let walk =
+                        |s: &mut Self, part: &[Statement]| s.block_in(fun, part, inner, inside);
                     match loops::trip_count(self.module, f, &here, body, continuing, *break_if) {
                         Some(loops::Trips {
                             trips,
@@ -360,7 +371,13 @@ impl Walker<'_> {
                     let passed: Vec<_> =
                         arguments.iter().map(|a| global_root(f, *a, args)).collect();
                     let callee_name = callee.name.as_deref().unwrap_or("?");
-                    t.add(&self.block(callee, callee_name, &callee.body, &passed, depth + 1, None));
+                    let called = Walked {
+                        f: callee,
+                        name: callee_name,
+                        args: &passed,
+                        depth: depth + 1,
+                    };
+                    t.add(&self.block(called, &callee.body, None));
                 }
                 Statement::Atomic { pointer, .. } => {
                     if let Some(g) = storage_root(self.module, f, *pointer, args) {
