@@ -13,7 +13,7 @@ use serde::Serialize;
 
 use super::DemoError;
 use super::clock::Timer;
-use super::frame_cost::Frame;
+use super::edge_frame::EdgeFrame;
 use super::plots::{Chart, Series, line_chart};
 use super::table::Table;
 use lodkit::framebuffer_lod::{
@@ -88,7 +88,7 @@ pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedL
     // One frame per timed run, as an engine times its frames: GPU timestamps where the device
     // has them.
     let timer = Timer::new(gpu, 1)?;
-    let (frame, mut scene) = Frame::new(gpu, &timer, size)?;
+    let (frame, mut scene) = EdgeFrame::new(gpu, &timer, size)?;
     let frame = |scene: &EdgeScene, r: f32| frame.whole(scene, r, 0).map(|ms| ms as f32);
     let times = |scene: &EdgeScene, r: f32| -> Result<Vec<f32>, GpuError> {
         let mut t = (0..CALIBRATION)

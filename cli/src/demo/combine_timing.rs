@@ -5,8 +5,9 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use super::clock::{Record, Timer, interleaved};
+use super::edge_frame::FORMAT;
 use super::reads::{Reads, Texels};
-use super::timing::{FORMAT, PassRatio, plain_pass_with, record_fullscreen};
+use super::timing::{PassRatio, plain_pass_with, record_fullscreen};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LOD_DEPTH_FORMAT, LodBuffers,
 };

@@ -21,13 +21,11 @@ use serde::Serialize;
 
 use super::DemoError;
 use super::clock::{Clock, Timer, median};
+use super::edge_frame::EdgeFrame;
 use super::plots::{BarChart, Chart, Series, line_chart, stacked_bars};
 use super::table::Table;
-use super::timing::{pass_descriptor, settings};
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, LowResLayout, UpsampleFrame, UpsamplePass};
-use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
-use lodkit::gpu::resources::texture_2d;
-use lodkit::gpu::{GpuContext, GpuError};
+use lodkit::gpu::GpuContext;
+use lodkit::gpu::gbuffer_scene::ShadingTerm;
 
 /// Resize factors of the breakdown.
 pub const BREAKDOWN_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];
@@ -111,129 +109,6 @@ impl FrameCost {
     }
 }
 
-/// The resources of a framebuffer-LOD frame of the edge scene (the scene is passed to each
-/// call, since its shading work is the knob the measurements turn): the low-resolution buffer,
-/// the full-resolution prepass, the upsample pass and the target; each pass timed on request.
-pub(super) struct Frame<'a> {
-    gpu: &'a GpuContext,
-    timer: &'a Timer,
-    /// L, unpacked and packed.
-    low: [LowResBuffer; 2],
-    prepass: LowResBuffer,
-    /// The upsample of each L.
-    upsample: [UpsamplePass; 2],
-    /// The fine-grained route's upsample of each L, which multiplies by the prepass's albedo.
-    fine: [UpsamplePass; 2],
-    view: wgpu::TextureView,
-}
-
-impl<'a> Frame<'a> {
-    /// The resources at `size`, RGBA8, and the edge scene for that aspect.
-    pub(super) fn new(
-        gpu: &'a GpuContext,
-        timer: &'a Timer,
-        size: (u32, u32),
-    ) -> Result<(Self, EdgeScene), GpuError> {
-        let ((w, h), format) = (size, wgpu::TextureFormat::Rgba8Unorm);
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let scene = EdgeScene::new(gpu, format, w as f32 / h as f32)?;
-        let frame = Self {
-            gpu,
-            timer,
-            low: [
-                LowResBuffer::new(gpu, w, h, format)?,
-                LowResBuffer::packed(gpu, w, h)?,
-            ],
-            prepass: LowResBuffer::new(gpu, w, h, format)?,
-            upsample: [
-                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::ColorAndGeometry, false))?,
-                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, false))?,
-            ],
-            fine: [
-                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::ColorAndGeometry, true))?,
-                UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, true))?,
-            ],
-            view: texture_2d(gpu, size, format, usage, "frame")?.create_view(&Default::default()),
-        };
-        Ok((frame, scene))
-    }
-
-    /// The time of `record` on the timer's clock, ms.
-    fn timed(&self, record: super::clock::Record<'_>) -> Result<f64, GpuError> {
-        self.timer.time(self.gpu, record)
-    }
-
-    /// The low-resolution shading at `r` into L (`p`: 0 unpacked, 1 packed).
-    fn shade(
-        &self,
-        scene: &EdgeScene,
-        r: f32,
-        term: ShadingTerm,
-        p: usize,
-    ) -> Result<f64, GpuError> {
-        self.timed(&|e| scene.record_term(self.gpu, e, &self.low[p], r, term))
-    }
-
-    fn prepass(&self, scene: &EdgeScene) -> Result<f64, GpuError> {
-        let albedo = ShadingTerm::Albedo;
-        self.timed(&|e| scene.record_term(self.gpu, e, &self.prepass, 1.0, albedo))
-    }
-
-    /// Records the upsample of L `p` at `r`; `term` is what L holds (the lighting alone:
-    /// fine-grained).
-    fn record_upsample(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        r: f32,
-        term: ShadingTerm,
-        p: usize,
-    ) -> Result<(), GpuError> {
-        let fine = term == ShadingTerm::Lighting;
-        let frame = UpsampleFrame {
-            low: &self.low[p],
-            full_geometry: self.prepass.geometry(),
-            full_albedo: fine.then(|| self.prepass.color()),
-            target: &self.view,
-            settings: settings(r),
-        };
-        let pass = if fine {
-            &self.fine[p]
-        } else {
-            &self.upsample[p]
-        };
-        pass.record(self.gpu, encoder, &frame)
-    }
-
-    fn upsample(&self, r: f32, term: ShadingTerm, p: usize) -> Result<f64, GpuError> {
-        self.timed(&|e| self.record_upsample(e, r, term, p))
-    }
-
-    /// A whole frame at `r` from L `p` (0 unpacked, 1 packed): its three passes recorded one
-    /// after the other; its time in ms.
-    pub(super) fn whole(&self, scene: &EdgeScene, r: f32, p: usize) -> Result<f64, GpuError> {
-        self.timed(&|e| {
-            scene.record_term(self.gpu, e, &self.prepass, 1.0, ShadingTerm::Albedo)?;
-            scene.record_term(self.gpu, e, &self.low[p], r, ShadingTerm::Full)?;
-            self.record_upsample(e, r, ShadingTerm::Full, p)
-        })
-    }
-
-    /// The three passes of a frame at `r` from L `p`, each waited for.
-    fn passes(
-        &self,
-        scene: &EdgeScene,
-        r: f32,
-        term: ShadingTerm,
-        p: usize,
-    ) -> Result<[f64; 3], GpuError> {
-        Ok([
-            self.prepass(scene)?,
-            self.shade(scene, r, term, p)?,
-            self.upsample(r, term, p)?,
-        ])
-    }
-}
-
 /// Measures the breakdown and the sweep on the edge scene at `size`, medians of `rounds`.
 pub fn measure_frame_cost(
     gpu: &GpuContext,
@@ -242,7 +117,7 @@ pub fn measure_frame_cost(
     rounds: usize,
 ) -> Result<FrameCost, DemoError> {
     let rounds = rounds.max(3);
-    let (frame, mut scene) = Frame::new(gpu, timer, size)?;
+    let (frame, mut scene) = EdgeFrame::new(gpu, timer, size)?;
     // Pass by pass, rounds interleaved over the configurations; round 0 warms up.
     scene.set_shading_work(BREAKDOWN_WORK);
     let full = ("full resolution", 1.0, ShadingTerm::Full, 0);

@@ -17,6 +17,7 @@ pub mod closed_loop;
 pub mod combine_timing;
 pub mod cpu;
 pub mod doc_pictures;
+pub mod edge_frame;
 pub mod frame_cost;
 pub mod gpu_report;
 pub mod impostor;

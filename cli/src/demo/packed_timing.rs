@@ -4,14 +4,12 @@
 //! composite with a bilinear sample. Same host work on both sides ([`super::timing::HOST_WORK`]).
 
 use super::clock::{Record, Timer, interleaved};
+use super::edge_frame::{EdgeFrame, FORMAT};
 use super::reads::{Reads, Texels};
-use super::timing::{
-    BILINEAR, FORMAT, PassRatio, pass_descriptor, plain_pass, record_fullscreen, settings,
-};
+use super::timing::{BILINEAR, PassRatio, plain_pass, record_fullscreen};
 use lodkit::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
-use lodkit::gpu::framebuffer_lod::{LowResBuffer, LowResLayout, UpsampleFrame, UpsamplePass};
-use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
-use lodkit::gpu::resources::{texture_2d, textures_and_uniform, uniform_buffer};
+use lodkit::gpu::gbuffer_scene::ShadingTerm;
+use lodkit::gpu::resources::{textures_and_uniform, uniform_buffer};
 use lodkit::gpu::{GpuContext, GpuError};
 
 /// The packed eq. 1's loads at the same texels, summed so none is optimized away, no weights.
@@ -62,27 +60,19 @@ pub fn packed_upsample_vs_bilinear(
     pairs: usize,
 ) -> Result<[PassRatio; 3], GpuError> {
     let (w, h) = size;
-    let scene = EdgeScene::new(gpu, FORMAT, w as f32 / h as f32)?;
-    let full = LowResBuffer::new(gpu, w, h, FORMAT)?;
-    scene.render_term(gpu, &full, 1.0, ShadingTerm::Albedo)?;
-    let low = LowResBuffer::new(gpu, w, h, FORMAT)?;
-    scene.render_term(gpu, &low, r, ShadingTerm::Lighting)?;
-    let packed = LowResBuffer::packed(gpu, w, h)?;
-    scene.render_term(gpu, &packed, r, ShadingTerm::Lighting)?;
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let view = texture_2d(gpu, size, FORMAT, usage, "target")?.create_view(&Default::default());
-    let upsample = UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, false))?;
-    let fold_in = UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::Packed, true))?;
+    let (frame, scene) = EdgeFrame::new(gpu, timer, size)?;
+    let (full, low, packed, view) = (&frame.prepass, &frame.low[0], &frame.low[1], &frame.view);
+    scene.render_term(gpu, full, 1.0, ShadingTerm::Albedo)?;
+    scene.render_term(gpu, low, r, ShadingTerm::Lighting)?;
+    scene.render_term(gpu, packed, r, ShadingTerm::Lighting)?;
+    // The fine-grained route's upsample multiplies by the prepass's albedo: the fold-in.
     let run_pass = |encoder: &mut wgpu::CommandEncoder, fine: bool| {
-        let frame = UpsampleFrame {
-            low: &packed,
-            full_geometry: full.geometry(),
-            full_albedo: fine.then(|| full.color()),
-            target: &view,
-            settings: settings(r),
+        let term = if fine {
+            ShadingTerm::Lighting
+        } else {
+            ShadingTerm::Full
         };
-        let pass = if fine { &fold_in } else { &upsample };
-        pass.record(gpu, encoder, &frame)
+        frame.record_upsample(encoder, r, term, 1)
     };
     let (vw, vh) = low.viewport(r);
     let s = [vw as f32 / w as f32, vh as f32 / h as f32, 0.0, 0.0];
@@ -129,7 +119,7 @@ pub fn packed_upsample_vs_bilinear(
             &bilinear,
             &|| group(&bilinear, false),
             uniform,
-            &view,
+            view,
         )
     };
     let run_composite = |e: &mut wgpu::CommandEncoder| {
@@ -139,7 +129,7 @@ pub fn packed_upsample_vs_bilinear(
             &composite,
             &|| group(&composite, true),
             uniform,
-            &view,
+            view,
         )
     };
     let loads = plain_pass(gpu, LOADS5, "loads5.wgsl")?;
@@ -147,7 +137,7 @@ pub fn packed_upsample_vs_bilinear(
     let textures = [packed.color(), full.geometry()];
     let loads_group = || textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads5");
     let run_loads = |e: &mut wgpu::CommandEncoder| {
-        record_fullscreen(gpu, e, &loads, &loads_group, uniform, &view)
+        record_fullscreen(gpu, e, &loads, &loads_group, uniform, view)
     };
     // Counted from the shaders.
     let packed_bound = [

@@ -10,15 +10,12 @@
 use serde::Serialize;
 
 use super::clock::{Clock, Timer, interleaved};
+use super::edge_frame::{EdgeFrame, FORMAT};
 use super::reads::{Reads, Texels};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
-use lodkit::gpu::framebuffer_lod::{
-    LowResBuffer, LowResLayout, RangeSigmas, UpsampleComposite, UpsampleFrame, UpsamplePass,
-    UpsamplePassDescriptor, UpsampleSettings,
-};
-use lodkit::gpu::gbuffer_scene::EdgeScene;
+use lodkit::gpu::gbuffer_scene::ShadingTerm;
 use lodkit::gpu::resources::{
-    begin_color_pass, fullscreen_pipeline_with, texture_2d, textures_and_uniform, uniform_buffer,
+    begin_color_pass, fullscreen_pipeline_with, textures_and_uniform, uniform_buffer,
 };
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
@@ -77,44 +74,6 @@ pub(super) fn plain_pass_with(
     let module = gpu.shader_module(name, &composed)?;
     fullscreen_pipeline_with(gpu, &module, FORMAT, layout, name)
 }
-
-/// The demo's upsample pass over an L of `layout`, times a full-resolution albedo when
-/// `times_albedo` (fine-grained resizing), into [`FORMAT`] targets.
-pub(super) fn pass_descriptor(layout: LowResLayout, times_albedo: bool) -> UpsamplePassDescriptor {
-    UpsamplePassDescriptor {
-        target_format: FORMAT,
-        low_res: layout,
-        composite: if times_albedo {
-            UpsampleComposite::TimesAlbedo
-        } else {
-            UpsampleComposite::Upsampled
-        },
-    }
-}
-
-/// Edge-stopping parameters of the bilateral filter in the demo.
-pub const SIGMA_Z: f32 = 0.25;
-/// See [`SIGMA_Z`].
-pub const SIGMA_N: f32 = 0.4;
-
-/// [`SIGMA_Z`] and [`SIGMA_N`] as the pass takes them.
-pub(super) fn sigmas() -> RangeSigmas {
-    RangeSigmas {
-        depth: SIGMA_Z,
-        normal: SIGMA_N,
-    }
-}
-
-/// The demo's upsampling parameters at resize factor `r`.
-pub(super) fn settings(r: f32) -> UpsampleSettings {
-    UpsampleSettings {
-        r,
-        sigmas: sigmas(),
-    }
-}
-
-/// Target format of the timed passes.
-pub(super) const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// The bilinear baseline: one hardware-filtered sample of L.
 pub(super) const BILINEAR: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
@@ -190,20 +149,10 @@ pub fn upsample_vs_bilinear(
     pairs: usize,
 ) -> Result<[PassRatio; 2], GpuError> {
     let (w, h) = size;
-    let scene = EdgeScene::new(gpu, FORMAT, w as f32 / h as f32)?;
-    let full = LowResBuffer::new(gpu, w, h, FORMAT)?;
-    scene.render(gpu, &full, 1.0)?;
-    let low = LowResBuffer::new(gpu, w, h, FORMAT)?;
-    scene.render(gpu, &low, r)?;
-    let upsample = UpsamplePass::new(gpu, &pass_descriptor(LowResLayout::ColorAndGeometry, false))?;
-    let target = texture_2d(
-        gpu,
-        size,
-        FORMAT,
-        wgpu::TextureUsages::RENDER_ATTACHMENT,
-        "target",
-    )?;
-    let view = target.create_view(&Default::default());
+    let (frame, scene) = EdgeFrame::new(gpu, timer, size)?;
+    let (full, low, view) = (&frame.prepass, &frame.low[0], &frame.view);
+    scene.render_term(gpu, full, 1.0, ShadingTerm::Albedo)?;
+    scene.render(gpu, low, r)?;
     let bilinear = plain_pass(gpu, BILINEAR, "bilinear.wgsl")?;
     let sampler = gpu.device.create_sampler(&wgpu::SamplerDescriptor {
         mag_filter: wgpu::FilterMode::Linear,
@@ -236,19 +185,12 @@ pub fn upsample_vs_bilinear(
         }))
     };
     let run_bilateral = |encoder: &mut wgpu::CommandEncoder| {
-        let frame = UpsampleFrame {
-            low: &low,
-            full_geometry: full.geometry(),
-            full_albedo: None,
-            target: &view,
-            settings: settings(r),
-        };
-        upsample.record(gpu, encoder, &frame)
+        frame.record_upsample(encoder, r, ShadingTerm::Full, 0)
     };
     let scale_bytes: &[u8] = bytemuck::cast_slice(&s);
     let run_bilinear = |encoder: &mut wgpu::CommandEncoder| {
         let uniform = Some((&scale, scale_bytes));
-        record_fullscreen(gpu, encoder, &bilinear, &group, uniform, &view)
+        record_fullscreen(gpu, encoder, &bilinear, &group, uniform, view)
     };
     let loads = plain_pass(gpu, LOADS9, "loads9.wgsl")?;
     let textures = [low.color(), low.geometry(), full.geometry()];
@@ -256,7 +198,7 @@ pub fn upsample_vs_bilinear(
     let loads_group = || textures_and_uniform(gpu, &layout, &textures, Some(&scale), "loads9");
     let run_loads = |encoder: &mut wgpu::CommandEncoder| {
         let uniform = Some((&scale, scale_bytes));
-        record_fullscreen(gpu, encoder, &loads, &loads_group, uniform, &view)
+        record_fullscreen(gpu, encoder, &loads, &loads_group, uniform, view)
     };
     // Counted from the shaders: eq. 1 reads the pixel's own geometry and the 2x2 cell's colors
     // and geometry; the bilinear pass one filtered sample (4 texels).

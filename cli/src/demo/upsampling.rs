@@ -30,8 +30,8 @@ pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];
 /// shaders). The scene costs little to shade without it.
 pub const SHADING_WORK: u32 = 64;
 
-use super::timing::sigmas as demo_sigmas;
-pub use super::timing::{SIGMA_N, SIGMA_Z};
+use super::edge_frame::sigmas as demo_sigmas;
+pub use super::edge_frame::{SIGMA_N, SIGMA_Z};
 
 /// Quality and speed of one resize factor.
 #[derive(Clone, Debug, Serialize)]
@@ -101,7 +101,7 @@ pub fn measure_upsampling(
     let albedo = LowResBuffer::new(gpu, w, h, format)?;
     let layouts = [LowResLayout::ColorAndGeometry, LowResLayout::Packed];
     let pass = |layout, times_albedo| {
-        let desc = super::timing::pass_descriptor(layout, times_albedo);
+        let desc = super::edge_frame::pass_descriptor(layout, times_albedo);
         UpsamplePass::new(
             gpu,
             &UpsamplePassDescriptor {
@@ -137,7 +137,7 @@ pub fn measure_upsampling(
             full_geometry: albedo.geometry(),
             full_albedo: Some(albedo.color()),
             target: &view,
-            settings: super::timing::settings(r),
+            settings: super::edge_frame::settings(r),
         };
         fine_pass[p].record(gpu, e, &frame)
     };
