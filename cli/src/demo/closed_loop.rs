@@ -2,17 +2,17 @@
 //! shading at the controller's r, upsample) is rendered and timed, the controller gets the
 //! measured time and answers the next r, and the scene's shading work doubles mid-run.
 //!
-//! Frame times are wall time around the frame's submissions and one wait. The passes submit their
-//! own command buffers, so GPU timestamp queries would need a query per submission; on a software
-//! GPU, where the GPU is the CPU, the wall time is the GPU time, and on a real GPU it adds the
-//! submission overhead the frame pays anyway.
+//! Each frame's three passes are recorded into one encoder and timed as one run on the
+//! [`Clock`] the figure names, as an engine times its frames: GPU timestamps around the
+//! recordings where the device has them, the wall clock around the submission and its wait
+//! otherwise.
 
 use std::path::Path;
 
 use serde::Serialize;
 
 use super::DemoError;
-use super::clock::Timer;
+use super::clock::{Clock, Timer};
 use super::edge_frame::EdgeFrame;
 use super::plots::{Chart, Series, line_chart};
 use super::table::Table;
@@ -74,6 +74,8 @@ pub struct ClosedLoop {
     pub noise: f32,
     /// Every run of each controller: [`REPEATS`] per controller.
     pub repeats: Vec<Vec<ClosedLoopRun>>,
+    /// The clock every frame time was read from.
+    pub clock: Clock,
 }
 
 impl ClosedLoop {
@@ -138,6 +140,7 @@ pub fn measure_closed_loop(gpu: &GpuContext, size: (u32, u32)) -> Result<ClosedL
         paper_k,
         noise,
         repeats,
+        clock: timer.clock(),
     })
 }
 
@@ -257,8 +260,8 @@ pub fn summary(closed: &ClosedLoop) -> String {
     let (w, h) = closed.size;
     format!(
         "The edge scene at {w}x{h}, rendered frame by frame (prepass, low-resolution shading at \
-         the controller's r, upsample), timed as wall time around the frame's submissions and one \
-         wait. Target {:.1} ms (the frame at r = {TARGET_R} measured before the runs); the shading \
+         the controller's r, upsample), each frame timed as one run of its recordings on the \
+         clock: {}. Target {:.1} ms (the frame at r = {TARGET_R} measured before the runs); the shading \
          work doubles from {BASE_WORK} to {} sky directions at frame {STEP_FRAME}; the paper's K \
          calibrated from frames at r = 1 and r = 2: {:.1} ms; lodkit's controller is told the \
          noise measured in the calibration frames ({:.1} %). Settling: frames after the step until \
@@ -266,6 +269,7 @@ pub fn summary(closed: &ClosedLoop) -> String {
          frame to the end of the run; single frames scatter around it by the noise. Each \
          controller ran {REPEATS} times, interleaved: the table gives the median and, in \
          brackets, the range.",
+        closed.clock.label(),
         closed.target_ms,
         2 * BASE_WORK,
         closed.paper_k,

@@ -380,7 +380,8 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     b.push_str("\n## Framebuffer LOD: whole-frame speed-up\n\n");
     let _ = writeln!(
         b,
-        "Median wall time of a full-resolution frame over a framebuffer-LOD frame: the full-resolution geometry prepass the upsampling needs (depth and normals, with the cheap albedo), the low-res shading pass and the upsample pass (fine-grained: the low-res lighting pass, the full-resolution albedo pass that also writes the geometry, and the upsample, which multiplies by that albedo: no composite pass left out). Edge scene with {SHADING_WORK} sky directions of shading work per fragment.\n"
+        "Median time of a full-resolution frame over a framebuffer-LOD frame (per recording, on the report's clock: {clock}): the full-resolution geometry prepass the upsampling needs (depth and normals, with the cheap albedo), the low-res shading pass and the upsample pass (fine-grained: the low-res lighting pass, the full-resolution albedo pass that also writes the geometry, and the upsample, which multiplies by that albedo: no composite pass left out). Edge scene with {SHADING_WORK} sky directions of shading work per fragment.\n",
+        clock = report.clock.label()
     );
     b.push_str(&speed_table(report).markdown());
     b.push_str(&super::report_fb::benchmarks_markdown(report));
