@@ -8,7 +8,8 @@
 //! ```text
 //! cargo run --example frame_sequential [-- [--out DIR] [--report FILE] [--frames DIR]
 //!     [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection]
-//!     [--coverage estimated|silhouette|depth-pass] [--without-prepass-only]]
+//!     [--coverage estimated|silhouette|depth-pass] [--combine-region hulls|rectangles]
+//!     [--without-prepass-only]]
 //! ```
 //!
 //! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_<run>.png` (7 frames over the
@@ -19,9 +20,11 @@
 //! levels share the pattern (default `paper`, the plugin's default). `--no-reprojection` breaks the
 //! combine on purpose (the older frame read at the same pixel): the moving camera then shows the
 //! background through the objects. `--coverage` sets `FrameSequentialLod::coverage` (default
-//! `estimated`; with `depth-pass` the older-level depth pass's samples are the report's
-//! `fragments_<run>_older_depth`). `--without-prepass-only` skips the app with a
-//! prepass.
+//! `silhouette`; with `depth-pass` the older-level depth pass's samples are the report's
+//! `fragments_<run>_older_depth`). `--combine-region` sets
+//! `FrameSequentialLod::combine_region` (default `hulls`; `rectangles`, the groups' screen
+//! rectangles, draws the same picture with more of the combine's fragments:
+//! `fragments_<run>_combine`). `--without-prepass-only` skips the app with a prepass.
 //! Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
 //!
 //! The scene is `scene.rs` (what a Bevy app writes to use the plugin is there, in
@@ -45,7 +48,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use lodkit::frame_sequential::Schedule;
-use lodkit_bevy::frame_sequential::{OlderCoverage, VisibilitySpace};
+use lodkit_bevy::frame_sequential::{CombineRegion, OlderCoverage, VisibilitySpace};
 
 /// Parsed command line.
 pub struct Args {
@@ -57,11 +60,13 @@ pub struct Args {
     anchor: VisibilitySpace,
     reprojection: bool,
     coverage: OlderCoverage,
+    combine_region: CombineRegion,
 }
 
 const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] [--frames DIR] \
 [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection] \
-[--coverage estimated|silhouette|depth-pass] [--without-prepass-only] [--chain]";
+[--coverage estimated|silhouette|depth-pass] [--combine-region hulls|rectangles] \
+[--without-prepass-only] [--chain]";
 
 fn parse() -> Result<Option<Args>, String> {
     let mut args = Args {
@@ -73,6 +78,7 @@ fn parse() -> Result<Option<Args>, String> {
         anchor: VisibilitySpace::Screen,
         reprojection: true,
         coverage: OlderCoverage::default(),
+        combine_region: CombineRegion::default(),
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -105,6 +111,13 @@ fn parse() -> Result<Option<Args>, String> {
                     "silhouette" => OlderCoverage::Silhouette,
                     "depth-pass" => OlderCoverage::DepthPass,
                     other => return Err(format!("unknown coverage `{other}`")),
+                }
+            }
+            "--combine-region" => {
+                args.combine_region = match value()?.as_str() {
+                    "hulls" => CombineRegion::Hulls,
+                    "rectangles" => CombineRegion::Rectangles,
+                    other => return Err(format!("unknown combine region `{other}`")),
                 }
             }
             _ => return Err(format!("unexpected argument `{arg}`")),

@@ -262,6 +262,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         "coverage".into(),
         format!("{:?}", args.coverage).to_lowercase().into(),
     );
+    report.insert(
+        "combine_region".into(),
+        format!("{:?}", args.combine_region).to_lowercase().into(),
+    );
     if let Some(dir) = &args.frames {
         report.insert("frames_dir".into(), dir.display().to_string().into());
     }

@@ -222,6 +222,7 @@ impl Harness {
                 },
                 reprojection: args.reprojection,
                 coverage: args.coverage,
+                combine_region: args.combine_region,
             });
         }
         camera.id()

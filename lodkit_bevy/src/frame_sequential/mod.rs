@@ -8,10 +8,11 @@
 //!
 //! No prepass is needed, as for Bevy's `VisibilityRange` crossfade. In the `frame_sequential`
 //! example (the plugin's defaults), each technique on a camera of its own, over its transitions,
-//! frame-sequential LOD draws 0.73x the crossfade's fragments on lavapipe in an app without a
-//! prepass and 0.78x in an app that runs Bevy's depth and motion-vector prepass anyway (TAA,
-//! motion blur), 1.21x and 0.97x on an NVIDIA H200, whose early depth test rejects most of the
-//! crossfade's hidden fragments; in GPU time (timestamps) it takes 20.5x the crossfade's on
+//! frame-sequential LOD draws 0.71x the crossfade's fragments on lavapipe in an app without a
+//! prepass and 0.77x in an app that runs Bevy's depth and motion-vector prepass anyway (TAA,
+//! motion blur), the combine running over the hulls of the levels' silhouettes ([`CombineRegion`];
+//! 0.73x and 0.78x over screen rectangles), and over rectangles 1.21x and 0.97x on an NVIDIA
+//! H200, whose early depth test rejects most of the crossfade's hidden fragments; in GPU time (timestamps) it takes 20.5x the crossfade's on
 //! lavapipe, nearly all of it the combine testing each pixel against every silhouette segment
 //! (the example reports `gpu_ms_<run>` per pass). It
 //! pops less (0.031 / 0.028 against 0.043 / 0.035, still / moving camera), shows no background
@@ -73,7 +74,8 @@
 //!   own, but the plugin drives only `FrameSequentialMaterial` levels for now.
 //! - After Bevy's opaque pass, before the transparent pass and post-processing, the plugin
 //!   copies the main texture and depth (the next frame's older buffer) and runs lodkit's
-//!   combine over the screen rectangles of the groups in transition.
+//!   combine over the convex hulls of the silhouettes of the groups in transition (both
+//!   levels'; [`CombineRegion`]), or their screen rectangles where a level has none.
 //!
 //! Limits: one camera per app drives the selection (the first active one with
 //! [`FrameSequentialLod`]); the combine needs `Msaa::Off` (with MSAA the plugin logs one
@@ -204,6 +206,36 @@ pub struct FrameSequentialLod {
     /// (default [`OlderCoverage::Silhouette`]; see there for what each costs).
     #[reflect(ignore)]
     pub coverage: OlderCoverage,
+    /// Where the combine runs (default [`CombineRegion::Hulls`]: only where it can change a
+    /// pixel).
+    #[reflect(ignore)]
+    pub combine_region: CombineRegion,
+}
+
+/// Where the combine pass runs: [`FrameSequentialLod::combine_region`]. Either way it draws the
+/// same picture; the hulls shade fewer pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum CombineRegion {
+    /// Over the convex hull of both levels' silhouettes, per group in transition (the
+    /// default), drawn as rows of 4 pixels. The combine changes a pixel only where this
+    /// frame's level was drawn (a t-instance's id is there) or where the older level's
+    /// silhouette covers its center or passes within `SILHOUETTE_TIE` of it (the shader reads
+    /// no other older coverage for a group with a silhouette; a pixel's motion changes what it
+    /// reads, not whether it changes), so the hull of both silhouettes, found with this
+    /// frame's camera and transform, grown by one pixel (the tie and the CPU's other rounding
+    /// of the projection are far below one), holds every pixel it changes. The levels'
+    /// silhouettes cost CPU time: the drawn level's is found as well as the older one's
+    /// ([`FrameSequentialStats::silhouette_time`]). A group whose levels do not both have a silhouette (coverage
+    /// [`OlderCoverage::Estimated`] or [`OlderCoverage::DepthPass`], a mesh without one, a
+    /// level reaching behind the camera) or that names its own
+    /// [`bounds`](FrameSequentialGroup::bounds) (vertex animation beyond its meshes, which
+    /// silhouettes do not follow) is combined over its rectangles, as with
+    /// [`Rectangles`](Self::Rectangles).
+    #[default]
+    Hulls,
+    /// Over the screen rectangles of each group's bounds, this frame and where the older
+    /// frame had it: the combine's region before the hulls, kept to compare with them.
+    Rectangles,
 }
 
 /// How the combine knows which pixels the older level (the one a group in transition does not
@@ -253,6 +285,7 @@ impl Default for FrameSequentialLod {
             },
             reprojection: true,
             coverage: OlderCoverage::default(),
+            combine_region: CombineRegion::default(),
         }
     }
 }

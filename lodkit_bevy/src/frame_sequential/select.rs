@@ -18,13 +18,13 @@ use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection, LodState};
 
-use super::rects::{Bounds, group_rect, level_bounds, to_lodkit};
-use super::silhouette::{Surfaces, forget_changed_meshes};
+use super::rects::{Bounds, group_hull, group_rect, level_bounds, merge_rows, to_lodkit};
+use super::silhouette::{OutlineView, Surfaces, forget_changed_meshes, outline};
 use super::tag::{decode_tag, encode_tag};
 use super::view::{FrameSequentialView, OlderLevel};
 use super::{
-    FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels, OlderCoverage,
-    VisibilitySpace,
+    CombineRegion, FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels,
+    OlderCoverage, VisibilitySpace,
 };
 
 pub(super) fn build(app: &mut App) {
@@ -76,7 +76,8 @@ pub struct FrameSequentialLevels {
 pub struct FrameSequentialStats {
     /// Groups in transition this frame.
     pub in_transition: usize,
-    /// Pixels the combine pass covers this frame (its rectangles' area).
+    /// Pixels the combine pass covers this frame (the area of its hulls' rows and its
+    /// rectangles).
     pub combine_pixels: u64,
     /// Frames the scheduler has run.
     pub frames: u64,
@@ -86,10 +87,11 @@ pub struct FrameSequentialStats {
     /// Frames kept so far (of [`frames`](Self::frames)).
     pub frames_kept: u64,
     /// CPU time this frame spent finding the older levels' silhouettes
-    /// ([`OlderCoverage::Silhouette`]), building a mesh's surface the first time it is needed
-    /// included.
+    /// ([`OlderCoverage::Silhouette`]) and, for the combine's hulls
+    /// ([`CombineRegion::Hulls`]), those of the levels drawn, building a mesh's surface the
+    /// first time it is needed included.
     pub silhouette_time: Duration,
-    /// Triangles whose facing this frame's silhouettes tested.
+    /// Triangles whose facing this frame's silhouettes tested (the drawn levels' included).
     pub silhouette_triangles: u64,
 }
 
@@ -303,6 +305,8 @@ fn update(
     );
     let object = settings.anchor == VisibilitySpace::Object;
     let mut rects = Vec::new();
+    // The rows of the groups' combine hulls.
+    let mut hull_rows = Vec::new();
     // The world motion of each t-instance that moved.
     let mut moved = Vec::new();
     let mut drawn_tau_next = Vec::new();
@@ -390,6 +394,8 @@ fn update(
                 .transition
                 .map(|(from, to)| if lod == from { to } else { from })
                 .and_then(|other| levels.0.get(usize::from(other)));
+            // Its combine hull's rows, where it has one.
+            let mut hull = None;
             if let Some(other) = other.filter(|_| selection.visible && settings.coverage.is_exact())
             {
                 let cull_mode = materials
@@ -400,25 +406,35 @@ fn update(
                 // older-level depth pass draws the level.
                 let wants_outline = settings.coverage == OlderCoverage::Silhouette
                     && cull_mode != Some(Face::Front);
-                let outline = wants_outline.then(|| {
+                let view = OutlineView {
+                    clip_from_world: clip_from_view * view_from_world,
+                    eye: camera_transform.translation(),
+                    model,
+                    size,
+                };
+                let mut outline_of = |mesh: &Handle<Mesh>| {
                     let start = Instant::now();
-                    let outline = surfaces.get(other.mesh.id(), &meshes).and_then(|surface| {
-                        silhouette_triangles += surface.triangles() as u64;
-                        let eye = model
-                            .inverse()
-                            .transform_point3(camera_transform.translation());
-                        Ok(surface.silhouette(
-                            to_lodkit(clip_from_view * view_from_world * model),
-                            glam::Vec3::from_array(eye.to_array()),
-                            (size.x, size.y),
-                            model.determinant() > 0.0,
-                        )?)
-                    });
+                    let outline = outline(&mut surfaces, &meshes, mesh.id(), &view);
                     silhouette_time += start.elapsed();
-                    outline
-                });
-                match outline {
-                    Some(Ok(segments)) => silhouettes.push((tag_id, segments)),
+                    outline.map(|(segments, triangles)| {
+                        silhouette_triangles += triangles;
+                        segments
+                    })
+                };
+                match wants_outline.then(|| outline_of(&other.mesh)) {
+                    Some(Ok(segments)) => {
+                        // The combine region: the hull of both levels' silhouettes, where the
+                        // level drawn now has one too (and the group names no bounds of its
+                        // own, which vertex animation may reach beyond the meshes).
+                        let drawn = levels.0.get(usize::from(lod)).or(levels.0.last());
+                        if settings.combine_region == CombineRegion::Hulls
+                            && group.bounds.is_none()
+                            && let Some(Ok(newer)) = drawn.map(|l| outline_of(&l.mesh))
+                        {
+                            hull = group_hull(&segments, &newer, size);
+                        }
+                        silhouettes.push((tag_id, segments));
+                    }
                     _ => older_levels.push(OlderLevel {
                         mesh: other.mesh.id(),
                         world_from_local: model,
@@ -430,8 +446,9 @@ fn update(
             if previous != model {
                 moved.push((tag_id, previous * model.inverse()));
             }
-            match state.bounds {
-                Some(bounds) => {
+            match (hull, state.bounds) {
+                (Some(rows), _) => hull_rows.extend(rows),
+                (None, Some(bounds)) => {
                     rects.extend(group_rect(
                         bounds,
                         model,
@@ -447,7 +464,7 @@ fn update(
                         size,
                     ));
                 }
-                None => rects.push(ScreenRect {
+                (None, None) => rects.push(ScreenRect {
                     x: 0,
                     y: 0,
                     width: size.x,
@@ -476,7 +493,10 @@ fn update(
             }
         }
     }
-    let rects = merge_rects(&rects);
+    // A rectangle and a row may overlap (groups with and without hulls): that pixel is combined
+    // twice, to the same color.
+    let mut rects = merge_rects(&rects);
+    rects.extend(merge_rows(&hull_rows));
     stats.in_transition = in_transition;
     stats.silhouette_time = silhouette_time;
     stats.silhouette_triangles = silhouette_triangles;

@@ -9,7 +9,9 @@ use std::sync::Arc;
 use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
-use lodkit::silhouette::{SilhouetteError, Surface};
+use lodkit::silhouette::{Segment, SilhouetteError, Surface};
+
+use super::rects::to_lodkit;
 
 /// Why a level has no silhouette here (the older-level depth pass then draws it).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,6 +68,37 @@ impl Surfaces {
         self.0.insert(id, surface.clone());
         surface
     }
+}
+
+/// What [`outline`] needs of the frame: the camera and the group's transform.
+pub struct OutlineView {
+    /// The camera's clip_from_world.
+    pub clip_from_world: Mat4,
+    /// The camera's position (world).
+    pub eye: Vec3,
+    /// The group's world_from_local.
+    pub model: Mat4,
+    /// The target's size in pixels.
+    pub size: UVec2,
+}
+
+/// The silhouette (segments in pixels) of mesh `id` under `view`, and the triangles whose facing
+/// it tested.
+pub fn outline(
+    surfaces: &mut Surfaces,
+    meshes: &Assets<Mesh>,
+    id: AssetId<Mesh>,
+    view: &OutlineView,
+) -> Result<(Vec<Segment>, u64), NoSilhouette> {
+    let surface = surfaces.get(id, meshes)?;
+    let eye = view.model.inverse().transform_point3(view.eye);
+    let segments = surface.silhouette(
+        to_lodkit(view.clip_from_world * view.model),
+        glam::Vec3::from_array(eye.to_array()),
+        (view.size.x, view.size.y),
+        view.model.determinant() > 0.0,
+    )?;
+    Ok((segments, surface.triangles() as u64))
 }
 
 /// Forgets the surfaces of meshes that changed or went.
