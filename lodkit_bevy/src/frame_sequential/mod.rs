@@ -10,9 +10,10 @@
 //! example (the plugin's defaults), each technique on a camera of its own, over its transitions,
 //! frame-sequential LOD draws 0.71x the crossfade's fragments on lavapipe in an app without a
 //! prepass and 0.77x in an app that runs Bevy's depth and motion-vector prepass anyway (TAA,
-//! motion blur), the combine running over the hulls of the levels' silhouettes ([`CombineRegion`];
-//! 0.73x and 0.78x over screen rectangles), and over rectangles 1.21x and 0.97x on an NVIDIA
-//! H200, whose early depth test rejects most of the crossfade's hidden fragments; in GPU time (timestamps) it takes 20.5x the crossfade's on
+//! motion blur), the combine running over the hulls of the levels' silhouettes
+//! ([`CombineRegion`]; 0.73x and 0.78x over screen rectangles), and over rectangles 1.21x and
+//! 0.97x on an NVIDIA H200, whose early depth test rejects most of the crossfade's hidden
+//! fragments; in GPU time (timestamps, over rectangles) it takes 20.5x the crossfade's on
 //! lavapipe, nearly all of it the combine testing each pixel against every silhouette segment
 //! (the example reports `gpu_ms_<run>` per pass). It
 //! pops less (0.031 / 0.028 against 0.043 / 0.035, still / moving camera), shows no background
@@ -225,9 +226,9 @@ pub enum CombineRegion {
     /// frame's camera and transform, grown by one pixel (the tie and the CPU's other rounding
     /// of the projection are far below one), holds every pixel it changes. The levels'
     /// silhouettes cost CPU time: the drawn level's is found as well as the older one's
-    /// ([`FrameSequentialStats::silhouette_time`]). A group whose levels do not both have a silhouette (coverage
-    /// [`OlderCoverage::Estimated`] or [`OlderCoverage::DepthPass`], a mesh without one, a
-    /// level reaching behind the camera) or that names its own
+    /// ([`FrameSequentialStats::silhouette_time`]). A group whose levels do not both have a
+    /// silhouette (coverage [`OlderCoverage::Estimated`] or [`OlderCoverage::DepthPass`], a
+    /// mesh without one, a level reaching behind the camera) or that names its own
     /// [`bounds`](FrameSequentialGroup::bounds) (vertex animation beyond its meshes, which
     /// silhouettes do not follow) is combined over its rectangles, as with
     /// [`Rectangles`](Self::Rectangles).
@@ -303,7 +304,8 @@ pub struct FrameSequentialGroup {
     /// The box that holds every level's vertices (object space; None: the union of the level
     /// meshes' bounds, computed once they are loaded). Give it for vertex animation that moves
     /// vertices beyond the meshes' bounds (`lodkit::combine::displaced_bounds`): the combine
-    /// only works inside the box's screen rectangle. Read once, when the group's levels are
+    /// then runs over the box's screen rectangle (not the levels' silhouettes' hull) and only
+    /// works inside it. Read once, when the group's levels are
     /// first drawn; a change to its [`LodLevels`] reads it again.
     pub bounds: Option<(Vec3, Vec3)>,
 }
