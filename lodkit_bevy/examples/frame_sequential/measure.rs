@@ -74,8 +74,15 @@ pub fn still_flicker(
 
 /// Per pixel of `frame`: whether it covers it (shows something other than `background`).
 fn mask(frame: &Frame, background: [u8; 3]) -> Vec<bool> {
-    frame.pixels().map(|p| !is_background(p, background)).collect()
+    frame
+        .pixels()
+        .map(|p| !is_background(p, background))
+        .collect()
 }
+
+/// A measure of three coverage masks (fine, coarse, shown): `lodkit::metrics::see_through` or
+/// `ghosts`.
+type MaskMeasure = fn(&[bool], &[bool], &[bool]) -> Result<usize, MetricsError>;
 
 /// Per frame of `frames`: `measure(fine, coarse, shown)` of the three coverage masks
 /// (`lodkit::metrics::see_through` or `ghosts`).
@@ -84,7 +91,7 @@ fn per_frame(
     fine: &[Frame],
     coarse: &[Frame],
     background: [u8; 3],
-    measure: fn(&[bool], &[bool], &[bool]) -> Result<usize, MetricsError>,
+    measure: MaskMeasure,
 ) -> Vec<usize> {
     frames
         .iter()

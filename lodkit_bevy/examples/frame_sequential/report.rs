@@ -113,8 +113,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             let f = flicker(&run.frames, &fine.frames).map_err(|e| Failure(1, e.to_string()))?;
             // Against the coarse level's frames too: a verdict that turns with the reference
             // does not show less flicker.
-            let fc =
-                flicker(&run.frames, &coarse.frames).map_err(|e| Failure(1, e.to_string()))?;
+            let fc = flicker(&run.frames, &coarse.frames).map_err(|e| Failure(1, e.to_string()))?;
             let holes = see_through(&run.frames, &fine.frames, &coarse.frames, background);
             let shown = coverage(&run.frames, &fine.frames, &coarse.frames, background);
             let window: Vec<usize> = (0..FRAMES).filter(|&f| run.in_transition[f]).collect();
@@ -160,7 +159,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             report.insert(format!("flicker_{name}_{path}"), f.ratio().into());
             report.insert(format!("reversals_{name}_{path}"), f.reversals.into());
             report.insert(format!("flicker_{name}_{path}_coarse"), fc.ratio().into());
-            report.insert(format!("reversals_{name}_{path}_coarse"), fc.reversals.into());
+            report.insert(
+                format!("reversals_{name}_{path}_coarse"),
+                fc.reversals.into(),
+            );
             // The silhouettes' CPU time per frame, over the frames that found any (the first
             // of a mesh builds its surface too).
             let times: Vec<f64> = run
