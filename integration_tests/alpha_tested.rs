@@ -65,16 +65,12 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
     single.set_alpha_mask(gpu, &mask).unwrap();
     let target = RenderTarget::new(gpu, W, W).unwrap();
     let item = card_draw(&card, rect);
-    let light = Vec3::Z;
-    let black = wgpu::Color::BLACK;
     single
         .render(
             gpu,
             &target,
             &MeshFrame {
-                clear: black,
                 view_proj,
-                light_dir: light,
                 items: &[item],
                 ..Default::default()
             },
@@ -104,10 +100,8 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
         gpu,
         &buffers,
         &LodBufferFrame {
-            index: 0,
             view: view_proj.into(),
             items: &[item],
-            clear: black,
             ..Default::default()
         },
     )
@@ -130,10 +124,8 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
         gpu,
         &buffers,
         &LodBufferFrame {
-            index: 0,
             view: view_proj.into(),
             items: &[whole],
-            clear: black,
             ..Default::default()
         },
     )
@@ -177,15 +169,12 @@ fn a_bad_alpha_mask_is_refused_and_the_old_one_kept() {
     let card = GpuMesh::new(gpu, &Mesh::card(Vec2::splat(-1.0), Vec2::ONE)).unwrap();
     let item = card_draw(&card, alpha_mask_rect(Vec2::splat(-1.0), Vec2::ONE));
     let view_proj = head_on();
-    let black = wgpu::Color::BLACK;
     single
         .render(
             gpu,
             &target,
             &MeshFrame {
-                clear: black,
                 view_proj,
-                light_dir: Vec3::Z,
                 items: &[item],
                 ..Default::default()
             },

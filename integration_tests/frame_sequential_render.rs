@@ -412,16 +412,13 @@ fn a_lod_whose_tau_is_zero_is_not_submitted() {
         alpha_rect: Vec4::ZERO,
     };
     let render = |items: &[LodDrawItem]| {
-        let clear = wgpu::Color::BLACK;
         let (triangles, _) = renderer
             .render(
                 gpu,
                 &buffers,
                 &LodBufferFrame {
-                    index: 0,
                     view: (proj * view).into(),
                     items,
-                    clear,
                     ..Default::default()
                 },
             )
@@ -676,16 +673,13 @@ fn a_swaying_lod_moves_with_its_phase() {
             prev_sway_phase: sway[1],
             alpha_rect: Vec4::ZERO,
         };
-        let clear = wgpu::Color::BLACK;
         renderer
             .render(
                 gpu,
                 &buffers,
                 &LodBufferFrame {
-                    index: 0,
                     view: (proj * view).into(),
                     items: &[item],
-                    clear,
                     ..Default::default()
                 },
             )
