@@ -9,9 +9,11 @@
 //! 2. `draw(key)` gives each instance this frame's LOD, id and visibility threshold tau; the
 //!    scene goes into LOD buffer `buffer_index()` (your forward pass writes color, id and depth;
 //!    `LodBufferRenderer` is lodkit's reference for it);
-//! 3. `CombinePass::record` (with `CombineRegions::Only`) merges that buffer with last frame's, reprojected through
-//!    the camera motion (`new_to_old_matrix`), into the frame's target, only inside the screen
-//!    rectangles of the instances in transition; the rest of the frame is a copy.
+//! 3. `CombinePass::record` (with `CombineRegions::Only`) merges that buffer with last frame's,
+//!    reprojected through the camera motion (`new_to_old_matrix`), into the frame's target, only
+//!    inside the screen rectangles of the instances in transition (the rest of the frame is a
+//!    copy), told where the level last frame drew covers the screen: its silhouette under this
+//!    frame's camera (`CombineCoverage::Known`, `lodkit::silhouette::Surface`).
 //!
 //! `cargo run --example frame_sequential -- [--out DIR]`
 //! Writes DIR/frame_sequential.png (default DIR: lodkit-out): frames of the camera pulling back
@@ -21,10 +23,13 @@ use std::error::Error;
 
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::screen_rect;
+use lodkit::combine_coverage::{
+    CombineData, CombineDataDescriptor, CombineObjectData, CoverageRoute,
+};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{
-    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
+    CombineCoverage, CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
 };
 use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
@@ -32,6 +37,7 @@ use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodGroup, LodSettings, LodState, TransitionMode};
+use lodkit::silhouette::Surface;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 const SIZE: (u32, u32) = (240, 135);
@@ -73,16 +79,25 @@ fn main() -> Result<(), Box<dyn Error>> {
         | wgpu::TextureUsages::COPY_DST;
     let target = texture_2d(&gpu, SIZE, FORMAT, usage, "frame")?;
     let target_view = target.create_view(&Default::default());
+    let meshes = [Mesh::sphere(16, 32), Mesh::cube()];
     let lods = [
         (
-            GpuMesh::new(&gpu, &Mesh::sphere(16, 32))?,
+            GpuMesh::new(&gpu, &meshes[0])?,
             Vec4::new(0.9, 0.2, 0.15, 1.0),
         ),
         (
-            GpuMesh::new(&gpu, &Mesh::cube())?,
+            GpuMesh::new(&gpu, &meshes[1])?,
             Vec4::new(0.15, 0.3, 0.9, 1.0),
         ),
     ];
+    // Each level's surface, for its silhouette (both are closed meshes).
+    let surfaces = meshes
+        .iter()
+        .map(|m| {
+            let points: Vec<[f32; 3]> = m.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect();
+            Surface::new(&points, Some(&m.indices))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
 
     // Five instances in a row going away from the camera; level 1 beyond a view-normalized
     // distance of 2.5. Selection switches hard: the scheduler spreads each switch over 0.3 s.
@@ -97,6 +112,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let mut scheduler = TransitionScheduler::new();
     let keys: Vec<_> = positions.iter().map(|_| scheduler.insert(0)).collect();
     let mut states = vec![LodState::NEW; positions.len()];
+    // The level each instance was drawn at last frame: the one the older buffer holds.
+    let mut older_lod: Vec<Option<usize>> = vec![None; positions.len()];
 
     let aspect = w as f32 / h as f32;
     let proj = glam::camera::rh::proj::directx::perspective(0.7, aspect, 0.1, 100.0);
@@ -194,6 +211,33 @@ fn main() -> Result<(), Box<dyn Error>> {
             .filter(|(key, _)| scheduler.in_transition(**key))
             .filter_map(|(_, &p)| screen_rect(unit_box, model(p), &views, SIZE, 2))
             .collect();
+        // Where the level the older buffer holds covers the screen now: its silhouette under
+        // this frame's camera (nothing moves by itself, so each instance's matrix is the
+        // camera's).
+        let mut silhouettes = Vec::new();
+        for ((key, &p), older) in keys.iter().zip(&positions).zip(&older_lod) {
+            let (Some(lod), true) = (older, scheduler.in_transition(*key)) else {
+                continue;
+            };
+            let eye = (view * model(p)).inverse().transform_point3(Vec3::ZERO);
+            let segments = surfaces[*lod].silhouette(proj * view * model(p), eye, SIZE, true)?;
+            silhouettes.push((scheduler.draw(*key)?.id, segments));
+        }
+        let objects: Vec<CombineObjectData> = silhouettes
+            .iter()
+            .map(|(id, segments)| CombineObjectData {
+                id: *id,
+                new_to_old,
+                older_tau: None,
+                route: CoverageRoute::Silhouette(segments),
+            })
+            .collect();
+        let data = CombineData::new(&CombineDataDescriptor {
+            new_to_old,
+            height: h,
+            objects: &objects,
+            ..Default::default()
+        })?;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         let frame_to_combine = CombineFrame {
             buffers: &buffers,
@@ -201,10 +245,17 @@ fn main() -> Result<(), Box<dyn Error>> {
             new_to_old,
             target: &target_view,
             regions: CombineRegions::Only(&regions),
+            coverage: CombineCoverage::Known {
+                data: &data,
+                level_depth: None,
+            },
         };
         combine.record(&gpu, &mut encoder, &frame_to_combine)?;
         gpu.queue.submit([encoder.finish()]);
         previous_view = Some(view);
+        for (key, older) in keys.iter().zip(&mut older_lod) {
+            *older = Some(usize::from(scheduler.draw(*key)?.lod.min(1)));
+        }
 
         if frame % (FRAMES / COLUMNS) == FRAMES / COLUMNS - 1 {
             let column = (frame / (FRAMES / COLUMNS)) as i64;

@@ -565,6 +565,7 @@ impl SphereLods {
             new_to_old,
             target: &self.target_view,
             regions: CombineRegions::Everywhere,
+            coverage: Default::default(),
         };
         self.combine.record(gpu, &mut encoder, &frame).unwrap();
         gpu.queue.submit([encoder.finish()]);

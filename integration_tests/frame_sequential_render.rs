@@ -636,6 +636,7 @@ fn everywhere<'a>(
         new_to_old,
         target,
         regions: CombineRegions::Everywhere,
+        coverage: Default::default(),
     }
 }
 
@@ -646,6 +647,7 @@ fn only<'a>(
 ) -> CombineFrame<'a> {
     CombineFrame {
         regions: CombineRegions::Only(regions),
+        coverage: Default::default(),
         ..frame
     }
 }

@@ -9,8 +9,12 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use lodkit::combine::DepthConvention;
+use lodkit::combine_coverage::{
+    CombineData, CombineDataDescriptor, CombineObjectData, CoverageRoute,
+};
 use lodkit::gpu::frame_sequential::{
-    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
+    CombineCoverage, CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions,
+    LOD_DEPTH_FORMAT, LodBuffers, read_lod_image,
 };
 use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
@@ -405,6 +409,67 @@ fn passes_given_mismatched_inputs_name_both() {
         .record(gpu, &mut e, &whole(&buffers, 1, &right))
         .unwrap();
     gpu.queue.submit([e.finish()]);
+    // Combine told the older levels' coverage: data that does not fill its texture, an object
+    // displayed at an older_tau (the pass reads no pattern), a depth pass read but not given,
+    // one of another size.
+    let known = |data, level_depth| {
+        let frame = CombineFrame {
+            coverage: CombineCoverage::Known { data, level_depth },
+            ..whole(&buffers, 0, &right)
+        };
+        no_panic("CombinePass::record", || {
+            combine.record(gpu, &mut encoder(), &frame).map(drop)
+        })
+    };
+    let square = [
+        [2.0, 2.0, 2.0, 6.0],
+        [2.0, 6.0, 6.0, 6.0],
+        [6.0, 6.0, 6.0, 2.0],
+    ];
+    let object = |older_tau, route| CombineObjectData {
+        id: 3,
+        new_to_old: glam::Mat4::IDENTITY,
+        older_tau,
+        route,
+    };
+    let data = |objects: &[CombineObjectData], level_depth| {
+        CombineData::new(&CombineDataDescriptor {
+            height: 24,
+            level_depth,
+            objects,
+            ..Default::default()
+        })
+        .unwrap()
+    };
+    let silhouette = data(&[object(None, CoverageRoute::Silhouette(&square))], false);
+    let mut short = silhouette.clone();
+    short.texels.pop();
+    mismatch(known(&short, None), "coverage.data", "texels", "texels");
+    let anchored = data(
+        &[object(Some(0.5), CoverageRoute::Silhouette(&square))],
+        false,
+    );
+    mismatch(known(&anchored, None), "coverage.data", "id 3", "older_tau");
+    let depth_pass = data(&[object(None, CoverageRoute::DepthPass)], true);
+    mismatch(
+        known(&depth_pass, None),
+        "coverage.level_depth",
+        "None",
+        "depth pass",
+    );
+    let depth = |w, h| {
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        texture_2d(gpu, (w, h), LOD_DEPTH_FORMAT, usage, "level depth").unwrap()
+    };
+    let (half, whole_size) = (depth(16, 24), depth(32, 24));
+    mismatch(
+        known(&depth_pass, Some(&half)),
+        "coverage.level_depth",
+        "16 x 24",
+        "32 x 24",
+    );
+    known(&depth_pass, Some(&whole_size)).unwrap();
+    known(&silhouette, None).unwrap();
 
     // Upsample: geometry and target of other sizes and formats, and sigmas out of range.
     let low = LowResBuffer::new(gpu, 32, 24, RGBA8).unwrap();
@@ -638,5 +703,6 @@ fn whole<'a>(
         new_to_old: CombinePass::NO_HISTORY,
         target,
         regions: CombineRegions::Everywhere,
+        coverage: Default::default(),
     }
 }

@@ -236,16 +236,44 @@ pub fn combine_read_level_depth(
     )
 }
 
+/// Whether the older texel at texture-space `at` holds an object other than `owner` closer than
+/// clip depth `depth` (Rust twin of `combine_hidden`): there the older frame drew that object in
+/// front of `owner`'s older level, so the older level's silhouette covering the pixel does not
+/// make it visible.
+pub fn combine_hidden(
+    older: &LodImage,
+    owner: u32,
+    at: Vec2,
+    depth: f32,
+    convention: DepthConvention,
+) -> bool {
+    let texel = combine_texel(at, size_of(older));
+    in_viewport(at)
+        && id_at(older, texel) != owner
+        && depth_closer(depth_at(older, texel), depth, convention)
+}
+
+/// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
+/// silhouette covers (or passes through) the pixel center `p` (Rust twin of
+/// `combine_known_covers`).
+pub fn combine_known_covers(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
+    let o = combine_object(data, id);
+    let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
+    id != 0 && o.flags & wanted == wanted && silhouette_covers(data, o.silhouette, p) != 0
+}
+
 /// For a pixel that shows no t-instance: the older read of the first t-instance whose older
-/// level's silhouette covers the pixel center `p` (pixels), read with that t-instance's own matrix
-/// and no motion (such a pixel has none of its own); not found where none does. A center on a
-/// silhouette ([`SILHOUETTE_ON`]) is covered as last frame's picture has it.
+/// level's silhouette covers the pixel center `p` (pixels) and that no other t-instance whose
+/// silhouette covers it too hides there ([`combine_hidden`], [`combine_known_covers`]), read with that t-instance's own matrix and no motion
+/// (such a pixel has none of its own); not found where none does. A center on a silhouette
+/// ([`SILHOUETTE_ON`]) is covered as last frame's picture has it.
 pub fn combine_read_silhouettes(
     older: &LodImage,
     data: &[[u32; 4]],
     uv: Vec2,
     depth: f32,
     p: Vec2,
+    convention: DepthConvention,
 ) -> CombineRead {
     let size = size_of(older);
     let slots = silhouette_texel(data, 5).z;
@@ -265,7 +293,11 @@ pub fn combine_read_silhouettes(
             let hit = in_viewport(read_at) && id_at(older, combine_texel(read_at, size)) == g;
             covers = i32::from(hit);
         }
-        if covers == 1 {
+        let point = reproject(uv, depth, &m);
+        let front = id_at(older, combine_texel(point.truncate(), size));
+        let hidden = combine_hidden(older, g, point.truncate(), point.z, convention)
+            && combine_known_covers(data, front, p);
+        if covers == 1 && !hidden {
             return combine_read_own(older, g, uv, depth, &m, Vec2::ZERO, COMBINE_BLOCK_REACH);
         }
     }
@@ -305,10 +337,13 @@ pub fn combine_read(
             if own == SILHOUETTE_ON {
                 own = i32::from(id_at(older, combine_texel(old.truncate() + motion, size)) == id);
             }
+            let read_at = old.truncate() + motion;
+            if own == 1 && combine_hidden(older, id, read_at, old.z, convention) {
+                return found(older, combine_texel(read_at, size));
+            }
             if own == 1 {
                 return combine_read_own(older, id, uv, depth, m, motion, COMBINE_BLOCK_REACH);
             }
-            let read_at = old.truncate() + motion;
             let texel = combine_other_texel(older, id, combine_texel(read_at, size), read_at);
             return found(older, texel);
         }
@@ -344,7 +379,7 @@ pub fn combine_read(
             convention,
         );
     }
-    let r = combine_read_silhouettes(older, data, uv, depth, p);
+    let r = combine_read_silhouettes(older, data, uv, depth, p, convention);
     if r.found {
         return r;
     }

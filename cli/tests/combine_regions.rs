@@ -2,7 +2,7 @@
 //! pixel of such an object outside them shows the newer buffer alone. The rectangles must take
 //! the whole reach of an animated object, not its rest pose.
 
-use lodkit_cli::demo::render::Technique;
+use lodkit_cli::demo::render::{Coverage, Technique};
 use lodkit_cli::demo::scene::DemoScene;
 
 #[test]
@@ -24,12 +24,16 @@ fn the_combine_rectangles_hold_every_pixel_of_the_swaying_tree() {
         o.sway = 1.0;
     }
     let renderer = SceneRenderer::new(gpu, &scene, (320, 180), 24).unwrap();
-    let technique = Technique::FrameSequential(
-        VisibilityPattern::BlueNoise,
-        Schedule::Complementary,
-        VisibilitySpace::Screen,
-    );
-    for moving in [false, true] {
+    for (coverage, moving) in [Coverage::Estimated, Coverage::Silhouettes]
+        .into_iter()
+        .flat_map(|c| [(c, false), (c, true)])
+    {
+        let technique = Technique::FrameSequential(
+            VisibilityPattern::BlueNoise,
+            Schedule::Complementary,
+            VisibilitySpace::Screen,
+            coverage,
+        );
         let spec = RunSpec {
             technique,
             moving,

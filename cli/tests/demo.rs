@@ -329,6 +329,23 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
         if let Some(f) = fade.fragments_vs_hard {
             assert!(f > 1.05, "drawing both LODs must shade more: {f}");
         }
+        // With a still camera the combine that knows the levels' silhouettes reverses no pixel
+        // where the one that estimates them reverses none: where another object hides a level
+        // that its silhouette says covers the pixel, it shows that object, as last frame did
+        // (`combine_hidden`). Without that test, 7,830 pixel reversals in `simple` at 320x180.
+        for (estimated, known) in [
+            ("frame-seq-blue-noise", "frame-seq-silhouettes"),
+            ("frame-seq-complementary", "frame-seq-compl-silhouettes"),
+        ] {
+            if row(estimated).reversals_static == 0 {
+                assert_eq!(
+                    row(known).reversals_static,
+                    0,
+                    "{known} in {}: a still camera reverses pixels",
+                    scene.name
+                );
+            }
+        }
         // Single-frame techniques draw the frame's own geometry: no silhouette error.
         assert_eq!(hard.silhouette_error, 0.0, "hard switch in {}", scene.name);
         for name in ["dither-bayer", "dither-blue-noise", "unpopping"] {
@@ -350,6 +367,8 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             "frame-seq-blue-noise",
             "frame-seq-complementary",
             "frame-seq-object-space",
+            "frame-seq-silhouettes",
+            "frame-seq-compl-silhouettes",
         ] {
             let r = row(name);
             // The combine follows the object motion, and where an animated object's LODs moved
@@ -400,8 +419,14 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             if name != "frame-seq-object-space" {
                 // With the screen anchor also under a moving camera (0.82-0.90x); in `chain`,
                 // whose small far objects change mostly in colour (their levels differ by a
-                // pixel at most), the screen-anchored schedules measured 0.96-1.02x: 5 % above.
-                let most = if scene.name == "chain" { 1.05 } else { 1.0 };
+                // pixel at most), the screen-anchored schedules measured 0.96-1.02x: 5 % above;
+                // with the levels' silhouettes 1.04-1.06x there (a far object's silhouette is a
+                // few pixels, each one a large share of its change): 4 % above.
+                let most = match (scene.name.as_str(), name.ends_with("silhouettes")) {
+                    ("chain", false) => 1.05,
+                    ("chain", true) => 1.10,
+                    _ => 1.0,
+                };
                 assert!(
                     r.pop_moving < most * unpopping.pop_moving,
                     "{name} in {}: moving pop {} against unpopping's {}",

@@ -10,7 +10,8 @@
 mod combine_pass;
 
 pub use combine_pass::{
-    CombineFrame, CombineParams, CombinePass, CombinePassDescriptor, CombineRegions,
+    CombineCoverage, CombineFrame, CombineParams, CombinePass, CombinePassDescriptor,
+    CombineRegions,
 };
 
 use super::checks::target_extent;

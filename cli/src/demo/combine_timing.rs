@@ -180,6 +180,7 @@ pub fn combine_vs_copy(
             new_to_old: m,
             target: &target_view,
             regions: CombineRegions::Everywhere,
+            coverage: Default::default(),
         };
         combine.record(gpu, encoder, &frame).map(drop)
     };

@@ -3,30 +3,26 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+mod sequential;
+
 use super::impostor::bake;
 use super::scene::DemoScene;
-use lodkit::combine::{
-    DepthConvention, PixelSource, ScreenRect, combine_images, displaced_bounds, merge_rects,
-    screen_rect,
-};
-use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
+use lodkit::combine::{PixelSource, ScreenRect, displaced_bounds, screen_rect};
 use lodkit::gpu::counters::FragmentCounter;
-use lodkit::gpu::frame_sequential::{
-    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
-};
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
+use lodkit::gpu::frame_sequential::{CombinePass, CombinePassDescriptor, LodBuffers};
+use lodkit::gpu::lod_buffer_scene::LodBufferRenderer;
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::gpu::transition_scene::{SingleFrameTechnique, transition_items};
 use lodkit::gpu::{GpuContext, GpuError};
-use lodkit::reproject::new_to_old_matrix;
 use lodkit::screen_door::DitherPattern;
+use lodkit::silhouette::Surface;
 use lodkit::unpopping::LodRenderState;
-use lodkit::visibility::{VisibilityPattern, VisibilitySpace, visibility_texture};
+use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 use super::technique::OBJECT;
-pub use super::technique::Technique;
+pub use super::technique::{Coverage, Technique};
 
 /// What the scene's non-transitioning objects and the clear color look like.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,6 +75,9 @@ pub struct SceneRenderer<'a> {
     bounds: Vec<Option<(Vec3, Vec3)>>,
     /// Alpha mask rect of both LODs of each object (zero: no alpha test).
     alpha_rects: Vec<[Vec4; 2]>,
+    /// Surface of both LODs of each object, for their silhouettes; `None` for a level whose
+    /// coverage is not its silhouette (alpha-masked, or not a closed mesh).
+    surfaces: Vec<[Option<Surface>; 2]>,
     single: [MeshRenderer; 2],
     target: RenderTarget,
     /// White noise on the screen, blue noise on the screen, blue noise on the object.
@@ -170,10 +169,26 @@ impl<'a> SceneRenderer<'a> {
                 r.set_alpha_mask(gpu, &mask)?;
             }
         }
-        let alpha_rects = scene
+        let alpha_rects: Vec<[Vec4; 2]> = scene
             .objects
             .iter()
             .map(|o| [o.fine.alpha_rect(), o.coarse.alpha_rect()])
+            .collect();
+        let surfaces = scene
+            .objects
+            .iter()
+            .zip(&alpha_rects)
+            .map(|(o, rects)| {
+                let surface = |shape: super::scene::Shape, rect: Vec4| {
+                    let mesh = shape.mesh();
+                    let points: Vec<[f32; 3]> =
+                        mesh.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect();
+                    (rect == Vec4::ZERO)
+                        .then(|| Surface::new(&points, Some(&mesh.indices)).ok())
+                        .flatten()
+                };
+                [surface(o.fine, rects[0]), surface(o.coarse, rects[1])]
+            })
             .collect();
         Ok(Self {
             scene,
@@ -182,6 +197,7 @@ impl<'a> SceneRenderer<'a> {
             meshes,
             bounds,
             alpha_rects,
+            surfaces,
             single,
             target: RenderTarget::new(gpu, size.0, size.1)?,
             lod_buffer,
@@ -305,8 +321,8 @@ impl<'a> SceneRenderer<'a> {
                 }
                 Ok(())
             }
-            Technique::FrameSequential(p, schedule, space) => {
-                let variant = (p, schedule, space);
+            Technique::FrameSequential(p, schedule, space, coverage) => {
+                let variant = (p, schedule, space, coverage);
                 self.run_frame_sequential(gpu, variant, spec, wanted, on_frame, on_sources)
             }
         }
@@ -385,156 +401,6 @@ impl<'a> SceneRenderer<'a> {
             triangles,
             fragments,
         })
-    }
-
-    fn run_frame_sequential(
-        &self,
-        gpu: &GpuContext,
-        (pattern, schedule, space): (VisibilityPattern, Schedule, VisibilitySpace),
-        spec: RunSpec,
-        wanted: &dyn Fn(usize) -> bool,
-        on_frame: &mut dyn FnMut(usize, Frame),
-        mut on_sources: Option<&mut dyn FnMut(Vec<PixelSource>)>,
-    ) -> Result<(), GpuError> {
-        let renderer = match (pattern, space) {
-            (_, OBJECT) => &self.lod_buffer[2],
-            (VisibilityPattern::BlueNoise, _) => &self.lod_buffer[1],
-            _ => &self.lod_buffer[0],
-        };
-        let mut scheduler = TransitionScheduler::with_schedule(schedule);
-        let keys: Vec<_> = self
-            .scene
-            .objects
-            .iter()
-            .map(|o| match o.transition && !spec.transition {
-                true => scheduler.insert(u8::from(spec.hold_level > 0)),
-                false => scheduler.insert(0),
-            })
-            .collect();
-        let clear = match spec.background {
-            Background::Scene => CLEAR,
-            Background::Flat(c) => c,
-        };
-        let mut previous: Option<Mat4> = None;
-        let middle = LEAD_FRAMES + self.frames / 2;
-        for frame in 0..self.run_length() {
-            if frame > 0 {
-                scheduler.advance(1.0 / 30.0);
-            }
-            // Progress is set from the frame number, exactly as the single-frame techniques
-            // get it (a time drive sums dt and could end a frame late).
-            for (o, key) in self.scene.objects.iter().zip(&keys) {
-                if !(o.transition && spec.transition) {
-                    continue;
-                }
-                // A fresh scheduler has ids to spare and the keys are live: these cannot fail.
-                if frame == LEAD_FRAMES {
-                    let _ = scheduler.begin_transition(*key, 1, Drive::Progress);
-                }
-                if frame >= LEAD_FRAMES {
-                    let _ = scheduler.set_progress(*key, self.progress(frame));
-                    let _ = scheduler.set_next_progress(*key, self.progress(frame + 1));
-                }
-            }
-            let (view, proj) = self.camera(frame, spec.moving);
-            let items: Vec<LodDrawItem> = keys
-                .iter()
-                .enumerate()
-                .filter_map(|(i, key)| {
-                    let d = scheduler.draw(*key).ok()?;
-                    let lod = usize::from(d.lod.min(1));
-                    let mut item = LodDrawItem::from_draw(
-                        &self.meshes[i][lod],
-                        self.scene.model(i),
-                        self.object_color(i, lod, spec.background),
-                        &d,
-                    );
-                    item.sway = self.sway(i, frame);
-                    item.prev_sway_phase = self.sway(i, frame.saturating_sub(1))[1];
-                    item.alpha_rect = self.alpha_rects[i][lod];
-                    Some(item)
-                })
-                .collect();
-            let index = scheduler.buffer_index();
-            let lod_view = LodView {
-                view_proj: proj * view,
-                prev_view_proj: proj * previous.unwrap_or(view),
-            };
-            let (triangles, fragments) = renderer.render(
-                gpu,
-                &self.buffers,
-                &LodBufferFrame {
-                    index,
-                    view: lod_view,
-                    items: &items,
-                    clear: color(clear),
-                    counter: Some(&self.counter),
-                },
-            )?;
-            let m = previous.map_or(CombinePass::NO_HISTORY, |old| {
-                new_to_old_matrix(&view, &proj, &old, &proj)
-            });
-            // The combine runs over the screen rectangles of the t-instances, where this frame's
-            // and the previous frame's views see them; the rest of the frame is a copy.
-            let views = [proj * view, proj * previous.unwrap_or(view)];
-            let regions: Vec<ScreenRect> = keys
-                .iter()
-                .enumerate()
-                .filter(|(_, key)| scheduler.in_transition(**key))
-                .filter_map(|(i, _)| {
-                    let bounds = self.animated_bounds(i)?;
-                    screen_rect(bounds, self.scene.model(i), &views, self.size, 2)
-                })
-                .collect();
-            // Every pixel of either buffer that holds an object in transition must lie inside
-            // them: outside, the output is the newer buffer alone.
-            let t_ids: Vec<u32> = keys
-                .iter()
-                .filter(|key| scheduler.in_transition(**key))
-                .filter_map(|key| scheduler.draw(*key).ok().map(|d| d.id))
-                .collect();
-            let merged = merge_rects(&regions);
-            let newer = read_lod_image(gpu, &self.buffers, index)?;
-            let older = read_lod_image(gpu, &self.buffers, 1 - index)?;
-            for image in [&newer, &older] {
-                let outside = image.ids.iter().enumerate().filter(|&(p, id)| {
-                    let (x, y) = (p as u32 % image.width, p as u32 / image.width);
-                    *id != 0 && t_ids.contains(id) && !merged.iter().any(|r| r.contains(x, y))
-                });
-                let count = outside.count() as u64;
-                self.outside_rects.set(self.outside_rects.get() + count);
-            }
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let target = self.combined.create_view(&Default::default());
-            let recording = CombineFrame {
-                buffers: &self.buffers,
-                newer: index,
-                new_to_old: m,
-                target: &target,
-                regions: CombineRegions::Only(&regions),
-            };
-            let combined = self.combine.record(gpu, &mut encoder, &recording)?;
-            gpu.queue.submit([encoder.finish()]);
-            if let Some(f) = on_sources.as_mut().filter(|_| frame == middle) {
-                let sources = combine_images(&newer, &older, &m, DepthConvention::Standard);
-                f(sources.iter().map(|p| p.source).collect());
-            }
-            if wanted(frame) {
-                // The combine pass shades each pixel of its rectangles once more.
-                let pixels = read_texture_rgba8(gpu, &self.combined)?;
-                let fragments = fragments + combined;
-                on_frame(
-                    frame,
-                    Frame {
-                        pixels,
-                        triangles,
-                        fragments,
-                    },
-                );
-            }
-            previous = Some(view);
-        }
-        Ok(())
     }
 
     /// Masks of the transitioning objects drawn opaque at the fine and at the coarse LOD (the

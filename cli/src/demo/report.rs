@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::plots::{Chart, Series, line_chart};
 use super::table::{Table, esc, img, pct, reads, times};
+use super::technique::Technique;
 use super::upsampling::{
     CONTROLLER_SEEDS, METHODS, ROUTES, SHADING_WORK, SIGMA_N, SIGMA_Z, TARGET_MS,
 };
@@ -476,7 +477,10 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
                 &format!("see-through/{scene}-{name}.png"),
                 "middle frame: interior of the transitioning objects (gray) and where the background shows through (red)",
             ));
-            if name.starts_with("frame-seq") {
+            let sourced = Technique::ALL
+                .iter()
+                .any(|t| t.name() == name && t.maps_sources());
+            if sourced {
                 h.push_str(&img(
                     &format!("sources/{scene}-{name}.png"),
                     "combine rule per pixel, middle frame, moving camera: gray newer, orange older, magenta average of both LODs, cyan outside the older view",

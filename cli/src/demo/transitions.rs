@@ -173,7 +173,7 @@ fn transition_run(
     let mut failed = None;
     let mut sources = None;
     let mut on_sources = |s| sources = Some(s);
-    let frame_sequential = matches!(technique, Technique::FrameSequential(..));
+    let sourced = technique.maps_sources();
     renderer.run(
         gpu,
         spec,
@@ -216,7 +216,7 @@ fn transition_run(
             }
             previous = Some(frame.pixels);
         },
-        (frame_sequential && moving).then_some(&mut on_sources as &mut dyn FnMut(Vec<PixelSource>)),
+        (sourced && moving).then_some(&mut on_sources as &mut dyn FnMut(Vec<PixelSource>)),
     )?;
     run.sources = sources;
     run.flicker = [meter.finish(), coarse_meter.finish()];

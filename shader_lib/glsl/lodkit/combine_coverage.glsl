@@ -23,6 +23,10 @@
 //   lodkit_combine_far_depth() -> float   the far clip depth (an older-level depth pass's clear)
 //   lodkit_combine_read_estimated(uv, depth, base, old, new_to_old, motion) -> lodkit_CombineRead
 //   lodkit_combine_read_level_depth(level, id, uv, depth, old, motion) -> lodkit_CombineRead
+//   lodkit_combine_hidden(owner, at, depth) -> bool   whether the older texel at `at` holds
+//       another object closer than clip depth `depth`
+//   lodkit_combine_known_covers(id, p) -> bool   whether id's older silhouette is known and
+//       covers the pixel center p
 //   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   the routes' reads
 //   lodkit_combine_read(newer, pixel, base, old, m) -> lodkit_CombineRead   by the route of what
 //       the pixel shows
@@ -181,8 +185,26 @@ lodkit_CombineRead lodkit_combine_read_level_depth(float level, uint id, vec2 uv
     return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
 }
 
+/// Whether the older texel at texture-space `at` holds an object other than `owner` closer than
+/// clip depth `depth`: there the older frame drew that object in front of `owner`'s older level.
+bool lodkit_combine_hidden(uint owner, vec2 at, float depth) {
+    uvec2 texel = lodkit_combine_texel(at, lodkit_combine_fetch_size());
+    uint held = lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel));
+    return lodkit_in_viewport(at) && held != owner && lodkit_depth_closer(lodkit_combine_fetch_depth(texel), depth);
+}
+
+/// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
+/// silhouette covers (or passes through) the pixel center `p`.
+bool lodkit_combine_known_covers(uint id, vec2 p) {
+    lodkit_CombineObject o = lodkit_combine_object(id);
+    uint wanted = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_SILHOUETTE;
+    return id != 0u && (o.flags & wanted) == wanted && lodkit_silhouette_covers(o.silhouette, p) != 0;
+}
+
 /// For a pixel showing no t-instance: the read of the first t-instance whose older silhouette
-/// covers the pixel center `p` (on it: as last frame's picture has it); none: not found.
+/// covers the pixel center `p` (on it: as last frame's picture has it) and is not hidden there
+/// by another t-instance whose silhouette covers it too (lodkit_combine_hidden,
+/// lodkit_combine_known_covers); none: not found.
 lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p) {
     uvec2 size = lodkit_combine_fetch_size();
     uint slots = lodkit_silhouette_texel(5u).z;
@@ -201,7 +223,10 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
             bool hit = lodkit_in_viewport(at) && lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(at, size))) == g;
             covers = hit ? 1 : 0;
         }
-        if (covers == 1) {
+        vec3 point = lodkit_reproject(uv, depth, m);
+        uint front = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(point.xy, size)));
+        bool hidden = lodkit_combine_hidden(g, point.xy, point.z) && lodkit_combine_known_covers(front, p);
+        if (covers == 1 && !hidden) {
             return lodkit_combine_read_own(g, uv, depth, m, vec2(0.0), LODKIT_COMBINE_BLOCK_REACH);
         }
     }
@@ -224,10 +249,14 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
             if (own == LODKIT_SILHOUETTE_ON) {
                 own = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(old.xy + newer.motion, size))) == id ? 1 : 0;
             }
+            vec2 at = old.xy + newer.motion;
+            if (own == 1 && lodkit_combine_hidden(id, at, old.z)) {
+                uvec2 hidden = lodkit_combine_texel(at, size);
+                return lodkit_CombineRead(hidden, lodkit_combine_fetch_color(hidden), true);
+            }
             if (own == 1) {
                 return lodkit_combine_read_own(id, uv, newer.depth, m, newer.motion, LODKIT_COMBINE_BLOCK_REACH);
             }
-            vec2 at = old.xy + newer.motion;
             uvec2 texel = lodkit_combine_other_texel(id, lodkit_combine_texel(at, size), at);
             return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
         }

@@ -25,6 +25,10 @@
 //       new_to_old, motion) -> CombineRead   a pixel showing no known t-instance, estimated
 //   combine_read_level_depth(older_color, older_id, older_depth, data, level, id, uv, depth, old,
 //       motion) -> CombineRead   by the older-level depth pass
+//   combine_hidden(older_id, older_depth, owner, at, depth) -> bool   whether the older texel at
+//       `at` holds another object closer than clip depth `depth` (owner's older level hidden)
+//   combine_known_covers(data, id, p) -> bool   whether id's older silhouette is known and covers
+//       the pixel center p
 //   combine_read_silhouettes(older_color, older_id, older_depth, data, uv, depth, p)
 //       -> CombineRead   a pixel showing no t-instance, covered by a level's silhouette
 //   combine_read(older_color, older_id, older_depth, data, newer, pixel, base, old, m)
@@ -176,8 +180,26 @@ fn combine_read_level_depth(older_color: texture_2d<f32>, older_id: texture_2d<u
     return CombineRead(texel, textureLoad(older_color, texel, 0), true);
 }
 
+/// Whether the older texel at texture-space `at` holds an object other than `owner` closer than
+/// clip depth `depth`: there the older frame drew that object in front of `owner`'s older level.
+fn combine_hidden(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, at: vec2<f32>, depth: f32) -> bool {
+    let texel = combine_texel(at, textureDimensions(older_id, 0));
+    let held = lod_buffer_id(textureLoad(older_id, texel, 0).x);
+    return in_viewport(at) && held != owner && depth_closer(textureLoad(older_depth, texel, 0).x, depth);
+}
+
+/// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
+/// silhouette covers (or passes through) the pixel center `p`.
+fn combine_known_covers(data: texture_2d<u32>, id: u32, p: vec2<f32>) -> bool {
+    let o = combine_object(data, id);
+    let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
+    return id != 0u && (o.flags & wanted) == wanted && silhouette_covers(data, o.silhouette, p) != 0;
+}
+
 /// For a pixel showing no t-instance: the read of the first t-instance whose older silhouette
-/// covers the pixel center `p` (on it: as last frame's picture has it); none: not found.
+/// covers the pixel center `p` (on it: as last frame's picture has it) and is not hidden there
+/// by another t-instance whose silhouette covers it too (combine_hidden, combine_known_covers);
+/// none: not found.
 fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, uv: vec2<f32>, depth: f32, p: vec2<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     let slots = silhouette_texel(data, 5u).z;
@@ -196,7 +218,10 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
             let hit = in_viewport(at) && lod_buffer_id(textureLoad(older_id, combine_texel(at, size), 0).x) == g;
             covers = select(0, 1, hit);
         }
-        if (covers == 1) {
+        let point = reproject(uv, depth, m);
+        let front = lod_buffer_id(textureLoad(older_id, combine_texel(point.xy, size), 0).x);
+        let hidden = combine_hidden(older_id, older_depth, g, point.xy, point.z) && combine_known_covers(data, front, p);
+        if (covers == 1 && !hidden) {
             return combine_read_own(older_color, older_id, older_depth, g, uv, depth, m, vec2<f32>(0.0), COMBINE_BLOCK_REACH);
         }
     }
@@ -217,10 +242,14 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
             if (own == SILHOUETTE_ON) {
                 own = select(0, 1, lod_buffer_id(textureLoad(older_id, combine_texel(old.xy + newer.motion, size), 0).x) == id);
             }
+            let at = old.xy + newer.motion;
+            if (own == 1 && combine_hidden(older_id, older_depth, id, at, old.z)) {
+                let texel = combine_texel(at, size);
+                return CombineRead(texel, textureLoad(older_color, texel, 0), true);
+            }
             if (own == 1) {
                 return combine_read_own(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion, COMBINE_BLOCK_REACH);
             }
-            let at = old.xy + newer.motion;
             let texel = combine_other_texel(older_id, id, combine_texel(at, size), at);
             return CombineRead(texel, textureLoad(older_color, texel, 0), true);
         }

@@ -2,13 +2,17 @@
 //! and recorded with a [`CombineFrame`].
 
 use glam::Mat4;
+use wgpu::util::DeviceExt;
 
 use super::LodBuffers;
 use crate::combine::{DepthConvention, ScreenRect, merge_rects};
+use crate::combine_coverage::{
+    COMBINE_ANCHORED, COMBINE_LEVEL_DEPTH, COMBINE_RECORD, CombineData, combine_object,
+};
 use crate::gpu::checks::{check_color_format, has_usage, texture_matches};
 use crate::gpu::resources::{
     RecordedUniform, begin_color_pass, begin_load_pass, fullscreen_pipeline_with, one_group_layout,
-    texture_2d, texture_entry, textures_and_uniform, uniform_entry,
+    texture_2d, texture_entry, uniform_entry,
 };
 use crate::gpu::{GpuContext, GpuError};
 use crate::lod_buffer::MOTION_FORMAT;
@@ -57,6 +61,31 @@ pub enum CombineRegions<'a> {
     Only(&'a [ScreenRect]),
 }
 
+/// What a recording knows of where the older levels (those the older buffer holds) cover the
+/// screen.
+#[derive(Clone, Copy, Debug, Default)]
+pub enum CombineCoverage<'a> {
+    /// Nothing: `lodkit::combine::combine_at_moved` (or `combine_at`) estimates it from last
+    /// frame's picture. Where a level's edge moved by a fraction of a texel, the pixel shows the
+    /// other level or the background every other frame.
+    #[default]
+    Estimated,
+    /// `lodkit::combine_coverage::combine_pixel` with this frame's [`CombineData`]: each
+    /// t-instance by its route (its older level's silhouette, the older-level depth pass, the
+    /// estimate). Build the data with the silhouettes of the levels the older buffer holds, seen
+    /// by this frame's camera ([`Surface::silhouette`](crate::silhouette::Surface::silhouette)):
+    /// the route docs/frame-sequential.md recommends.
+    Known {
+        /// The frame's data ([`CombineData::new`]) with its `new_to_old` equal to the
+        /// recording's. Objects with `older_tau` are refused: this pass reads no visibility
+        /// pattern, so the older buffer's display flags stand.
+        data: &'a CombineData,
+        /// The older-level depth pass (`LOD_DEPTH_FORMAT`, the buffers' size, cleared to the far
+        /// depth), required when the data's `level_depth` is set.
+        level_depth: Option<&'a wgpu::Texture>,
+    },
+}
+
 /// One recording of a [`CombinePass`]: what it reads, where it writes, its parameters.
 #[derive(Clone, Copy, Debug)]
 pub struct CombineFrame<'a> {
@@ -73,6 +102,8 @@ pub struct CombineFrame<'a> {
     pub target: &'a wgpu::TextureView,
     /// Where to combine (default everywhere).
     pub regions: CombineRegions<'a>,
+    /// What is known of the older levels' coverage (default [`CombineCoverage::Estimated`]).
+    pub coverage: CombineCoverage<'a>,
 }
 
 /// The combine pass (`passes/combine.wgsl`) as a ready object: build once per target format,
@@ -86,10 +117,15 @@ pub struct CombinePass {
     pipeline: wgpu::RenderPipeline,
     /// The pipeline for buffers without object motion (`LODKIT_COMBINE_STILL`).
     still_pipeline: wgpu::RenderPipeline,
+    /// The pipeline for [`CombineCoverage::Known`] (`LODKIT_COMBINE_KNOWN`).
+    known_pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     params: RecordedUniform,
     /// 1x1, zero: bound at the motion binding for buffers without a motion target.
     still: wgpu::Texture,
+    /// 1x1: bound at the data and level depth bindings when they are not read.
+    unused_data: wgpu::Texture,
+    unused_depth: wgpu::Texture,
     target_format: wgpu::TextureFormat,
 }
 
@@ -112,12 +148,11 @@ impl CombinePass {
             let mut entries = Self::buffer_layout_entries(0);
             entries.push(Self::motion_layout_entry(6));
             entries.push(uniform_entry(7, false));
+            entries.push(texture_entry(8, wgpu::TextureSampleType::Uint));
+            entries.push(Self::motion_layout_entry(9));
             let (group, layout) = one_group_layout(gpu, &entries, "lodkit combine");
-            let pipeline = |still: bool| {
-                let defs: Vec<&str> = reverse
-                    .into_iter()
-                    .chain(still.then_some("LODKIT_COMBINE_STILL"))
-                    .collect();
+            let pipeline = |def: Option<&'static str>| {
+                let defs: Vec<&str> = reverse.into_iter().chain(def).collect();
                 let module = gpu.pass_module("combine", &defs)?;
                 fullscreen_pipeline_with(
                     gpu,
@@ -128,8 +163,9 @@ impl CombinePass {
                 )
             };
             Ok(Self {
-                pipeline: pipeline(false)?,
-                still_pipeline: pipeline(true)?,
+                pipeline: pipeline(None)?,
+                still_pipeline: pipeline(Some("LODKIT_COMBINE_STILL"))?,
+                known_pipeline: pipeline(Some("LODKIT_COMBINE_KNOWN"))?,
                 layout: group,
                 params: RecordedUniform::new(gpu, size, "combine params")?,
                 still: texture_2d(
@@ -138,6 +174,20 @@ impl CombinePass {
                     MOTION_FORMAT,
                     wgpu::TextureUsages::TEXTURE_BINDING,
                     "combine: no object motion",
+                )?,
+                unused_data: texture_2d(
+                    gpu,
+                    (1, 1),
+                    wgpu::TextureFormat::Rgba32Uint,
+                    wgpu::TextureUsages::TEXTURE_BINDING,
+                    "combine: no data",
+                )?,
+                unused_depth: texture_2d(
+                    gpu,
+                    (1, 1),
+                    super::LOD_DEPTH_FORMAT,
+                    wgpu::TextureUsages::TEXTURE_BINDING,
+                    "combine: no older-level depth pass",
                 )?,
                 target_format,
             })
@@ -191,6 +241,7 @@ impl CombinePass {
             self.target_format,
             "the pass (built for its format, drawing the LOD buffers' size)",
         )?;
+        self.check_coverage(frame)?;
         let (w, h) = buffers.size();
         let CombineRegions::Only(regions) = frame.regions else {
             self.draw(gpu, encoder, frame, None)?;
@@ -240,6 +291,61 @@ impl CombinePass {
         Ok(merged.iter().map(ScreenRect::area).sum())
     }
 
+    /// Refuses [`CombineCoverage::Known`] data this pass cannot honour: texels that do not fill
+    /// its size, objects displayed at an `older_tau` (the pass reads no visibility pattern), a
+    /// depth pass the data reads but the frame does not give, or one of another size.
+    fn check_coverage(&self, frame: &CombineFrame) -> Result<(), GpuError> {
+        const CALL: &str = "CombinePass::record";
+        let CombineCoverage::Known { data, level_depth } = frame.coverage else {
+            return Ok(());
+        };
+        let texels = u64::from(data.width) * u64::from(data.height);
+        if data.width == 0 || texels != data.texels.len() as u64 {
+            return Err(GpuError::Mismatch {
+                call: CALL,
+                parameter: "coverage.data",
+                found: format!("{} texels", data.texels.len()),
+                expected: format!(
+                    "{} x {} texels, non-empty, as CombineData::new lays them out",
+                    data.width, data.height
+                ),
+            });
+        }
+        let records = combine_object(&data.texels, 0);
+        let slots = data.texels.get(5).map_or(0, |t| t[2]);
+        if let Some(k) = (1..slots).find(|&k| {
+            let flags = data.texels.get((k * COMBINE_RECORD + 5) as usize);
+            flags.is_some_and(|t| t[0] & COMBINE_ANCHORED != 0)
+        }) {
+            return Err(GpuError::Mismatch {
+                call: CALL,
+                parameter: "coverage.data",
+                found: format!("id {k} displayed at an older_tau"),
+                expected: "no older_tau: the pass reads no visibility pattern, so the older \
+                           buffer's display flags are used"
+                    .into(),
+            });
+        }
+        let reads_depth = records.flags & COMBINE_LEVEL_DEPTH != 0;
+        match (reads_depth, level_depth) {
+            (true, None) => Err(GpuError::Mismatch {
+                call: CALL,
+                parameter: "coverage.level_depth",
+                found: "None".into(),
+                expected: "the older-level depth pass: the data's level_depth is set".into(),
+            }),
+            (_, Some(depth)) => texture_matches(
+                CALL,
+                "coverage.level_depth",
+                depth,
+                frame.buffers.size(),
+                super::LOD_DEPTH_FORMAT,
+                "the older-level depth pass (LOD_DEPTH_FORMAT, the LOD buffers' size)",
+            ),
+            (false, None) => Ok(()),
+        }
+    }
+
     /// Draws the combine over the whole target, or inside `rects` over what is there (the
     /// target already checked).
     fn draw(
@@ -255,6 +361,32 @@ impl CombinePass {
                 new_to_old: frame.new_to_old.to_cols_array_2d(),
             };
             self.params.write(encoder, &params)?;
+            let known = match frame.coverage {
+                CombineCoverage::Known { data, level_depth } => Some((data, level_depth)),
+                CombineCoverage::Estimated => None,
+            };
+            let data = known.map(|(data, _)| {
+                gpu.device.create_texture_with_data(
+                    &gpu.queue,
+                    &wgpu::TextureDescriptor {
+                        label: Some("lodkit combine data"),
+                        size: wgpu::Extent3d {
+                            width: data.width,
+                            height: data.height,
+                            depth_or_array_layers: 1,
+                        },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: wgpu::TextureFormat::Rgba32Uint,
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    },
+                    wgpu::util::TextureDataOrder::LayerMajor,
+                    bytemuck::cast_slice(&data.texels),
+                )
+            });
+            let level_depth = known.and_then(|(_, depth)| depth);
             let textures = [
                 buffers.color(newer),
                 buffers.id(newer),
@@ -263,22 +395,39 @@ impl CombinePass {
                 buffers.id(newer + 1),
                 buffers.depth(newer + 1),
                 buffers.motion().unwrap_or(&self.still),
+                data.as_ref().unwrap_or(&self.unused_data),
+                level_depth.unwrap_or(&self.unused_depth),
             ];
-            let bind_group = textures_and_uniform(
-                gpu,
-                &self.layout,
-                &textures,
-                Some(self.params.buffer()),
-                "lodkit combine",
-            )?;
+            let views: Vec<wgpu::TextureView> = textures
+                .iter()
+                .map(|t| t.create_view(&Default::default()))
+                .collect();
+            let entries: Vec<wgpu::BindGroupEntry> = views
+                .iter()
+                .zip([0, 1, 2, 3, 4, 5, 6, 8, 9])
+                .map(|(view, binding)| wgpu::BindGroupEntry {
+                    binding,
+                    resource: wgpu::BindingResource::TextureView(view),
+                })
+                .chain(std::iter::once(wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: self.params.buffer().as_entire_binding(),
+                }))
+                .collect();
+            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("lodkit combine"),
+                layout: &self.layout,
+                entries: &entries,
+            });
             let label = "lodkit combine";
             let mut pass = match rects {
                 None => begin_color_pass(encoder, frame.target, wgpu::Color::BLACK, label),
                 Some(_) => begin_load_pass(encoder, frame.target, label),
             };
-            pass.set_pipeline(match buffers.motion() {
-                Some(_) => &self.pipeline,
-                None => &self.still_pipeline,
+            pass.set_pipeline(match (known, buffers.motion()) {
+                (Some(_), _) => &self.known_pipeline,
+                (None, Some(_)) => &self.pipeline,
+                (None, None) => &self.still_pipeline,
             });
             pass.set_bind_group(0, &bind_group, &[]);
             match rects {
