@@ -300,7 +300,7 @@ impl CombinePass {
             return Ok(());
         };
         let texels = u64::from(data.width) * u64::from(data.height);
-        if data.width == 0 || texels != data.texels.len() as u64 {
+        if data.width == 0 || data.height == 0 || texels != data.texels.len() as u64 {
             return Err(GpuError::Mismatch {
                 call: CALL,
                 parameter: "coverage.data",
