@@ -37,7 +37,6 @@ use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodGroup, LodSettings, LodState, TransitionMode};
-use lodkit::silhouette::Surface;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 const SIZE: (u32, u32) = (240, 135);
@@ -93,10 +92,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     // Each level's surface, for its silhouette (both are closed meshes).
     let surfaces = meshes
         .iter()
-        .map(|m| {
-            let points: Vec<[f32; 3]> = m.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect();
-            Surface::new(&points, Some(&m.indices))
-        })
+        .map(Mesh::surface)
         .collect::<Result<Vec<_>, _>>()?;
 
     // Five instances in a row going away from the camera; level 1 beyond a view-normalized

@@ -20,6 +20,22 @@ fn head_on() -> Mat4 {
 }
 
 /// An opaque white draw of `card` with the alpha mask over `rect`.
+/// Draws `item` alone into `target` through `renderer`, black clear.
+fn draw_one(
+    gpu: &lodkit::gpu::GpuContext,
+    renderer: &MeshRenderer,
+    target: &RenderTarget,
+    view_proj: Mat4,
+    item: DrawItem,
+) {
+    let frame = MeshFrame {
+        view_proj,
+        items: &[item],
+        ..Default::default()
+    };
+    renderer.render(gpu, target, &frame).unwrap();
+}
+
 fn card_draw(card: &GpuMesh, rect: Vec4) -> DrawItem<'_> {
     DrawItem {
         mesh: card,
@@ -65,17 +81,7 @@ fn an_alpha_tested_card_covers_what_its_mask_covers_in_both_passes() {
     single.set_alpha_mask(gpu, &mask).unwrap();
     let target = RenderTarget::new(gpu, W, W).unwrap();
     let item = card_draw(&card, rect);
-    single
-        .render(
-            gpu,
-            &target,
-            &MeshFrame {
-                view_proj,
-                items: &[item],
-                ..Default::default()
-            },
-        )
-        .unwrap();
+    draw_one(gpu, &single, &target, view_proj, item);
     let pixels = read_texture_rgba8(gpu, &target.color).unwrap();
     let single_got: Vec<bool> = pixels.chunks(4).map(|p| p[0] > 8).collect();
 
@@ -169,17 +175,7 @@ fn a_bad_alpha_mask_is_refused_and_the_old_one_kept() {
     let card = GpuMesh::new(gpu, &Mesh::card(Vec2::splat(-1.0), Vec2::ONE)).unwrap();
     let item = card_draw(&card, alpha_mask_rect(Vec2::splat(-1.0), Vec2::ONE));
     let view_proj = head_on();
-    single
-        .render(
-            gpu,
-            &target,
-            &MeshFrame {
-                view_proj,
-                items: &[item],
-                ..Default::default()
-            },
-        )
-        .unwrap();
+    draw_one(gpu, &single, &target, view_proj, item);
     let lit = read_texture_rgba8(gpu, &target.color).unwrap();
     assert!(
         lit.chunks(4).all(|p| p[0] > 8),

@@ -16,6 +16,7 @@ use super::resources::{
 use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
 use super::{GpuContext, GpuError};
 use crate::alpha_mask::AlphaMask;
+use crate::silhouette::{SilhouetteError, Surface};
 use crate::unpopping::LodRenderState;
 
 /// Depth format of [`RenderTarget`].
@@ -114,6 +115,13 @@ impl Mesh {
         let mut points = self.vertices.iter().map(|v| Vec3::new(v[0], v[1], v[2]));
         let first = points.next()?;
         Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+
+    /// Its surface for silhouettes ([`Surface`]: welded positions, edge twins); an error for a
+    /// mesh that is not closed (a card) or has an index past its vertices.
+    pub fn surface(&self) -> Result<Surface, SilhouetteError> {
+        let points: Vec<[f32; 3]> = self.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect();
+        Surface::new(&points, Some(&self.indices))
     }
 
     /// Number of triangles.

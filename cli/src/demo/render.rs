@@ -180,12 +180,7 @@ impl<'a> SceneRenderer<'a> {
             .zip(&alpha_rects)
             .map(|(o, rects)| {
                 let surface = |shape: super::scene::Shape, rect: Vec4| {
-                    let mesh = shape.mesh();
-                    let points: Vec<[f32; 3]> =
-                        mesh.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect();
-                    (rect == Vec4::ZERO)
-                        .then(|| Surface::new(&points, Some(&mesh.indices)).ok())
-                        .flatten()
+                    (rect == Vec4::ZERO).then(|| shape.mesh().surface().ok())?
                 };
                 [surface(o.fine, rects[0]), surface(o.coarse, rects[1])]
             })

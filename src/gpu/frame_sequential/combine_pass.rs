@@ -6,9 +6,7 @@ use wgpu::util::DeviceExt;
 
 use super::LodBuffers;
 use crate::combine::{DepthConvention, ScreenRect, merge_rects};
-use crate::combine_coverage::{
-    COMBINE_ANCHORED, COMBINE_LEVEL_DEPTH, COMBINE_RECORD, CombineData, combine_object,
-};
+use crate::combine_coverage::{COMBINE_ANCHORED, COMBINE_LEVEL_DEPTH, CombineData, combine_object};
 use crate::gpu::checks::{check_color_format, has_usage, texture_matches};
 use crate::gpu::resources::{
     RecordedUniform, begin_color_pass, begin_load_pass, fullscreen_pipeline_with, one_group_layout,
@@ -16,6 +14,7 @@ use crate::gpu::resources::{
 };
 use crate::gpu::{GpuContext, GpuError};
 use crate::lod_buffer::MOTION_FORMAT;
+use crate::silhouette::silhouette_texel;
 
 /// Rust mirror of `CombineParams` in `passes/combine.wgsl`.
 #[repr(C)]
@@ -312,11 +311,10 @@ impl CombinePass {
             });
         }
         let records = combine_object(&data.texels, 0);
-        let slots = data.texels.get(5).map_or(0, |t| t[2]);
-        if let Some(k) = (1..slots).find(|&k| {
-            let flags = data.texels.get((k * COMBINE_RECORD + 5) as usize);
-            flags.is_some_and(|t| t[0] & COMBINE_ANCHORED != 0)
-        }) {
+        let slots = silhouette_texel(&data.texels, 5).z;
+        if let Some(k) =
+            (1..slots).find(|&k| combine_object(&data.texels, k).flags & COMBINE_ANCHORED != 0)
+        {
             return Err(GpuError::Mismatch {
                 call: CALL,
                 parameter: "coverage.data",
