@@ -19,11 +19,11 @@ use std::error::Error;
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
-use lodkit::gpu::transition_scene::{SingleFrameTechnique, transition_items};
 use lodkit::screen_door::DitherPattern;
 use lodkit::select::{LodCamera, LodGroup, LodSettings, LodState, TransitionMode};
 use lodkit::unpopping::LodRenderState;
+use lodkit_scenes::mesh::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
+use lodkit_scenes::transition::{SingleFrameTechnique, transition_items};
 
 const SIZE: (u32, u32) = (200, 150);
 /// Frames per second of the simulated clock.

@@ -31,13 +31,13 @@ use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{
     CombineCoverage, CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
-use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodGroup, LodSettings, LodState, TransitionMode};
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
+use lodkit_scenes::mesh::{GpuMesh, Mesh};
 
 const SIZE: (u32, u32) = (240, 135);
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;

@@ -19,16 +19,17 @@ use std::error::Error;
 use std::time::Instant;
 
 use glam::{Mat4, Vec3, Vec4};
-use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController, psnr_rgba8};
+use lodkit::framebuffer_lod::{ResizeController, ResizeLimits, RlsController};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
     UpsampleSettings,
 };
-use lodkit::gpu::gbuffer_scene::{GBufferFrame, GBufferRenderer, GDrawItem, ShadingTerm};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
-use lodkit::gpu::scene::{GpuMesh, Mesh};
+use lodkit::metrics::psnr_rgba8;
+use lodkit_scenes::gbuffer::{GBufferFrame, GBufferRenderer, GDrawItem, ShadingTerm};
+use lodkit_scenes::mesh::{GpuMesh, Mesh};
 
 const SIZE: (u32, u32) = (640, 360);
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;

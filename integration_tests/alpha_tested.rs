@@ -5,11 +5,11 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use lodkit::alpha_mask::{AlphaMask, alpha_mask_keep, alpha_mask_rect};
 use lodkit::gpu::frame_sequential::{LodBuffers, read_lod_image};
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::unpopping::LodRenderState;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
+use lodkit_scenes::mesh::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 
 use crate::harness::say;
 

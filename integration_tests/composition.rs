@@ -454,8 +454,8 @@ fn add_to_composer_lets_a_foreign_composer_import_lodkit() {
 
 #[test]
 fn rust_uniform_mirrors_match_the_wgsl_layout() {
-    use lodkit::gpu::lod_buffer_scene::{LodCameraUniform, LodDrawUniform};
-    use lodkit::gpu::scene::{CameraUniform, DrawUniform};
+    use lodkit_scenes::lod_buffer::{LodCameraUniform, LodDrawUniform};
+    use lodkit_scenes::mesh::{CameraUniform, DrawUniform};
     let mirrors: [(&str, &str, usize); 4] = [
         ("lod_mesh", "Camera", std::mem::size_of::<CameraUniform>()),
         ("lod_mesh", "Draw", std::mem::size_of::<DrawUniform>()),

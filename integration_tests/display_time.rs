@@ -9,9 +9,7 @@ use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::lod_buffer::{
     LOD_BUFFER_MAX_ID, LOD_BUFFER_SHOWN_NEXT, LOD_BUFFER_SHOWN_NOW, lod_buffer_flags,
     lod_buffer_id, lod_buffer_shown, lod_buffer_word,
@@ -22,6 +20,8 @@ use lodkit::visibility::{
     VisibilityPattern, check_visibility, visibility_flags, visibility_texture,
     visibility_threshold_complementary,
 };
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
+use lodkit_scenes::mesh::{GpuMesh, Mesh};
 
 use crate::harness::{Probe, Word, assert_twin, floats, run_with, say, twin_mismatch, words};
 
@@ -540,7 +540,7 @@ impl SphereLods {
         gpu: &lodkit::gpu::GpuContext,
         buffers: &LodBuffers,
         index: usize,
-        view: impl Into<lodkit::gpu::lod_buffer_scene::LodView>,
+        view: impl Into<lodkit_scenes::lod_buffer::LodView>,
         item: LodDrawItem,
         new_to_old: Mat4,
     ) -> Vec<u8> {

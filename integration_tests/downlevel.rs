@@ -111,7 +111,7 @@ fn draw_two_of_each(gpu: &GpuContext) -> [u8; 4] {
             },
         ],
     });
-    let target = lodkit::gpu::scene::RenderTarget::new(gpu, 1, 1).unwrap();
+    let target = lodkit_scenes::mesh::RenderTarget::new(gpu, 1, 1).unwrap();
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let view = target.color.create_view(&Default::default());
@@ -203,7 +203,7 @@ fn every_pass_builds_or_names_the_capability_it_lacks() {
             ),
         }
     }
-    let renderer = lodkit::gpu::scene::MeshRenderer::new(gpu, false);
+    let renderer = lodkit_scenes::mesh::MeshRenderer::new(gpu, false);
     assert_eq!(
         matches!(renderer, Err(GpuError::MissingCapability { .. })),
         !caps.binding_layout,

@@ -5,12 +5,12 @@ use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::GpuError;
 use lodkit::gpu::frame_sequential::LodBuffers;
 use lodkit::gpu::framebuffer_lod::LowResBuffer;
-use lodkit::gpu::gbuffer_scene::{GBufferFrame, GBufferRenderer, GDrawItem, ShadingTerm};
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::DrawUniforms;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::unpopping::LodRenderState;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
+use lodkit_scenes::gbuffer::{GBufferFrame, GBufferRenderer, GDrawItem, ShadingTerm};
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
+use lodkit_scenes::mesh::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 
 const RGBA8: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 

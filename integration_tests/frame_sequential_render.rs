@@ -7,11 +7,11 @@ use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodBufferRenderer, LodDrawItem, LodView};
+use lodkit_scenes::mesh::{GpuMesh, Mesh};
 
 use crate::harness::say;
 

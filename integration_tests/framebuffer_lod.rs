@@ -406,15 +406,15 @@ mod controller {
 }
 
 mod rendered {
-    use lodkit::framebuffer_lod::{multiply_rgba8, psnr_rgba8};
     use lodkit::gpu::GpuError;
     use lodkit::gpu::framebuffer_lod::{
         LowResBuffer, RangeSigmas, UpsampleComposite, UpsampleFrame, UpsamplePass,
         UpsamplePassDescriptor, UpsampleSettings,
     };
-    use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
     use lodkit::gpu::readback::read_texture_rgba8;
     use lodkit::gpu::resources::texture_2d;
+    use lodkit::metrics::psnr_rgba8;
+    use lodkit_scenes::gbuffer::{EdgeScene, ShadingTerm};
 
     use crate::harness::say;
 
@@ -496,7 +496,7 @@ mod rendered {
             // The fine-grained pass multiplies in the upsample: within 1 of the product of the
             // two RGBA8 images (it multiplies before the lighting is quantized).
             let composite = run(&fine_pass, frame(r, sigmas, Some(albedo.color())));
-            let product = multiply_rgba8(&lighting, &albedo_pixels);
+            let product = super::multiply_rgba8(&lighting, &albedo_pixels);
             let worst = composite
                 .iter()
                 .zip(&product)
@@ -728,4 +728,31 @@ fn bilateral_upsample_at_twins_match_on_real_textures() {
             &format!("{language:?} bilateral_upsample_at"),
         );
     }
+}
+
+/// Multiplies two RGBA8 images channel by channel (RGB; alpha 255), rounding to nearest: the
+/// composite of fine-grained resizing (an upsampled term times a full-resolution term) done on
+/// the CPU.
+fn multiply_rgba8(a: &[u8], b: &[u8]) -> Vec<u8> {
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .flat_map(|(x, y)| {
+            let m = |c: usize| ((u32::from(x[c]) * u32::from(y[c]) + 127) / 255) as u8;
+            [m(0), m(1), m(2), 255]
+        })
+        .collect()
+}
+
+#[test]
+fn multiply_rgba8_rounds_each_channel_and_makes_alpha_opaque() {
+    // 255 * 128 / 255 = 128; 128 * 255 / 255 = 128; 0 * 9 = 0; alpha 255 whatever the inputs.
+    assert_eq!(
+        multiply_rgba8(&[255, 128, 0, 255], &[128, 255, 9, 7]),
+        vec![128, 128, 0, 255]
+    );
+    // 100 * 100 / 255 = 39.2 -> 39; 200 * 200 / 255 = 156.9 -> 157.
+    assert_eq!(
+        multiply_rgba8(&[100, 200, 0, 0], &[100, 200, 0, 0]),
+        vec![39, 157, 0, 255]
+    );
 }

@@ -20,14 +20,14 @@ use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
     UpsampleSettings,
 };
-use lodkit::gpu::gbuffer_scene::{EdgeScene, GBufferFrame, GBufferRenderer, ShadingTerm};
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer};
 use lodkit::gpu::readback::{read_buffer, read_texture, read_texture_rgba8};
 use lodkit::gpu::resources::{DrawUniforms, r32float_texture, texture_2d, uniform_buffer};
-use lodkit::gpu::scene::{GpuMesh, Mesh, MeshRenderer, RenderTarget};
-use lodkit::gpu::transition_scene::TransitionScene;
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
+use lodkit_scenes::gbuffer::{EdgeScene, GBufferFrame, GBufferRenderer, ShadingTerm};
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodBufferRenderer};
+use lodkit_scenes::mesh::{GpuMesh, Mesh, MeshRenderer, RenderTarget};
+use lodkit_scenes::transition::TransitionScene;
 
 use crate::support::say;
 

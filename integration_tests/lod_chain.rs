@@ -8,9 +8,9 @@
 
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::lod_chain::{LodChain, LodChainDescriptor, MeshData, PixelErrorCamera};
 use lodkit::unpopping::LodRenderState;
+use lodkit_scenes::mesh::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
 
 use crate::harness::say;
 

@@ -7,11 +7,11 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use lodkit::combine::combine_object_motion;
 use lodkit::frame_sequential::{Drive, FrameDraw, InstanceKey, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture;
 use lodkit::lod_buffer::{lod_buffer_motion, lod_buffer_output_motion};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::shaders::SourceLanguage;
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodDrawItem, LodView};
 
 use crate::display_time::SphereLods;
 use crate::harness::{Probe, floats, run_with, say, words};

@@ -315,9 +315,9 @@ fn packed_route_renders_the_unpacked_image_and_layouts_must_match() {
         LowResBuffer, LowResLayout, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
         UpsampleSettings,
     };
-    use lodkit::gpu::gbuffer_scene::EdgeScene;
     use lodkit::gpu::readback::read_texture_rgba8;
     use lodkit::gpu::resources::texture_2d;
+    use lodkit_scenes::gbuffer::EdgeScene;
     let gpu = lodkit_test_gpu!();
     let (w, h, r) = (96, 64, 2.0);
     let format = wgpu::TextureFormat::Rgba8Unorm;

@@ -6,7 +6,6 @@
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{CombinePass, LodBuffers};
-use lodkit::gpu::lod_buffer_scene::{LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture;
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::shaders::SourceLanguage;
@@ -14,6 +13,7 @@ use lodkit::visibility::{
     VisibilityPattern, VisibilitySpace, visibility_flags_screen, visibility_next_coord,
     visibility_screen_texel, visibility_shown, visibility_texture,
 };
+use lodkit_scenes::lod_buffer::{LodDrawItem, LodView};
 
 use crate::display_time::SphereLods;
 use crate::harness::{Probe, floats, run_with, say, words};

@@ -2,14 +2,12 @@
 //! their Rust twins, and rendered: how much background shows through a transitioning object.
 
 use glam::Vec2;
-use lodkit::gpu::transition_scene::{
-    SceneParts, SingleFrameTechnique, TransitionScene, see_through,
-};
 use lodkit::screen_door::{
     BAYER_4X4, DitherPattern, blue_noise_ranks, pack_ranks, screen_door_keep_with,
 };
 use lodkit::shaders::{self, SourceLanguage};
 use lodkit::unpopping::{unpopping_alpha, unpopping_is_opaque, unpopping_plan};
+use lodkit_scenes::transition::{SceneParts, SingleFrameTechnique, TransitionScene, see_through};
 
 use crate::harness::{Probe, floats, run_with, say, words};
 

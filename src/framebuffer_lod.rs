@@ -502,28 +502,3 @@ pub fn step_response(
         spread,
     }
 }
-
-/// PSNR of two RGBA8 images: [`crate::metrics::psnr_rgba8`], re-exported where framebuffer LOD's
-/// quality is measured.
-pub use crate::metrics::psnr_rgba8;
-
-/// Multiplies two RGBA8 images channel by channel (RGB; alpha 255): how fine-grained resizing
-/// puts an upsampled term and a full-resolution term back together. Stops at the shorter image
-/// and ignores a trailing partial pixel.
-///
-/// ```
-/// # use lodkit::framebuffer_lod::multiply_rgba8;
-/// assert_eq!(multiply_rgba8(&[255, 128, 0, 255], &[128, 255, 9, 7]), vec![128, 128, 0, 255]);
-/// ```
-pub fn multiply_rgba8(a: &[u8], b: &[u8]) -> Vec<u8> {
-    a.chunks_exact(4)
-        .zip(b.chunks_exact(4))
-        .flat_map(|(x, y)| {
-            let m = |c: usize| ((u32::from(x[c]) * u32::from(y[c]) + 127) / 255) as u8;
-            [m(0), m(1), m(2), 255]
-        })
-        .collect()
-}
-
-/// SSIM of two RGBA8 images, where the framebuffer-LOD quality is measured.
-pub use crate::metrics::ssim_rgba8;

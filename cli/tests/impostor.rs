@@ -8,9 +8,9 @@ use crate::support::say;
 #[test]
 fn a_baked_impostor_mask_is_its_trees_silhouette() {
     use lodkit::alpha_mask::alpha_mask_keep;
-    use lodkit::gpu::scene::MeshRenderer;
     use lodkit_cli::demo::impostor::{MASK_SIZE, bake};
     use lodkit_cli::demo::scene::Shape;
+    use lodkit_scenes::mesh::MeshRenderer;
     let gpu = lodkit_test_gpu!();
     let renderer = MeshRenderer::new(gpu, false).unwrap();
     let impostor = Shape::Impostor { puffs: 7, rings: 8 };

@@ -25,12 +25,12 @@ use glam::Vec3;
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::buffer_with_data;
-use lodkit::gpu::scene::{MESH_VERTEX_LAYOUT, Mesh, RenderTarget};
 use lodkit::gpu::select::{
     GpuLodInstance, GpuLodSelector, GpuLodSelectorDescriptor, GpuSelectFrame, LevelMesh,
 };
 use lodkit::select::{LodCamera, LodGroup, LodSettings, TransitionMode};
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary, SourceLanguage};
+use lodkit_scenes::mesh::{MESH_VERTEX_LAYOUT, Mesh, RenderTarget};
 
 const SIZE: (u32, u32) = (320, 180);
 const SIDE: usize = 320; // 320 x 320 = 102,400 instances
@@ -277,14 +277,14 @@ fn draw_pipeline(
                 module: &module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[Some(lodkit::gpu::scene::COLOR_FORMAT.into())],
+                targets: &[Some(lodkit_scenes::mesh::COLOR_FORMAT.into())],
             }),
             primitive: wgpu::PrimitiveState {
                 cull_mode: Some(wgpu::Face::Back),
                 ..Default::default()
             },
             depth_stencil: Some(wgpu::DepthStencilState {
-                format: lodkit::gpu::scene::DEPTH_FORMAT,
+                format: lodkit_scenes::mesh::DEPTH_FORMAT,
                 depth_write_enabled: Some(true),
                 depth_compare: Some(wgpu::CompareFunction::Less),
                 stencil: Default::default(),

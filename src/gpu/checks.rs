@@ -4,11 +4,15 @@
 //! Rule for sizes: a width or height of 0 is taken as 1 (so a minimized window keeps working);
 //! the object's `size()` reports the size it really has. A side larger than
 //! `Limits::max_texture_dimension_2d` is [`GpuError::TooLarge`].
+//!
+//! The public ones are for an engine's own passes beside lodkit's (the reference renderers of
+//! the `lodkit-scenes` crate call them), so that they refuse what lodkit's passes refuse, with
+//! the same errors.
 
 use super::{GpuContext, GpuError};
 
 /// `width` and `height` with 0 taken as 1, checked against `max_texture_dimension_2d`.
-pub(crate) fn texture_extent(
+pub fn texture_extent(
     gpu: &GpuContext,
     call: &'static str,
     width: u32,
@@ -66,7 +70,7 @@ fn unsupported_format(
 
 /// Checks that `format` is a floating-point color format (what lodkit's passes read and write
 /// as `vec4<f32>`) that the device allows with `usages`.
-pub(crate) fn check_color_format(
+pub fn check_color_format(
     gpu: &GpuContext,
     call: &'static str,
     parameter: &'static str,
@@ -93,7 +97,7 @@ pub(crate) fn check_color_format(
 /// [`check_color_format`], also accepting `lodkit::gbuffer`'s packed low-resolution format
 /// ([`crate::gbuffer::PACKED_FORMAT`]), which lodkit's framebuffer-LOD passes write and read as
 /// integers.
-pub(crate) fn check_low_res_format(
+pub fn check_low_res_format(
     gpu: &GpuContext,
     call: &'static str,
     parameter: &'static str,
@@ -175,7 +179,7 @@ pub(crate) fn target_extent(
 }
 
 /// Checks that `parameter` has the color format `built_for` that a renderer was built for.
-pub(crate) fn same_color_format(
+pub fn same_color_format(
     call: &'static str,
     parameter: &'static str,
     found: wgpu::TextureFormat,

@@ -7,19 +7,15 @@
 //! error scopes, and a lost device is reported by the next call (docs/errors.md).
 
 mod capabilities;
-mod checks;
+pub mod checks;
 mod context;
 pub mod counters;
 mod error;
 pub mod frame_sequential;
 pub mod framebuffer_lod;
-pub mod gbuffer_scene;
-pub mod lod_buffer_scene;
 pub mod readback;
 pub mod resources;
-pub mod scene;
 pub mod select;
-pub mod transition_scene;
 pub mod unpopping;
 
 pub use capabilities::{GlVersion, GpuCapabilities};

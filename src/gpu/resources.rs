@@ -11,8 +11,8 @@ mod params;
 pub use draw_uniforms::DrawUniforms;
 pub use params::RecordedUniform;
 
-/// Vertex buffer layout of the meshes [`mesh_pipeline`] draws (`scene::Mesh`): 24 bytes a
-/// vertex, [`MESH_VERTEX_ATTRIBUTES`].
+/// Vertex buffer layout of the meshes [`mesh_pipeline`] draws: position then normal,
+/// 24 bytes a vertex (the `lodkit-scenes` crate's `Mesh`), [`MESH_VERTEX_ATTRIBUTES`].
 pub const MESH_VERTEX_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
     array_stride: 24,
     step_mode: wgpu::VertexStepMode::Vertex,
@@ -277,7 +277,7 @@ pub fn texture_entry(
     }
 }
 
-/// A render pipeline for [`Mesh`](super::scene::Mesh) geometry: `vs_main` / `fs_main` of
+/// A render pipeline for meshes laid out as [`MESH_VERTEX_LAYOUT`]: `vs_main` / `fs_main` of
 /// `module`, back faces culled, the given layout, color targets and depth state.
 pub fn mesh_pipeline(
     gpu: &GpuContext,

@@ -5,8 +5,8 @@
 use std::sync::OnceLock;
 
 use glam::Vec3;
-use lodkit::gpu::scene::Mesh;
 use lodkit::lod_chain::{LodChain, LodChainDescriptor, MeshData, PixelErrorCamera, uv_sphere};
+use lodkit_scenes::mesh::Mesh;
 
 /// The chain's reference camera: the scene's field of view on the default demo image's height
 /// (180 pixels), one pixel of error.

@@ -20,8 +20,8 @@ use lodkit::framebuffer_lod::{
     PaperController, ResizeController, ResizeLimits, RlsController, SimulatedFrame, StepController,
     step_response,
 };
-use lodkit::gpu::gbuffer_scene::EdgeScene;
 use lodkit::gpu::{GpuContext, GpuError};
+use lodkit_scenes::gbuffer::EdgeScene;
 
 /// Shading work before the step (sky directions per fragment); it doubles at [`STEP_FRAME`].
 pub const BASE_WORK: u32 = 64;

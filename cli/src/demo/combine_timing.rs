@@ -11,13 +11,13 @@ use super::timing::{PassRatio, plain_pass_with, record_fullscreen};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LOD_DEPTH_FORMAT, LodBuffers,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
 use lodkit::gpu::resources::{one_group_layout, texture_2d, textures_and_uniform};
-use lodkit::gpu::scene::{GpuMesh, Mesh};
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodBufferRenderer, LodDrawItem};
+use lodkit_scenes::mesh::{GpuMesh, Mesh};
 
 /// A fullscreen pass reading color, id word and depth of both buffers and, with `motion`, the
 /// object motion at the pixel, summed so none is optimized away; `$depth` adds more to the depth

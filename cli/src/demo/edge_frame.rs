@@ -8,9 +8,9 @@ use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, LowResLayout, RangeSigmas, UpsampleComposite, UpsampleFrame, UpsamplePass,
     UpsamplePassDescriptor, UpsampleSettings,
 };
-use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::{GpuContext, GpuError};
+use lodkit_scenes::gbuffer::{EdgeScene, ShadingTerm};
 
 use super::clock::Timer;
 

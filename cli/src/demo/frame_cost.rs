@@ -25,7 +25,7 @@ use super::edge_frame::EdgeFrame;
 use super::plots::{BarChart, Chart, Series, line_chart, stacked_bars};
 use super::table::Table;
 use lodkit::gpu::GpuContext;
-use lodkit::gpu::gbuffer_scene::ShadingTerm;
+use lodkit_scenes::gbuffer::ShadingTerm;
 
 /// Resize factors of the breakdown.
 pub const BREAKDOWN_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];

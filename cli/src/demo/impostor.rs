@@ -4,9 +4,9 @@
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::alpha_mask::AlphaMask;
 use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::scene::{DrawItem, GpuMesh, MeshFrame, MeshRenderer, RenderTarget};
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::unpopping::LodRenderState;
+use lodkit_scenes::mesh::{DrawItem, GpuMesh, MeshFrame, MeshRenderer, RenderTarget};
 
 use super::scene::Shape;
 

@@ -8,9 +8,9 @@ use super::edge_frame::{EdgeFrame, FORMAT};
 use super::reads::{Reads, Texels};
 use super::timing::{BILINEAR, PassRatio, plain_pass, record_fullscreen};
 use lodkit::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
-use lodkit::gpu::gbuffer_scene::ShadingTerm;
 use lodkit::gpu::resources::{textures_and_uniform, uniform_buffer};
 use lodkit::gpu::{GpuContext, GpuError};
+use lodkit_scenes::gbuffer::ShadingTerm;
 
 /// The packed eq. 1's loads at the same texels, summed so none is optimized away, no weights.
 const LOADS5: &str = "#import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}

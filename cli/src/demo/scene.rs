@@ -19,7 +19,7 @@ use std::path::Path;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
-use lodkit::gpu::scene::Mesh;
+use lodkit_scenes::mesh::Mesh;
 
 /// The most objects a scene may have (each transition draws two items per object).
 pub const MAX_OBJECTS: usize = 100;

@@ -1,9 +1,9 @@
 //! The transition techniques the demo compares.
 
 use lodkit::frame_sequential::Schedule;
-use lodkit::gpu::transition_scene::SingleFrameTechnique;
 use lodkit::screen_door::DitherPattern;
 use lodkit::visibility::{VisibilityPattern, VisibilitySpace};
+use lodkit_scenes::transition::SingleFrameTechnique;
 
 const WHITE: VisibilityPattern = VisibilityPattern::WhiteNoise;
 const BLUE: VisibilityPattern = VisibilityPattern::BlueNoise;

@@ -13,12 +13,12 @@ use super::clock::{Clock, Timer, interleaved};
 use super::edge_frame::{EdgeFrame, FORMAT};
 use super::reads::{Reads, Texels};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
-use lodkit::gpu::gbuffer_scene::ShadingTerm;
 use lodkit::gpu::resources::{
     begin_color_pass, fullscreen_pipeline_with, textures_and_uniform, uniform_buffer,
 };
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::shaders::{ComposeDescriptor, ShaderLibrary};
+use lodkit_scenes::gbuffer::ShadingTerm;
 
 /// A pass timed against its baseline.
 #[derive(Clone, Debug, Serialize)]

@@ -11,16 +11,17 @@ use super::DemoError;
 use super::clock::{Timer, median};
 use lodkit::framebuffer_lod::{
     FixedController, FrameTimeModel, PaperController, ResizeController, ResizeLimits,
-    RlsController, StepController, psnr_rgba8, simulate, ssim_rgba8, step_response,
+    RlsController, StepController, simulate, step_response,
 };
 use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, LowResLayout, RangeSigmas, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor,
     UpsampleSettings,
 };
-use lodkit::gpu::gbuffer_scene::{EdgeScene, ShadingTerm};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::resources::texture_2d;
 use lodkit::gpu::{GpuContext, GpuError};
+use lodkit::metrics::{psnr_rgba8, ssim_rgba8};
+use lodkit_scenes::gbuffer::{EdgeScene, ShadingTerm};
 
 /// Resize factors the demo measures.
 pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];

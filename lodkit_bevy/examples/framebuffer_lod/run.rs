@@ -4,7 +4,7 @@
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
 use bevy::prelude::*;
-use lodkit::framebuffer_lod::psnr_rgba8;
+use lodkit::metrics::psnr_rgba8;
 use lodkit_bevy::framebuffer_lod::EFFECT_PASS;
 use lodkit_bevy::prelude::*;
 use serde_json::json;

@@ -15,12 +15,12 @@ use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
     CombineCoverage, CombineFrame, CombinePass, CombineRegions, read_lod_image,
 };
-use lodkit::gpu::lod_buffer_scene::{LodBufferFrame, LodDrawItem, LodView};
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::silhouette::Segment;
 use lodkit::visibility::{VisibilityPattern, VisibilitySpace};
+use lodkit_scenes::lod_buffer::{LodBufferFrame, LodDrawItem, LodView};
 
 impl SceneRenderer<'_> {
     /// The silhouette of object `i`'s level `lod` at `frame` (swayed as `sway_offset` in

@@ -7,17 +7,17 @@ use std::f32::consts::{PI, TAU};
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 
-use super::checks::texture_extent;
-use super::counters::FragmentCounter;
-use super::resources::{
+use lodkit::alpha_mask::AlphaMask;
+use lodkit::gpu::checks::texture_extent;
+use lodkit::gpu::counters::FragmentCounter;
+use lodkit::gpu::resources::{
     DrawUniforms, begin_targets_pass, buffer_with_data, camera_draw_layouts, mesh_pipeline,
     r32float_texture, texture_2d, texture_entry, uniform_buffer,
 };
-use super::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
-use super::{GpuContext, GpuError};
-use crate::alpha_mask::AlphaMask;
-use crate::silhouette::{SilhouetteError, Surface};
-use crate::unpopping::LodRenderState;
+use lodkit::gpu::unpopping::{lod_blend, lod_blend_constant, lod_depth_stencil};
+use lodkit::gpu::{GpuContext, GpuError};
+use lodkit::silhouette::{SilhouetteError, Surface};
+use lodkit::unpopping::LodRenderState;
 
 /// Depth format of [`RenderTarget`].
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -93,7 +93,7 @@ impl Mesh {
 
     /// A card: the rectangle `min..max` in the z = 0 plane, facing +z (two triangles). With an
     /// alpha mask over the same rectangle
-    /// ([`alpha_mask_rect`](crate::alpha_mask::alpha_mask_rect)) it is a billboard impostor.
+    /// ([`alpha_mask_rect`](lodkit::alpha_mask::alpha_mask_rect)) it is a billboard impostor.
     pub fn card(min: glam::Vec2, max: glam::Vec2) -> Self {
         let corners = [
             (min.x, min.y),
@@ -192,7 +192,7 @@ impl GpuMesh {
 
 /// Vertex buffer layout and attributes of [`Mesh`] (position at location 0, normal at 1): the
 /// layout `resources::mesh_pipeline` builds pipelines with.
-pub use super::resources::{MESH_VERTEX_ATTRIBUTES, MESH_VERTEX_LAYOUT};
+pub use lodkit::gpu::resources::{MESH_VERTEX_ATTRIBUTES, MESH_VERTEX_LAYOUT};
 
 /// Rust mirror of `Camera` in `passes/lod_mesh.wgsl`.
 #[repr(C)]
@@ -267,7 +267,7 @@ pub struct DrawItem<'a> {
     /// 0 = none) and phase (advance it over time).
     pub sway: [f32; 2],
     /// Where the renderer's alpha mask lies in object space
-    /// ([`alpha_mask_rect`](crate::alpha_mask::alpha_mask_rect)); `Vec4::ZERO`: no alpha test.
+    /// ([`alpha_mask_rect`](lodkit::alpha_mask::alpha_mask_rect)); `Vec4::ZERO`: no alpha test.
     pub alpha_rect: Vec4,
 }
 

@@ -3,20 +3,20 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::checks::{check_color_format, same_color_format};
-use super::counters::FragmentCounter;
-use super::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
-use super::resources::{
+use crate::mesh::{GpuMesh, UNFILTERABLE, masked_view_group};
+use lodkit::alpha_mask::AlphaMask;
+use lodkit::combine::DepthConvention;
+use lodkit::frame_sequential::FrameDraw;
+use lodkit::gpu::checks::{check_color_format, same_color_format};
+use lodkit::gpu::counters::FragmentCounter;
+use lodkit::gpu::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
+use lodkit::gpu::resources::{
     DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, r32float_texture,
     texture_entry, uniform_buffer,
 };
-use super::scene::{GpuMesh, UNFILTERABLE, masked_view_group};
-use super::{GpuContext, GpuError};
-use crate::alpha_mask::AlphaMask;
-use crate::combine::DepthConvention;
-use crate::frame_sequential::FrameDraw;
-use crate::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
-use crate::visibility::{VisibilitySpace, VisibilityTexture};
+use lodkit::gpu::{GpuContext, GpuError};
+use lodkit::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
+use lodkit::visibility::{VisibilitySpace, VisibilityTexture};
 
 /// Rust mirror of `LodCamera` in `passes/lod_buffer_mesh.wgsl`.
 #[repr(C)]
@@ -123,7 +123,7 @@ pub struct LodDrawItem<'a> {
     pub color: Vec4,
     /// Instance id (0 = n-instance, always shown).
     pub id: u32,
-    /// Visibility threshold this frame ([`visibility_shown`](crate::visibility::visibility_shown):
+    /// Visibility threshold this frame ([`visibility_shown`](lodkit::visibility::visibility_shown):
     /// 1 shows every fragment, 0 none, negative the inverted pattern).
     pub tau: f32,
     /// Visibility threshold of the same LOD in the next frame, when this buffer is the older one.
@@ -134,7 +134,7 @@ pub struct LodDrawItem<'a> {
     /// The sway phase of the previous frame.
     pub prev_sway_phase: f32,
     /// Where the renderer's alpha mask lies in object space
-    /// ([`alpha_mask_rect`](crate::alpha_mask::alpha_mask_rect)); `Vec4::ZERO`: no alpha test.
+    /// ([`alpha_mask_rect`](lodkit::alpha_mask::alpha_mask_rect)); `Vec4::ZERO`: no alpha test.
     pub alpha_rect: Vec4,
 }
 

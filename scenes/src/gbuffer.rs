@@ -4,14 +4,14 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::checks::{check_low_res_format, same_color_format};
-use super::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
-use super::resources::{
+use crate::mesh::GpuMesh;
+use lodkit::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
+use lodkit::gpu::checks::{check_low_res_format, same_color_format};
+use lodkit::gpu::framebuffer_lod::{LOW_DEPTH_FORMAT, LowResBuffer};
+use lodkit::gpu::resources::{
     DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, uniform_buffer,
 };
-use super::scene::GpuMesh;
-use super::{GpuContext, GpuError};
-use crate::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
+use lodkit::gpu::{GpuContext, GpuError};
 
 /// Rust mirror of `GCamera` in `passes/gbuffer_mesh.wgsl`.
 #[repr(C)]
@@ -292,8 +292,8 @@ impl EdgeScene {
                 renderers: Self::renderers(gpu, color_format, 0)?,
                 packed: std::sync::OnceLock::new(),
                 shading_work: 0,
-                sphere: GpuMesh::new(gpu, &super::scene::Mesh::sphere(24, 48))?,
-                cube: GpuMesh::new(gpu, &super::scene::Mesh::cube())?,
+                sphere: GpuMesh::new(gpu, &crate::mesh::Mesh::sphere(24, 48))?,
+                cube: GpuMesh::new(gpu, &crate::mesh::Mesh::cube())?,
                 aspect,
             })
         })

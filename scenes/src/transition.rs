@@ -4,12 +4,12 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::readback::read_texture_rgba8;
-use super::scene::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
-use super::{GpuContext, GpuError};
-use crate::screen_door::DitherPattern;
-use crate::select::LodSelection;
-use crate::unpopping::{LodRenderState, LodRole, TransitionPlan, cross_fade_plan, unpopping_plan};
+use crate::mesh::{DrawItem, GpuMesh, Mesh, MeshFrame, MeshRenderer, RenderTarget};
+use lodkit::gpu::readback::read_texture_rgba8;
+use lodkit::gpu::{GpuContext, GpuError};
+use lodkit::screen_door::DitherPattern;
+use lodkit::select::LodSelection;
+use lodkit::unpopping::{LodRenderState, LodRole, TransitionPlan, cross_fade_plan, unpopping_plan};
 
 /// How a single-frame transition is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
