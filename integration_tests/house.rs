@@ -2,7 +2,8 @@
 //! between the files of `src/`, `cli/src`, `lodkit_bevy/src` and `scenes/src` (a `use` or an inline
 //! `crate::`/`super::`/`self::` path from one file to an item of another is an edge; an item a
 //! module re-exports with `pub use` counts as the file that defines it), and no file over 600
-//! lines outside tests and generated files.
+//! lines outside tests and generated files; and the demo (`cli/src/demo`) imports only from a
+//! file's own layer or those below (error, fixtures, measures, report).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -408,6 +409,55 @@ fn no_import_circle_between_the_files_of_any_crate() {
     }
     assert!(files > 100, "the module trees were read ({files} files)");
     assert!(found.is_empty(), "import circles:\n{}", found.join("\n"));
+}
+
+/// The demo's layer of a file under `demo` (`cli/src/demo`), bottom up: the error type, the
+/// fixtures, the measures, the report, and `mod.rs`, which runs them in order. `None` outside
+/// the demo.
+fn demo_layer(file: &Path, demo: &Path) -> Option<(usize, &'static str)> {
+    let first = file.strip_prefix(demo).ok()?.components().next()?;
+    Some(match first.as_os_str().to_str()? {
+        "error.rs" => (0, "error"),
+        "fixtures" => (1, "fixtures"),
+        "measures" => (2, "measures"),
+        "report" => (3, "report"),
+        _ => (4, "demo/mod.rs"),
+    })
+}
+
+/// The demo is three layers (fixtures, measures, report) over its error type: a file imports
+/// only from its own layer or those below, so a measure never reaches into the report.
+#[test]
+fn the_demo_imports_only_from_its_own_layer_or_below() {
+    let root = workspace_root();
+    let demo = root.join("cli/src/demo");
+    let krate = Crate::load(&root.join("cli/src/lib.rs"));
+    let (mut edges, mut up) = (0, Vec::new());
+    for (from, tos) in krate.edges() {
+        let Some((a, layer_a)) = demo_layer(&from, &demo) else {
+            continue;
+        };
+        for to in tos {
+            let Some((b, layer_b)) = demo_layer(&to, &demo) else {
+                continue;
+            };
+            edges += 1;
+            if b > a {
+                let name = |p: &Path| p.strip_prefix(&root).unwrap_or(p).display().to_string();
+                up.push(format!(
+                    "{} ({layer_a}) -> {} ({layer_b})",
+                    name(&from),
+                    name(&to)
+                ));
+            }
+        }
+    }
+    assert!(edges > 50, "the demo's imports were read ({edges} edges)");
+    assert!(
+        up.is_empty(),
+        "imports from a lower layer up:\n{}",
+        up.join("\n")
+    );
 }
 
 /// The checker sees a circle: hand-made modules that import each other.

@@ -10,8 +10,10 @@
 //!
 //! `cargo bench -p lodkit-cli --bench combine [-- SIZE PAIRS]` (default 512 x 512, 200 pairs)
 
-use lodkit_cli::demo::clock::Timer;
-use lodkit_cli::demo::{RECORDINGS, combine_timing::combine_vs_copy, open_gpu};
+use lodkit_cli::demo::fixtures::clock::RECORDINGS;
+use lodkit_cli::demo::fixtures::clock::Timer;
+use lodkit_cli::demo::measures::combine_timing::combine_vs_copy;
+use lodkit_cli::demo::open_gpu;
 
 fn main() {
     let args: Vec<u32> = std::env::args().filter_map(|a| a.parse().ok()).collect();

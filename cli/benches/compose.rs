@@ -9,7 +9,7 @@ use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use lodkit::shaders::{self, ExportOptions, ExportTarget, ShaderLibrary};
-use lodkit_cli::demo::cpu::{USER_SHADER, compose_user_shader};
+use lodkit_cli::demo::measures::host_cost::{USER_SHADER, compose_user_shader};
 
 fn compose(library: &mut ShaderLibrary) -> shaders::Composed {
     compose_user_shader(library).expect("composes")

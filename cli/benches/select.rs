@@ -6,7 +6,7 @@ use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use lodkit::select::*;
-use lodkit_cli::demo::cpu::SelectionWorkload;
+use lodkit_cli::demo::measures::host_cost::SelectionWorkload;
 
 fn benches(c: &mut Criterion) {
     for n in [10_000, 100_000] {

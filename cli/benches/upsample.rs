@@ -10,9 +10,11 @@
 //!
 //! `cargo bench -p lodkit-cli --bench upsample [-- WIDTH HEIGHT PAIRS]` (default 1280 x 720, 60 pairs)
 
-use lodkit_cli::demo::clock::Timer;
-use lodkit_cli::demo::packed_timing::packed_upsample_vs_bilinear;
-use lodkit_cli::demo::{RECORDINGS, open_gpu, timing::upsample_vs_bilinear};
+use lodkit_cli::demo::fixtures::clock::RECORDINGS;
+use lodkit_cli::demo::fixtures::clock::Timer;
+use lodkit_cli::demo::measures::packed_upsample_timing::packed_upsample_vs_bilinear;
+use lodkit_cli::demo::measures::upsample_timing::upsample_vs_bilinear;
+use lodkit_cli::demo::open_gpu;
 
 fn main() {
     let args: Vec<u32> = std::env::args().filter_map(|a| a.parse().ok()).collect();

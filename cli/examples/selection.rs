@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use glam::Vec3;
 use lodkit::select::config::LodConfig;
 use lodkit::select::*;
-use lodkit_cli::demo::plots::{Chart, Series, line_chart};
+use lodkit_cli::demo::report::plots::{Chart, Series, line_chart};
 
 fn arg(name: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();

@@ -289,7 +289,7 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
     ));
     let code = match lodkit_cli::demo::run(&options) {
         Ok(report) => {
-            out.println(&lodkit_cli::demo::terminal::summary(&report));
+            out.println(&lodkit_cli::demo::report::terminal::summary(&report));
             out.println(&format!(
                 "open {}",
                 options.out.join("index.html").display()
@@ -315,19 +315,20 @@ fn demo(options: lodkit_cli::demo::DemoOptions) -> ExitCode {
 
 fn gpu_report(
     out_dir: &Path,
-    options: &lodkit_cli::demo::gpu_report::GpuReportOptions,
+    options: &lodkit_cli::demo::measures::gpu_report::GpuReportOptions,
 ) -> ExitCode {
-    use lodkit_cli::demo::gpu_report;
+    use lodkit_cli::demo::measures::gpu_report::measure;
+    use lodkit_cli::demo::report::gpu_report::{markdown, write};
     let mut out = Output::default();
     let run = lodkit_cli::demo::open_gpu().and_then(|gpu| {
         out.println(&format!("lodkit gpu-report on {}", gpu.adapter_summary()));
-        let report = gpu_report::measure(&gpu, options)?;
-        gpu_report::write(&report, out_dir)?;
+        let report = measure(&gpu, options)?;
+        write(&report, out_dir)?;
         Ok(report)
     });
     let code = match run {
         Ok(report) => {
-            out.println(&gpu_report::markdown(&report));
+            out.println(&markdown(&report));
             out.println(&format!(
                 "wrote {}",
                 out_dir.join("gpu-report.md").display()
@@ -363,7 +364,7 @@ fn main() -> ExitCode {
         Command::Adapter => adapter(),
         Command::GpuReport { out, quick, pairs } => gpu_report(
             &out,
-            &lodkit_cli::demo::gpu_report::GpuReportOptions { quick, pairs },
+            &lodkit_cli::demo::measures::gpu_report::GpuReportOptions { quick, pairs },
         ),
         // clap requires exactly one of the two.
         Command::Wesl { out, npm } => match npm {

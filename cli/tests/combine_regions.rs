@@ -2,14 +2,14 @@
 //! pixel of such an object outside them shows the newer buffer alone. The rectangles must take
 //! the whole reach of an animated object, not its rest pose.
 
-use lodkit_cli::demo::render::{Coverage, Technique};
-use lodkit_cli::demo::scene::DemoScene;
+use lodkit_cli::demo::fixtures::render::{Coverage, Technique};
+use lodkit_cli::demo::fixtures::scene::DemoScene;
 
 #[test]
 fn the_combine_rectangles_hold_every_pixel_of_the_swaying_tree() {
     use lodkit::frame_sequential::Schedule;
     use lodkit::visibility::{VisibilityPattern, VisibilitySpace};
-    use lodkit_cli::demo::render::{Background, RunSpec, SceneRenderer};
+    use lodkit_cli::demo::fixtures::render::{Background, RunSpec, SceneRenderer};
     let gpu = lodkit_test_gpu!();
     // The field scene at the docs' size, every object swaying as far as a scene may (1 object
     // unit at the top): its reach leaves the rest-pose rectangles and their 2 px margin. With

@@ -5,9 +5,9 @@ use std::process::Command;
 
 use lodkit::gpu::counters::{CounterKind, FragmentCounter};
 use lodkit::metrics::{pop, transition_change};
-use lodkit_cli::demo::render::Technique;
-use lodkit_cli::demo::scene::{DemoScene, SceneError};
-use lodkit_cli::demo::upsampling::METHODS;
+use lodkit_cli::demo::fixtures::render::Technique;
+use lodkit_cli::demo::fixtures::scene::{DemoScene, SceneError};
+use lodkit_cli::demo::measures::upsample_quality::METHODS;
 use lodkit_cli::demo::{DemoOptions, run_on, utc_date};
 
 use crate::support::{browser_script, say, scratch};
@@ -59,7 +59,7 @@ fn scene_files_name_the_line_and_the_field() {
         other => panic!("expected a parse error, got {other:?}"),
     }
     let mut bad = good.clone();
-    bad.objects[3].fine = lodkit_cli::demo::scene::Shape::Sphere {
+    bad.objects[3].fine = lodkit_cli::demo::fixtures::scene::Shape::Sphere {
         rings: 1,
         segments: 8,
     };
@@ -87,7 +87,7 @@ fn scene_files_name_the_line_and_the_field() {
         bad.check()
     );
     let mut bad = good.clone();
-    bad.objects[0].fine = lodkit_cli::demo::scene::Shape::Sphere {
+    bad.objects[0].fine = lodkit_cli::demo::fixtures::scene::Shape::Sphere {
         rings: 256,
         segments: 512,
     };
@@ -241,7 +241,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     let sel = &report.selection;
     assert_eq!(
         sel.rows.iter().map(|r| r.instances).collect::<Vec<_>>(),
-        lodkit_cli::demo::selection::SIZES
+        lodkit_cli::demo::measures::selection::SIZES
     );
     assert!(
         sel.rows
@@ -490,7 +490,10 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
 
     // The generated chain: a row per level, the picture the page shows.
     let chain = report.chain.as_ref().expect("the chain scene's report");
-    assert_eq!(chain.levels.len(), lodkit_cli::demo::chain::levels());
+    assert_eq!(
+        chain.levels.len(),
+        lodkit_cli::demo::fixtures::lod_chain::levels()
+    );
     assert!(out.join(&chain.picture).is_file());
 
     // Framebuffer LOD at --fb-size: every pass of every configuration timed, the sweep's shading
@@ -521,9 +524,12 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     // the online controller at r = 1.0 for the whole run). That is a figure, reported here and
     // in the demo's tables, not a verdict; the controllers' pass/fail tests drive them with
     // modelled frame times (`upsampling::measure_controllers`, lodkit_bevy's controller test).
-    let step = lodkit_cli::demo::closed_loop::STEP_FRAME;
+    let step = lodkit_cli::demo::measures::closed_loop::STEP_FRAME;
     for run in closed.repeats.iter().flatten() {
-        assert_eq!(run.ms.len(), lodkit_cli::demo::closed_loop::FRAMES);
+        assert_eq!(
+            run.ms.len(),
+            lodkit_cli::demo::measures::closed_loop::FRAMES
+        );
         let distinct = |rs: &[f32]| {
             let mut v = rs.to_vec();
             v.sort_by(f32::total_cmp);
@@ -616,7 +622,8 @@ const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// Counts one fullscreen triangle over a `w` x `h` target.
 fn count_fullscreen(gpu: &lodkit::gpu::GpuContext, w: u32, h: u32) -> (CounterKind, u64) {
-    let pipeline = lodkit_cli::demo::timing::plain_pass(gpu, FLAT, "flat.wgsl").unwrap();
+    let pipeline =
+        lodkit_cli::demo::measures::upsample_timing::plain_pass(gpu, FLAT, "flat.wgsl").unwrap();
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
     let target = lodkit::gpu::resources::texture_2d(gpu, (w, h), FORMAT, usage, "t").unwrap();
     let view = target.create_view(&Default::default());

@@ -9,8 +9,11 @@ use crate::support::say;
 #[test]
 fn chain_scene_stands_each_transition_at_its_switch_distance() {
     use lodkit::lod_chain::projected_error;
-    use lodkit_cli::demo::chain::{CAMERA, chain, scene};
-    use lodkit_cli::demo::scene::Shape;
+    use lodkit_cli::demo::fixtures::scene::Shape;
+    use lodkit_cli::demo::fixtures::{
+        chain_scene::scene,
+        lod_chain::{CAMERA, chain},
+    };
     let scene = scene();
     let radius = chain().bounding_sphere().radius;
     let eye = glam::Vec3::from(scene.camera.eye);
@@ -43,7 +46,7 @@ fn chain_scene_stands_each_transition_at_its_switch_distance() {
         );
         seen += 1;
     }
-    assert_eq!(seen, lodkit_cli::demo::chain::levels() - 1);
+    assert_eq!(seen, lodkit_cli::demo::fixtures::lod_chain::levels() - 1);
 }
 
 /// The report's picture of the levels shows each level as a sphere: in every panel the shaded
@@ -51,7 +54,7 @@ fn chain_scene_stands_each_transition_at_its_switch_distance() {
 /// sphere, so between 0.94 / 1.06 of that for the bumps: 0.55-0.72 of the panel).
 #[test]
 fn chain_picture_shows_every_level() {
-    use lodkit_cli::demo::chain::{levels, levels_picture};
+    use lodkit_cli::demo::{fixtures::lod_chain::levels, measures::lod_chain::levels_picture};
     let size = 64;
     let picture = levels_picture(size);
     assert_eq!(picture.dimensions(), (size * levels() as u32, size));

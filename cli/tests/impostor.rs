@@ -1,15 +1,15 @@
 //! The demo's alpha-tested billboard impostor: the mask baked from the tree, and impostor
 //! scenes read from RON.
 
-use lodkit_cli::demo::scene::DemoScene;
+use lodkit_cli::demo::fixtures::scene::DemoScene;
 
 use crate::support::say;
 
 #[test]
 fn a_baked_impostor_mask_is_its_trees_silhouette() {
     use lodkit::alpha_mask::alpha_mask_keep;
-    use lodkit_cli::demo::impostor::{MASK_SIZE, bake};
-    use lodkit_cli::demo::scene::Shape;
+    use lodkit_cli::demo::fixtures::impostor::{MASK_SIZE, bake};
+    use lodkit_cli::demo::fixtures::scene::Shape;
     use lodkit_scenes::mesh::MeshRenderer;
     let gpu = lodkit_test_gpu!();
     let renderer = MeshRenderer::new(gpu, false).unwrap();
@@ -40,7 +40,7 @@ fn a_baked_impostor_mask_is_its_trees_silhouette() {
 
 #[test]
 fn an_impostor_scene_reads_from_ron() {
-    use lodkit_cli::demo::scene::Shape;
+    use lodkit_cli::demo::fixtures::scene::Shape;
     let text = "(name: \"card\", camera: (eye: (0.0, 1.0, 6.0), target: (0.0, 0.0, 0.0), \
         moving_eye: (1.0, 1.0, 5.0)), objects: [(fine: Tree(puffs: 5, rings: 6), \
         coarse: Impostor(puffs: 5, rings: 6), fine_color: (0.2, 0.6, 0.2), \
@@ -60,7 +60,7 @@ fn an_impostor_scene_reads_from_ron() {
 
 #[test]
 fn a_scene_with_two_kinds_of_impostor_is_refused() {
-    use lodkit_cli::demo::scene::Shape;
+    use lodkit_cli::demo::fixtures::scene::Shape;
     let mut scene = DemoScene::field();
     assert_eq!(scene.check(), Ok(()));
     let last = scene.objects.len() - 1;

@@ -6,43 +6,39 @@
 //! ```no_run
 //! let options = lodkit_cli::demo::DemoOptions::default();
 //! let report = lodkit_cli::demo::run(&options)?;
-//! println!("{}", lodkit_cli::demo::terminal::summary(&report));
+//! println!("{}", lodkit_cli::demo::report::terminal::summary(&report));
 //! # Ok::<(), lodkit_cli::demo::DemoError>(())
 //! ```
 
-pub mod chain;
-pub mod chain_levels;
-pub mod clock;
-pub mod closed_loop;
-pub mod combine_timing;
-pub mod cpu;
-pub mod doc_pictures;
-pub mod edge_frame;
-pub mod frame_cost;
-pub mod gpu_report;
-pub mod impostor;
-pub mod packed_timing;
-pub mod plots;
-pub mod reads;
-pub mod render;
+//! Three layers, each importing only from those below it (`integration_tests/house.rs` checks):
+//! - [`fixtures`]: the scenes, their renderers, the edge-scene frame every framebuffer-LOD timing
+//!   reads, the GPU clock;
+//! - [`measures`]: each figure of the report, returned as a serializable struct;
+//! - [`report`]: the HTML page, the Markdown pages, the plots, the tables and the terminal
+//!   summary.
+//!
+//! [`error`] is beneath all three; this module runs them in order.
+
+pub mod error;
+pub mod fixtures;
+pub mod measures;
 pub mod report;
-pub mod report_fb;
-pub mod scene;
-pub mod selection;
-pub mod table;
-pub mod technique;
-pub mod terminal;
-pub mod timing;
-pub mod transitions;
-pub mod upsampling;
 
-use std::path::{Path, PathBuf};
-
-use serde::Serialize;
+use std::path::PathBuf;
 
 use lodkit::gpu::{GpuContext, GpuError, GpuOptions};
-use lodkit::shaders::ShaderError;
-use scene::{DemoScene, SceneError};
+
+pub use error::{DemoError, save};
+use fixtures::chain_scene;
+use fixtures::clock::{self, RECORDINGS};
+use fixtures::render;
+use fixtures::scene::{DemoScene, SceneError};
+pub use measures::DemoReport;
+use measures::{
+    closed_loop, combine_timing, controllers, frame_cost, host_cost, lod_chain,
+    packed_upsample_timing, selection, transitions, upsample_quality, upsample_timing,
+};
+use report::{doc_pictures, framebuffer_lod, plots};
 
 /// What `lodkit demo` renders and where it writes.
 #[derive(Clone, Debug)]
@@ -104,119 +100,6 @@ impl Default for DemoOptions {
         }
     }
 }
-
-/// Why the demo stopped.
-#[derive(Debug, thiserror::Error)]
-pub enum DemoError {
-    /// No GPU adapter at all.
-    #[error(
-        "{source}\n\nlodkit demo needs a GPU adapter: a GPU driver with Vulkan, or the software \
-         rasterizers. On Debian/Ubuntu: `sudo apt-get install mesa-vulkan-drivers libvulkan1` \
-         (lavapipe); for OpenGL, `libegl1 libgl1-mesa-dri` and LODKIT_BACKEND=gl. On a desktop \
-         without a session bus set XDG_RUNTIME_DIR to a private folder."
-    )]
-    NoAdapter {
-        /// What wgpu said.
-        #[source]
-        source: GpuError,
-    },
-    /// The device could not be created.
-    #[error(transparent)]
-    Gpu(#[from] GpuError),
-    /// A lodkit pass did not compose (a bug: please report it).
-    #[error("a lodkit pass does not compose: {0}")]
-    Shader(#[from] ShaderError),
-    /// The scene file.
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    /// An option out of range.
-    #[error("{0}")]
-    Options(String),
-    /// Writing output.
-    #[error("{path}: {message}")]
-    Io {
-        /// The file or folder.
-        path: String,
-        /// What failed.
-        message: String,
-    },
-    /// Drawing a plot.
-    #[error("plot: {0}")]
-    Plot(String),
-    /// An inconsistency inside the harness.
-    #[error("internal: {0}")]
-    Internal(String),
-}
-
-impl DemoError {
-    fn io(path: &Path, e: impl std::fmt::Display) -> Self {
-        DemoError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        }
-    }
-}
-
-/// Saves `image` as PNG at `path`, creating folders.
-pub fn save(image: &image::RgbaImage, path: &Path) -> Result<(), DemoError> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| DemoError::io(dir, e))?;
-    }
-    image.save(path).map_err(|e| DemoError::io(path, e))
-}
-
-/// Everything the demo measured.
-#[derive(Clone, Debug, Serialize)]
-pub struct DemoReport {
-    /// Adapter name, backend, driver.
-    pub adapter: String,
-    /// The driver and its version, as the adapter reports them.
-    pub driver: String,
-    /// The clock the timed figures were read from (GPU timestamps where the device has them).
-    pub clock: clock::Clock,
-    /// Backend (Vulkan, Gl, ...).
-    pub backend: String,
-    /// Device type (Cpu = software rasterizer).
-    pub device_type: String,
-    /// UTC date of the run, YYYY-MM-DD.
-    pub date: String,
-    /// The command line that reproduces the run.
-    pub command: String,
-    /// Image size.
-    pub size: (u32, u32),
-    /// Transition length in frames.
-    pub frames: usize,
-    /// What the fragment counts count.
-    pub counter: String,
-    /// Scenes measured.
-    pub scenes: Vec<String>,
-    /// Transition metrics, scene by scene, technique by technique.
-    pub transitions: Vec<transitions::TransitionMetrics>,
-    /// Framebuffer LOD quality and speed.
-    pub upsampling: Vec<upsampling::UpsampleRow>,
-    /// Pass time ratios.
-    pub pass_ratios: Vec<timing::PassRatio>,
-    /// Framebuffer LOD: where a frame's time goes, and the speed-up against shading cost.
-    pub frame_cost: frame_cost::FrameCost,
-    /// Framebuffer LOD: the controllers on the real frame.
-    pub closed_loop: closed_loop::ClosedLoop,
-    /// Framerate controllers (simulated).
-    pub controllers: Vec<upsampling::ControllerRow>,
-    /// GPU LOD selection against `select_batch`.
-    pub selection: selection::SelectionReport,
-    /// Host-side figures (composition, selection).
-    pub cpu: Vec<cpu::CpuFigure>,
-    /// The generated LOD chain's levels, when its scene was measured.
-    pub chain: Option<chain::ChainReport>,
-    /// Whether the plots have text (a font was found).
-    pub plot_text: bool,
-    /// Wall time of the whole run, seconds.
-    pub seconds: f64,
-}
-
-/// Recordings of a pass per timed run: the run shares one encoder and one submission, so the
-/// submission's fixed cost is spread over them (and, on GPU timestamps, not counted at all).
-pub const RECORDINGS: usize = 8;
 
 /// The most memory the frames of one run may take.
 pub const MAX_FRAME_MEMORY_MIB: u64 = 2048;
@@ -303,7 +186,8 @@ pub fn run_on(
     let start = std::time::Instant::now();
     let out = &options.out;
     std::fs::create_dir_all(out).map_err(|e| DemoError::io(out, e))?;
-    let steps = scenes.len() * render::Technique::ALL.len() + upsampling::RESIZE_FACTORS.len() + 7;
+    let steps =
+        scenes.len() * render::Technique::ALL.len() + upsample_quality::RESIZE_FACTORS.len() + 7;
     let bar = if options.progress {
         indicatif::ProgressBar::new(steps as u64)
     } else {
@@ -345,7 +229,7 @@ pub fn run_on(
     let rounds = (options.timing_pairs / 4).max(3);
     let timer = clock::Timer::new(gpu, RECORDINGS)?;
     let upsampling =
-        upsampling::measure_upsampling(gpu, &timer, options.size, rounds, out, &mut tick)?;
+        upsample_quality::measure_upsampling(gpu, &timer, options.size, rounds, out, &mut tick)?;
     bar.set_message("framebuffer LOD: frame cost and shading sweep");
     let frame_cost = frame_cost::measure_frame_cost(gpu, &timer, options.fb_size, rounds)?;
     bar.inc(1);
@@ -358,22 +242,22 @@ pub fn run_on(
     let mut pass_ratios =
         combine_timing::combine_vs_copy(gpu, &timer, combine_size, pairs)?.to_vec();
     let fb_size = options.fb_size;
-    pass_ratios.extend(timing::upsample_vs_bilinear(
+    pass_ratios.extend(upsample_timing::upsample_vs_bilinear(
         gpu, &timer, fb_size, 2.0, pairs,
     )?);
-    pass_ratios.extend(packed_timing::packed_upsample_vs_bilinear(
+    pass_ratios.extend(packed_upsample_timing::packed_upsample_vs_bilinear(
         gpu, &timer, fb_size, 2.0, pairs,
     )?);
     bar.inc(1);
     bar.set_message("controllers and host-side figures");
-    let controllers = upsampling::measure_controllers(upsampling::CONTROLLER_SEEDS);
-    let cpu = cpu::cpu_figures(15)?;
+    let controllers = controllers::measure_controllers(controllers::CONTROLLER_SEEDS);
+    let cpu = host_cost::cpu_figures(15)?;
     bar.inc(1);
     bar.set_message("GPU LOD selection against select_batch");
     let selection = selection::measure(gpu, &timer, 5, &selection::SIZES)?;
     bar.inc(1);
-    let chain = if scenes.iter().any(|s| s.name == chain::SCENE) {
-        Some(chain::report(out)?)
+    let chain = if scenes.iter().any(|s| s.name == chain_scene::SCENE) {
+        Some(lod_chain::report(out)?)
     } else {
         None
     };
@@ -409,7 +293,7 @@ pub fn run_on(
     };
     bar.set_message("plots and report");
     report::write_plots(&report, out)?;
-    report_fb::write_plots(&report, out)?;
+    framebuffer_lod::write_plots(&report, out)?;
     report.seconds = start.elapsed().as_secs_f64();
     report::write_report(&report, out)?;
     if let Some(docs) = &options.docs {
