@@ -12,7 +12,7 @@ use lodkit::combine::{
 };
 use lodkit::combine_coverage::{
     CombineData, CombineDataDescriptor, CombineNewer, CombineObjectData, CoverageRoute,
-    combine_far_depth, combine_new_to_old, combine_object, combine_pixel,
+    combine_far_depth, combine_known_covers, combine_new_to_old, combine_object, combine_pixel,
 };
 use lodkit::lod_buffer::{lod_buffer_id, lod_buffer_word};
 use lodkit::reproject::{reproject, reproject_base};
@@ -24,7 +24,7 @@ use crate::harness::{Probe, Route, Word, assert_twin, floats, run_on, words};
 const W: u32 = 16;
 const H: u32 = 12;
 /// Output words per pixel.
-const OUT: usize = 20;
+const OUT: usize = 21;
 /// The camera moved so that every pixel's center reprojects 0.3 texel right of its own texel's
 /// center (NDC x + 0.3 * 2 / 16): a read lands at x + 0.8 texels, 0.2 texel from any edge.
 const SHIFT: f32 = 0.0375;
@@ -217,6 +217,14 @@ fn twin_words(s: &Scene) -> Vec<u32> {
             w.extend(words(&[offset]));
             w.push(shown);
             w.extend(words(&[snap.x, snap.y]));
+            let p = px.as_vec2() + 0.5;
+            w.push(
+                [SIL, EST, FRONT, 0]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &id)| u32::from(combine_known_covers(texels, id, p)) << k)
+                    .sum(),
+            );
             w
         })
         .collect()
@@ -291,6 +299,17 @@ fn check_known(out: &[u32], s: &Scene, who: &str) {
         "{who}: pixel (6, 7) shows {got}, not the older object in front, {}",
         older(6, 7)
     );
+    // combine_known_covers: only the silhouette t-instance has a known silhouette, the square
+    // from (3, 3) to (10, 9), which holds the centers of pixels 3..=9 x 3..=8 (a center is never
+    // on its integer edges); the estimated t-instance, FRONT (no record) and id 0 never.
+    for (x, y) in (0..W).flat_map(|x| (0..H).map(move |y| (x, y))) {
+        let inside = (3..=9).contains(&x) && (3..=8).contains(&y);
+        assert_eq!(
+            pixel(x, y)[20],
+            u32::from(inside),
+            "{who}: combine_known_covers at pixel ({x}, {y}) (bits: SIL, EST, FRONT, id 0)"
+        );
+    }
     // The ray offset of every read is 0.3 texel; the snap keeps 0.3 and takes 0.995 as 1.
     assert!(
         (f32::from_bits(pixel(0, 0)[16]) - 0.3).abs() < 1e-4,
@@ -351,7 +370,9 @@ fn combine_coverage_twins_match() {
         out_f(16u, combine_ray_offset(a, read, size));
         out_u(17u, combine_displayed_word(newer.word, true, 0.5, newer.pattern));
         let snap = combine_snap(vec2(newer.pattern, 1.0 - newer.pattern * 0.02));
-        out_f(18u, snap.x); out_f(19u, snap.y);"
+        out_f(18u, snap.x); out_f(19u, snap.y);
+        let p = vec2<f32>(px) + 0.5;
+        out_u(20u, select(0u, 1u, combine_known_covers(probe_urgba1, {SIL}u, p)) | select(0u, 2u, combine_known_covers(probe_urgba1, {EST}u, p)) | select(0u, 4u, combine_known_covers(probe_urgba1, {FRONT}u, p)) | select(0u, 8u, combine_known_covers(probe_urgba1, 0u, p)));"
     );
     let glsl = format!(
         "uvec2 px = uvec2(inp_u(0u), inp_u(1u));
@@ -376,7 +397,9 @@ fn combine_coverage_twins_match() {
         out_f(16u, lodkit_combine_ray_offset(a, read, size));
         out_u(17u, lodkit_combine_displayed_word(newer.word, true, 0.5, newer.pattern));
         vec2 snap = lodkit_combine_snap(vec2(newer.pattern, 1.0 - newer.pattern * 0.02));
-        out_f(18u, snap.x); out_f(19u, snap.y);"
+        out_f(18u, snap.x); out_f(19u, snap.y);
+        vec2 p = vec2(px) + 0.5;
+        out_u(20u, (lodkit_combine_known_covers({SIL}u, p) ? 1u : 0u) | (lodkit_combine_known_covers({EST}u, p) ? 2u : 0u) | (lodkit_combine_known_covers({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_known_covers(0u, p) ? 8u : 0u));"
     );
     // The GLSL twins read the textures through the hooks the includer defines.
     let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
@@ -389,7 +412,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
 }";
     let wgsl_header = "#import lodkit::combine::{combine_uv, combine_texel, combine_read_own, combine_cover_texel, combine_other_texel, combine_ray_offset, combine_displayed_word, combine_snap, COMBINE_BLOCK_REACH, COMBINE_COVER_REACH}
-#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth}
+#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers}
 #import lodkit::reproject::{reproject, reproject_base}
 #import lodkit::silhouette::silhouette_covers";
     // Texels, flags and ids exact; colors are sums of at most four weighted texels (weights
@@ -403,6 +426,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     // The snap passes its input through or rounds it; the input 1 - 0.02 p may be computed with
     // a fused multiply-add on the GPU (an ulp apart, ~1.2e-7 near 1): 1e-6.
     kinds.extend([Word::Float(1e-6); 2]);
+    kinds.push(Word::Exact);
     // The fragment route on every device (GL 3.3 and WebGL2 class contexts have no compute), and
     // the compute route where compute shaders work.
     let mut routes = vec![Route::Fragment];
