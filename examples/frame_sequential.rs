@@ -8,7 +8,7 @@
 //!    instance whose level changes begins a time-driven transition;
 //! 2. `draw(key)` gives each instance this frame's LOD, id and visibility threshold tau; the
 //!    scene goes into LOD buffer `buffer_index()` (your forward pass writes color, id and depth;
-//!    `LodBufferRenderer` is lodkit's reference for it);
+//!    `lodkit_scenes::lod_buffer::LodBufferRenderer` is the reference for it);
 //! 3. `CombinePass::record` (with `CombineRegions::Only`) merges that buffer with last frame's,
 //!    reprojected through the camera motion (`new_to_old_matrix`), into the frame's target, only
 //!    inside the screen rectangles of the instances in transition (the rest of the frame is a

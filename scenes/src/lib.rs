@@ -9,6 +9,8 @@
 //! - [`gbuffer`]: the low-resolution (or full-resolution prepass) G-buffer pass of framebuffer
 //!   LOD, and the edge scene its measures use.
 
+#![warn(missing_docs)]
+
 pub mod gbuffer;
 pub mod lod_buffer;
 pub mod mesh;

@@ -7,7 +7,11 @@
 //!
 //! The public ones are for an engine's own passes beside lodkit's (the reference renderers of
 //! the `lodkit-scenes` crate call them), so that they refuse what lodkit's passes refuse, with
-//! the same errors.
+//! the same errors. Each takes the `call` (the function the user called, e.g.
+//! `"MyPass::new"`) and, where a value is checked, the `parameter` that holds it; the error
+//! names both. [`texture_extent`] returns [`GpuError::TooLarge`], [`check_color_format`] and
+//! [`check_low_res_format`] [`GpuError::UnsupportedFormat`], [`same_color_format`]
+//! [`GpuError::Mismatch`].
 
 use super::{GpuContext, GpuError};
 

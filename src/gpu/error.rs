@@ -143,7 +143,8 @@ pub enum GpuError {
         /// wgpu's message.
         message: String,
     },
-    /// More draw items than one call of a renderer takes (its `MAX_DRAWS`). Nothing was drawn:
+    /// More draw items than one call of a renderer takes (its `MAX_DRAWS`; raised through
+    /// `DrawUniforms::check_count`, by the `lodkit-scenes` reference renderers). Nothing was drawn:
     /// split the items over several calls (the later ones loading what the first drew), or
     /// merge meshes.
     #[error("{call}: {count} draw items, but one call draws at most {max} (MAX_DRAWS)")]

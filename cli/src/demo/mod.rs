@@ -1,4 +1,4 @@
-//! The quality and cost harness behind `lodkit demo` (feature `demo`): renders the built-in
+//! The quality and cost harness behind `lodkit demo`: renders the built-in
 //! scenes (or a RON scene) headless with every technique, measures pop, see-through, cost, pass
 //! time ratios and framebuffer-LOD quality, and writes images, PNG plots, `report.json` and a
 //! browsable `index.html`; optionally regenerates `docs/benchmarks.md` and `docs/quality.md`.
@@ -9,10 +9,10 @@
 //! println!("{}", lodkit_cli::demo::report::terminal::summary(&report));
 //! # Ok::<(), lodkit_cli::demo::DemoError>(())
 //! ```
-
+//!
 //! Three layers, each importing only from those below it (`integration_tests/house.rs` checks):
-//! - [`fixtures`]: the scenes, their renderers, the edge-scene frame every framebuffer-LOD timing
-//!   reads, the GPU clock;
+//! - [`fixtures`]: the scenes, their renderers, the edge-scene frame the pass ratios, the frame
+//!   cost and the closed loop read, the GPU clock;
 //! - [`measures`]: each figure of the report, returned as a serializable struct;
 //! - [`report`]: the HTML page, the Markdown pages, the plots, the tables and the terminal
 //!   summary.

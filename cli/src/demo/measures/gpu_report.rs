@@ -2,8 +2,9 @@
 //! timestamps where the device has them: the pass ratios at 1920x1080 and 3840x2160 (the
 //! bilateral upsample, its loads and the packed L against bilinear; the combine against a copy
 //! of its textures at 1024^2 and 2048^2), the whole-frame cost sweep of framebuffer LOD at
-//! 1920x1080, and GPU selection from 10^4 to 10^7 instances against `select_batch`. Writes
-//! `gpu-report.json` and `gpu-report.md`; `scripts/gpu-report.sh` adds the test binaries' runs.
+//! 1920x1080, and GPU selection from 10^4 to 10^7 instances against `select_batch`, returned as a
+//! [`GpuReport`] (`report::gpu_report` writes `gpu-report.json` and `gpu-report.md`;
+//! `scripts/gpu-report.sh` adds the test binaries' runs).
 //! `--quick` measures small sizes for a test on the software GPU.
 
 use serde::Serialize;

@@ -1,4 +1,4 @@
-//! The report's selection section: GPU LOD selection (`GpuLodSelector`, the compute pass
+//! GPU LOD selection measured (`GpuLodSelector`, the compute pass
 //! `passes/select.wgsl`) against `select_batch` on one core, in the same run, over the same
 //! instances and camera path; the bytes the pass moves per instance, counted from the shader;
 //! and what a GPU at a stated memory bandwidth would take, on paper.

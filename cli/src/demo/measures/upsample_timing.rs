@@ -2,9 +2,9 @@
 //! interleaved pairs so machine noise hits both alike: the bilateral upsample against a
 //! hardware-filtered bilinear fetch (the combine's timings are in
 //! [`combine_timing`](crate::demo::measures::combine_timing), the packed upsample's in
-//! [`packed_timing`](crate::demo::measures::packed_upsample_timing)). Each figure is read from the
-//! [`Clock`](crate::demo::fixtures::clock::Clock) it names: GPU timestamps around a run of recordings where the
-//! device has them, so the submission's fixed cost sits on neither side of a ratio; the wall
+//! [`packed_upsample_timing`](crate::demo::measures::packed_upsample_timing)). Each figure is
+//! read from the [`Clock`](crate::demo::fixtures::clock::Clock) it names: GPU timestamps around
+//! a run of recordings where the device has them, so the submission's fixed cost sits on neither side of a ratio; the wall
 //! clock otherwise.
 
 use serde::Serialize;

@@ -1,4 +1,4 @@
-//! `lodkit demo --gpu-report`'s files: `gpu-report.json` and `gpu-report.md`.
+//! `lodkit gpu-report`'s files: `gpu-report.json` and `gpu-report.md`.
 
 use std::path::Path;
 
