@@ -4,10 +4,10 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::demo::fixtures::clock::{Record, Timer, interleaved};
+use crate::demo::fixtures::clock::{Record, Timer};
 use crate::demo::fixtures::edge_frame::FORMAT;
 use crate::demo::measures::reads::{Reads, Texels};
-use crate::demo::measures::upsample_timing::{PassRatio, plain_pass_with, record_fullscreen};
+use crate::demo::measures::upsample_timing::{PassRatio, Side, plain_pass_with, record_fullscreen};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LOD_DEPTH_FORMAT, LodBuffers,
 };
@@ -234,20 +234,20 @@ pub fn combine_vs_copy(
                 reads: Reads,
                 run: Record<'_>,
                 (baseline, run_baseline, baseline_reads): &Baseline| {
-        let (pass_ms, baseline_ms, ratio) = interleaved(gpu, timer, run, *run_baseline, pairs)?;
-        Ok::<_, GpuError>(PassRatio {
-            pass: pass.to_owned(),
-            baseline: (*baseline).to_owned(),
-            size: (size, size),
-            pass_ms,
-            baseline_ms,
-            ratio,
+        let name = pass.to_owned();
+        let baseline = Side {
+            name: (*baseline).to_owned(),
+            reads: *baseline_reads,
+            run: *run_baseline,
+        };
+        PassRatio::time(
+            gpu,
+            timer,
+            (size, size),
             pairs,
-            clock: timer.clock(),
-            recordings: timer.recordings(),
-            pass_reads: reads,
-            baseline_reads: *baseline_reads,
-        })
+            Side { name, reads, run },
+            &baseline,
+        )
     };
     Ok([
         time(

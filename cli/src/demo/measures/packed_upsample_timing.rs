@@ -3,10 +3,12 @@
 //! floor of any packed eq. 1), and the fold-in upsample inside a composite pass against the same
 //! composite with a bilinear sample. Same host work on both sides ([`crate::demo::measures::upsample_timing::HOST_WORK`]).
 
-use crate::demo::fixtures::clock::{Record, Timer, interleaved};
+use crate::demo::fixtures::clock::{Record, Timer};
 use crate::demo::fixtures::edge_frame::{EdgeFrame, FORMAT};
 use crate::demo::measures::reads::{Reads, Texels};
-use crate::demo::measures::upsample_timing::{BILINEAR, PassRatio, plain_pass, record_fullscreen};
+use crate::demo::measures::upsample_timing::{
+    BILINEAR, PassRatio, Side, plain_pass, record_fullscreen,
+};
 use lodkit::gbuffer::{GEOMETRY_FORMAT, PACKED_FORMAT};
 use lodkit::gpu::resources::{textures_and_uniform, uniform_buffer};
 use lodkit::gpu::{GpuContext, GpuError};
@@ -161,26 +163,25 @@ pub fn packed_upsample_vs_bilinear(
         "composite_bilinear.wgsl",
         &bilinear_bound,
     )?;
-    let time = |pass: String,
+    let time = |name: String,
                 reads: Reads,
                 run: Record<'_>,
                 baseline: &str,
                 baseline_reads: Reads,
                 run_baseline: Record<'_>| {
-        let (pass_ms, baseline_ms, ratio) = interleaved(gpu, timer, run, run_baseline, pairs)?;
-        Ok::<_, GpuError>(PassRatio {
-            pass,
-            baseline: baseline.to_owned(),
+        let baseline = Side {
+            name: baseline.to_owned(),
+            reads: baseline_reads,
+            run: run_baseline,
+        };
+        PassRatio::time(
+            gpu,
+            timer,
             size,
-            pass_ms,
-            baseline_ms,
-            ratio,
             pairs,
-            clock: timer.clock(),
-            recordings: timer.recordings(),
-            pass_reads: reads,
-            baseline_reads,
-        })
+            Side { name, reads, run },
+            &baseline,
+        )
     };
     let bilinear_name = "bilinear upsample (hardware filter)";
     Ok([

@@ -9,7 +9,7 @@
 
 use serde::Serialize;
 
-use crate::demo::fixtures::clock::{Clock, Timer, interleaved};
+use crate::demo::fixtures::clock::{Clock, Record, Timer, interleaved};
 use crate::demo::fixtures::edge_frame::{EdgeFrame, FORMAT};
 use crate::demo::measures::reads::{Reads, Texels};
 use lodkit::gbuffer::GEOMETRY_FORMAT;
@@ -45,6 +45,44 @@ pub struct PassRatio {
     pub pass_reads: Reads,
     /// Texture reads per output pixel of the baseline.
     pub baseline_reads: Reads,
+}
+
+/// One side of a timed pair: what it is called, its texture reads per pixel, its recording.
+pub struct Side<'a> {
+    /// The pass's name in the report.
+    pub name: String,
+    /// Its texture reads per output pixel.
+    pub reads: Reads,
+    /// One recording of it.
+    pub run: Record<'a>,
+}
+
+impl PassRatio {
+    /// Times `pass` against `baseline` in `pairs` interleaved pairs ([`interleaved`]) on images
+    /// of `size`.
+    pub fn time(
+        gpu: &GpuContext,
+        timer: &Timer,
+        size: (u32, u32),
+        pairs: usize,
+        pass: Side<'_>,
+        baseline: &Side<'_>,
+    ) -> Result<Self, GpuError> {
+        let (pass_ms, baseline_ms, ratio) = interleaved(gpu, timer, pass.run, baseline.run, pairs)?;
+        Ok(PassRatio {
+            pass: pass.name,
+            baseline: baseline.name.clone(),
+            size,
+            pass_ms,
+            baseline_ms,
+            ratio,
+            pairs,
+            clock: timer.clock(),
+            recordings: timer.recordings(),
+            pass_reads: pass.reads,
+            baseline_reads: baseline.reads,
+        })
+    }
 }
 
 pub use crate::demo::fixtures::clock::median;
@@ -214,21 +252,20 @@ pub fn upsample_vs_bilinear(
         "bilinear.wgsl",
         &[("low_color", FORMAT, Texels::Linear)],
     )?;
-    let time = |pass: String, reads: Reads, run: crate::demo::fixtures::clock::Record<'_>| {
-        let (pass_ms, baseline_ms, ratio) = interleaved(gpu, timer, run, &run_bilinear, pairs)?;
-        Ok::<_, GpuError>(PassRatio {
-            pass,
-            baseline: "bilinear upsample (hardware filter)".to_owned(),
+    let bilinear = Side {
+        name: "bilinear upsample (hardware filter)".to_owned(),
+        reads: bilinear_reads,
+        run: &run_bilinear,
+    };
+    let time = |name: String, reads: Reads, run: Record<'_>| {
+        PassRatio::time(
+            gpu,
+            timer,
             size,
-            pass_ms,
-            baseline_ms,
-            ratio,
             pairs,
-            clock: timer.clock(),
-            recordings: timer.recordings(),
-            pass_reads: reads,
-            baseline_reads: bilinear_reads,
-        })
+            Side { name, reads, run },
+            &bilinear,
+        )
     };
     Ok([
         time(
