@@ -85,6 +85,7 @@
 //! at most [`MAX_TAG_ID`] groups in transition at once (more switch at once, with a warning);
 //! the combine reads a storage buffer in its fragment shader, which WebGL2 does not offer.
 
+mod data;
 mod material;
 mod older_depth;
 mod rects;
@@ -99,7 +100,7 @@ use bevy::camera::Hdr;
 use bevy::pbr::MaterialPlugin;
 use bevy::prelude::*;
 use bevy::render::RenderApp;
-use bevy::render::extract_component::{ExtractComponentPlugin, UniformComponentPlugin};
+use bevy::render::extract_component::ExtractComponentPlugin;
 use lodkit::frame_sequential::Schedule;
 use lodkit::select::{LodGroup, LodSettings};
 
@@ -150,7 +151,6 @@ impl Plugin for FrameSequentialLodPlugin {
         app.add_plugins((
             MaterialPlugin::<FrameSequentialMaterial>::default(),
             ExtractComponentPlugin::<view::FrameSequentialView>::default(),
-            UniformComponentPlugin::<view::CombineParams>::default(),
         ));
         select::build(app);
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {

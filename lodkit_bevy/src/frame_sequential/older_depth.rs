@@ -18,7 +18,7 @@ use bevy::render::render_resource::*;
 use bevy::render::renderer::{RenderDevice, RenderQueue};
 use bevy::render::view::ExtractedView;
 
-use super::view::{CombineParams, FrameSequentialView};
+use super::view::FrameSequentialView;
 
 /// Name of the pass in Bevy's render diagnostics (`render/<name>/...`).
 pub const OLDER_DEPTH_PASS: &str = "lodkit_frame_sequential_older_depth";
@@ -105,6 +105,9 @@ pub struct OlderDepthDraws {
     uniforms: DynamicUniformBuffer<OlderLevelUniform>,
     bind_group: Option<BindGroup>,
     draws: Vec<(CachedRenderPipelineId, AssetId<Mesh>, u32)>,
+    /// Whether every older level is drawn this frame (no pipeline still compiling, no mesh
+    /// still uploading): only then does the combine read the pass (else it estimates).
+    pub(super) ready: bool,
 }
 
 #[allow(
@@ -123,11 +126,10 @@ pub(super) fn prepare_draws(
         Entity,
         &ExtractedView,
         &FrameSequentialView,
-        &mut CombineParams,
         Option<&mut OlderDepthDraws>,
     )>,
 ) {
-    for (entity, view, frame, mut params, kept) in &mut views {
+    for (entity, view, frame, kept) in &mut views {
         if !frame.exact_coverage {
             if kept.is_some() {
                 commands.entity(entity).remove::<OlderDepthDraws>();
@@ -146,6 +148,7 @@ pub(super) fn prepare_draws(
             uniforms,
             bind_group,
             draws,
+            ready: ready_of_view,
         } = draws_of_view;
         uniforms.clear();
         draws.clear();
@@ -184,7 +187,7 @@ pub(super) fn prepare_draws(
                 &BindGroupEntries::single(binding),
             )
         });
-        params.set_exact_coverage(ready);
+        *ready_of_view = ready;
         if is_new {
             commands.entity(entity).insert(fresh);
         }

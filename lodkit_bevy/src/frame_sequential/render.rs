@@ -11,22 +11,21 @@ use bevy::ecs::query::QueryItem;
 use bevy::log::warn_once;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RecordDiagnostics;
-use bevy::render::extract_component::{ComponentUniforms, DynamicUniformIndex, ExtractComponent};
+use bevy::render::extract_component::ExtractComponent;
 use bevy::render::mesh::RenderMesh;
 use bevy::render::mesh::allocator::MeshAllocator;
 use bevy::render::render_asset::RenderAssets;
-use bevy::render::render_resource::binding_types::{
-    storage_buffer_read_only_sized, texture_2d, texture_depth_2d, uniform_buffer,
-};
+use bevy::render::render_resource::binding_types::{texture_2d, texture_depth_2d};
 use bevy::render::render_resource::*;
-use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
+use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::sync_component::SyncComponent;
 use bevy::render::texture::{FallbackImage, GpuImage};
 use bevy::render::view::{ExtractedView, ViewDepthStencilTexture, ViewTarget};
 use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
 
+use super::data::combine_data;
 use super::older_depth::{self, OLDER_DEPTH_PASS, OlderDepthDraws, OlderDepthPipeline};
-use super::view::{CombineParams, FrameSequentialView};
+use super::view::FrameSequentialView;
 
 /// Name of the combine pass in Bevy's render diagnostics: with `RenderDiagnosticsPlugin`,
 /// `render/<name>/elapsed_gpu` and `render/<name>/fragment_shader_invocations`.
@@ -35,7 +34,6 @@ pub const COMBINE_PASS: &str = "lodkit_frame_sequential_combine";
 impl SyncComponent<RenderApp> for FrameSequentialView {
     type Target = (
         FrameSequentialView,
-        CombineParams,
         FrameSequentialTextures,
         CombineBindGroup,
         CombinePipelineId,
@@ -46,19 +44,10 @@ impl SyncComponent<RenderApp> for FrameSequentialView {
 impl ExtractComponent<RenderApp> for FrameSequentialView {
     type QueryData = &'static FrameSequentialView;
     type QueryFilter = ();
-    type Out = (FrameSequentialView, CombineParams);
+    type Out = FrameSequentialView;
 
     fn extract_component(view: QueryItem<'_, '_, Self::QueryData>) -> Option<Self::Out> {
-        let params = CombineParams {
-            new_to_old: view.new_to_old,
-            flags: UVec4::new(
-                u32::from(view.motion_vectors),
-                u32::from(view.exact_coverage),
-                0,
-                0,
-            ),
-        };
-        Some((view.clone(), params))
+        Some(view.clone())
     }
 }
 
@@ -99,21 +88,25 @@ pub struct CombinePipeline {
 impl FromWorld for CombinePipeline {
     fn from_world(world: &mut World) -> Self {
         let color = texture_2d(TextureSampleType::Float { filterable: false });
+        let words = texture_2d(TextureSampleType::Uint);
         let layout = BindGroupLayoutDescriptor::new(
             "lodkit_frame_sequential_combine",
             &BindGroupLayoutEntries::sequential(
                 ShaderStages::FRAGMENT,
                 (
+                    // newer color and depth
                     color,
                     texture_depth_2d(),
+                    // older color, id words and depth (Depth32Float read as unfilterable float)
+                    color,
+                    words,
+                    color,
+                    // motion vectors, the visibility pattern, the older-level depth pass
+                    color,
                     color,
                     texture_depth_2d(),
-                    color,
-                    uniform_buffer::<CombineParams>(true),
-                    storage_buffer_read_only_sized(false, None),
-                    texture_2d(TextureSampleType::Float { filterable: false }),
-                    texture_depth_2d(),
-                    storage_buffer_read_only_sized(false, None),
+                    // lodkit::combine_coverage::CombineData
+                    words,
                 ),
             ),
         );
@@ -138,11 +131,18 @@ impl SpecializedRenderPipeline for CombinePipeline {
                 // Bevy's depth is reversed: 1 near, 0 far.
                 shader_defs: vec!["LODKIT_REVERSE_Z".into()],
                 entry_point: Some("fragment".into()),
-                targets: vec![Some(ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: ColorWrites::ALL,
-                })],
+                targets: vec![
+                    Some(ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: ColorWrites::ALL,
+                    }),
+                    Some(ColorTargetState {
+                        format: ID_FORMAT,
+                        blend: None,
+                        write_mask: ColorWrites::ALL,
+                    }),
+                ],
                 ..default()
             }),
             ..default()
@@ -167,13 +167,19 @@ fn prepare_pipelines(
     }
 }
 
-/// The two frames' copies (color with id words, depth), used in turn as newer and older.
+/// The format of the id-word target the combine writes (the next frame's older ids).
+const ID_FORMAT: TextureFormat = TextureFormat::R32Uint;
+
+/// The two frames' copies (color with id words, depth) and id words, used in turn as newer and
+/// older.
 #[derive(Component)]
 pub struct FrameSequentialTextures {
     size: UVec2,
     format: TextureFormat,
     color: [(Texture, TextureView); 2],
     depth: [(Texture, TextureView); 2],
+    /// The id words the combine writes over its region (0 elsewhere).
+    ids: [(Texture, TextureView); 2],
     /// The older-level depth pass's target: the camera's size with exact coverage, else one
     /// texel (bound, never read).
     older_level_depth: (Texture, TextureView),
@@ -235,11 +241,20 @@ fn prepare_textures(
                 size,
             )
         };
+        let ids = || {
+            make(
+                "lodkit_frame_sequential_ids",
+                ID_FORMAT,
+                TextureUsages::RENDER_ATTACHMENT,
+                size,
+            )
+        };
         commands.entity(entity).insert(FrameSequentialTextures {
             size,
             format,
             color: [color(), color()],
             depth: [depth(), depth()],
+            ids: [ids(), ids()],
             older_level_depth: make(
                 OLDER_DEPTH_PASS,
                 CORE_3D_DEPTH_FORMAT,
@@ -255,6 +270,15 @@ fn prepare_textures(
 #[derive(Component)]
 pub struct CombineBindGroup(BindGroup);
 
+/// What `prepare_bind_groups` reads of a camera.
+type BindGroupView = (
+    Entity,
+    &'static FrameSequentialView,
+    &'static FrameSequentialTextures,
+    Option<&'static ViewPrepassTextures>,
+    Option<&'static OlderDepthDraws>,
+);
+
 #[allow(
     clippy::too_many_arguments,
     reason = "one system's render-world inputs"
@@ -262,45 +286,57 @@ pub struct CombineBindGroup(BindGroup);
 fn prepare_bind_groups(
     mut commands: Commands,
     device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
     cache: Res<PipelineCache>,
     pipeline: Res<CombinePipeline>,
-    params: Res<ComponentUniforms<CombineParams>>,
     fallback: Res<FallbackImage>,
     images: Res<RenderAssets<GpuImage>>,
-    views: Query<(
-        Entity,
-        &FrameSequentialView,
-        &FrameSequentialTextures,
-        Option<&ViewPrepassTextures>,
-    )>,
+    views: Query<BindGroupView>,
 ) {
-    let Some(params) = params.uniforms().binding() else {
-        return;
-    };
     let Some(visibility) = images.get(&super::VISIBILITY_TEXTURE) else {
         return;
     };
-    for (entity, view, textures, prepass) in &views {
+    for (entity, view, textures, prepass, older) in &views {
         let motion = match prepass.and_then(ViewPrepassTextures::motion_vectors_view) {
             Some(motion) => motion,
             None if view.motion_vectors => {
                 warn_once!("FrameSequentialLod: the motion-vector prepass has no texture yet");
                 continue;
             }
-            // Not read (flags.x = 0): any texture of the layout's type.
+            // Not read (no COMBINE_OBJECT_MOTION): any texture of the layout's type.
             None => &fallback.d2.texture_view,
         };
-        let (objects, segments) = object_data(view);
-        let object_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
-            label: Some("lodkit_frame_sequential_objects"),
-            contents: &objects,
-            usage: BufferUsages::STORAGE,
-        });
-        let segment_buffer = device.create_buffer_with_data(&BufferInitDescriptor {
-            label: Some("lodkit_frame_sequential_silhouettes"),
-            contents: &segments,
-            usage: BufferUsages::STORAGE,
-        });
+        // The depth pass is read once every older level is drawn; until then the combine
+        // estimates every level's coverage.
+        let exact = view.exact_coverage && older.is_some_and(|o| o.ready);
+        let data = match combine_data(view, exact, textures.size.y) {
+            Ok(data) => data,
+            Err(error) => {
+                warn_once!("FrameSequentialLod: no combine this frame: {error}");
+                commands.entity(entity).remove::<CombineBindGroup>();
+                continue;
+            }
+        };
+        let data_texture = device.create_texture_with_data(
+            &queue,
+            &TextureDescriptor {
+                label: Some("lodkit_frame_sequential_combine_data"),
+                size: Extent3d {
+                    width: data.width,
+                    height: data.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: TextureDimension::D2,
+                format: TextureFormat::Rgba32Uint,
+                usage: TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            TextureDataOrder::LayerMajor,
+            &data.bytes(),
+        );
+        let data_view = data_texture.create_view(&TextureViewDescriptor::default());
         let (newer, older) = (view.buffer, 1 - view.buffer);
         let bind_group = device.create_bind_group(
             "lodkit_frame_sequential_combine",
@@ -309,62 +345,16 @@ fn prepare_bind_groups(
                 &textures.color[newer].1,
                 &textures.depth[newer].1,
                 &textures.color[older].1,
+                &textures.ids[older].1,
                 &textures.depth[older].1,
                 motion,
-                params.clone(),
-                object_buffer.as_entire_binding(),
                 &visibility.texture_view,
                 &textures.older_level_depth.1,
-                segment_buffer.as_entire_binding(),
+                &data_view,
             )),
         );
         commands.entity(entity).insert(CombineBindGroup(bind_group));
     }
-}
-
-/// combine.wesl's `objects` and `silhouettes`, as bytes: per t-instance id (up to the largest
-/// named), the reprojection of its pixels, the tau its older level is displayed at and where its
-/// older level's silhouette lies among the segments; then the segments (one zero segment when
-/// there are none: a storage buffer is not empty).
-fn object_data(view: &FrameSequentialView) -> (Vec<u8>, Vec<u8>) {
-    let ids = view.object_new_to_old.iter().map(|&(id, _)| id);
-    let slots = ids
-        .chain(view.older_tau.iter().map(|&(id, _)| id))
-        .chain(view.silhouettes.iter().map(|&(id, _)| id))
-        .max()
-        .map_or(1, |id| id as usize + 1);
-    let mut objects = vec![(view.new_to_old, Vec4::ZERO, UVec4::ZERO); slots];
-    for &(id, m) in &view.object_new_to_old {
-        objects[id as usize].0 = m;
-    }
-    for &(id, tau) in &view.older_tau {
-        objects[id as usize].1 = Vec4::new(tau, 1.0, 0.0, 0.0);
-    }
-    let mut segments: Vec<[f32; 4]> = Vec::new();
-    for (id, outline) in &view.silhouettes {
-        objects[*id as usize].2 = UVec4::new(segments.len() as u32, outline.len() as u32, 1, 0);
-        segments.extend_from_slice(outline);
-    }
-    if segments.is_empty() {
-        segments.push([0.0; 4]);
-    }
-    let objects = objects
-        .iter()
-        .flat_map(|(m, t, s)| {
-            let floats = m.to_cols_array().into_iter().chain(t.to_array());
-            floats
-                .map(f32::to_le_bytes)
-                .chain(s.to_array().map(u32::to_le_bytes))
-                .collect::<Vec<_>>()
-        })
-        .flatten()
-        .collect();
-    let segments = segments
-        .iter()
-        .flatten()
-        .flat_map(|f| f.to_le_bytes())
-        .collect();
-    (objects, segments)
 }
 
 type PassView = (
@@ -373,7 +363,6 @@ type PassView = (
     &'static ViewDepthStencilTexture,
     &'static FrameSequentialView,
     &'static FrameSequentialTextures,
-    &'static DynamicUniformIndex<CombineParams>,
     Option<&'static CombineBindGroup>,
     Option<&'static CombinePipelineId>,
     Option<&'static OlderDepthDraws>,
@@ -389,8 +378,7 @@ fn combine_pass(
     allocator: Res<MeshAllocator>,
     mut ctx: RenderContext,
 ) {
-    let (_, target, depth, frame, textures, params, bind_group, pipeline_id, older) =
-        view.into_inner();
+    let (_, target, depth, frame, textures, bind_group, pipeline_id, older) = view.into_inner();
     let newer = frame.buffer;
     let main = target.main_texture();
     let extent = main.size();
@@ -414,6 +402,15 @@ fn combine_pass(
         bind_group,
         pipeline_id.and_then(|id| cache.get_render_pipeline(id.0)),
     ) else {
+        if frame.keep {
+            // No combine yet (its pipeline still compiling): the next frame reads no id words
+            // of an older frame than its colors.
+            ctx.begin_tracked_render_pass(RenderPassDescriptor {
+                label: Some(COMBINE_PASS),
+                color_attachments: &[Some(id_attachment(textures, frame))],
+                ..default()
+            });
+        }
         return;
     };
     let diagnostics = ctx.diagnostic_recorder();
@@ -442,15 +439,18 @@ fn combine_pass(
     }
     let mut pass = ctx.begin_tracked_render_pass(RenderPassDescriptor {
         label: Some(COMBINE_PASS),
-        color_attachments: &[Some(RenderPassColorAttachment {
-            view: target.main_texture_view(),
-            depth_slice: None,
-            resolve_target: None,
-            ops: Operations {
-                load: LoadOp::Load,
-                store: StoreOp::Store,
-            },
-        })],
+        color_attachments: &[
+            Some(RenderPassColorAttachment {
+                view: target.main_texture_view(),
+                depth_slice: None,
+                resolve_target: None,
+                ops: Operations {
+                    load: LoadOp::Load,
+                    store: StoreOp::Store,
+                },
+            }),
+            Some(id_attachment(textures, frame)),
+        ],
         depth_stencil_attachment: None,
         timestamp_writes: None,
         occlusion_query_set: None,
@@ -458,7 +458,7 @@ fn combine_pass(
     });
     let span = diagnostics.pass_span(&mut pass, COMBINE_PASS);
     pass.set_render_pipeline(pipeline);
-    pass.set_bind_group(0, &bind_group.0, &[params.index()]);
+    pass.set_bind_group(0, &bind_group.0, &[]);
     // The pass runs even without rectangles, so its diagnostics count every frame.
     for rect in &frame.rects {
         let r = rect.intersect(URect::new(0, 0, extent.width, extent.height));
@@ -469,4 +469,25 @@ fn combine_pass(
         pass.draw(0..3, 0..1);
     }
     span.end(&mut pass);
+}
+
+/// The combine's second target, this frame's id words (the next frame's older ids): cleared
+/// where the frame is kept (the combine then writes them over its region), else kept.
+fn id_attachment<'a>(
+    textures: &'a FrameSequentialTextures,
+    frame: &FrameSequentialView,
+) -> RenderPassColorAttachment<'a> {
+    RenderPassColorAttachment {
+        view: &textures.ids[frame.buffer].1,
+        depth_slice: None,
+        resolve_target: None,
+        ops: Operations {
+            load: if frame.keep {
+                LoadOp::Clear(LinearRgba::NONE.into())
+            } else {
+                LoadOp::Load
+            },
+            store: StoreOp::Store,
+        },
+    }
 }

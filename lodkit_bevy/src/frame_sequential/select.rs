@@ -316,6 +316,7 @@ fn update(
     let mut silhouette_time = Duration::ZERO;
     let mut silhouette_triangles = 0;
     let mut in_transition = 0;
+    let mut transition_ids = Vec::new();
     // The combine needs last frame's picture: a transition begins only after a frame that the
     // render world kept, and frames are kept only while a group is in transition or about to be.
     let older_kept = !multisampled && last.is_some_and(|l| l.keep);
@@ -363,6 +364,7 @@ fn update(
         let (tag_id, _, tau_next, _) = decode_tag(tag);
         if tag_id != 0 {
             in_transition += 1;
+            transition_ids.push(tag_id);
             if !object {
                 drawn_tau_next.push((tag_id, tau_next));
                 // The older buffer holds this id's other level when last frame drew the id: the
@@ -533,6 +535,7 @@ fn update(
         view_from_world,
         clip_from_view,
         new_to_old,
+        transition_ids,
         object_new_to_old,
         older_tau,
         drawn_tau_next,

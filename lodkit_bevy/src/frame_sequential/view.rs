@@ -1,9 +1,9 @@
 //! What the main world hands the render world each frame for a frame-sequential camera: the
-//! view's matrices, thresholds, silhouettes and older levels, and the combine's uniform.
+//! view's matrices, thresholds, silhouettes and older levels.
 
 use bevy::mesh::Mesh;
 use bevy::prelude::*;
-use bevy::render::render_resource::{Face, ShaderType};
+use bevy::render::render_resource::Face;
 
 /// What the render world needs of the camera's frame (inserted every frame by the plugin).
 /// When it goes, the render world drops the camera's ping-pong textures, bind group and
@@ -16,6 +16,9 @@ pub struct FrameSequentialView {
     pub clip_from_view: Mat4,
     /// This frame's clip space to last frame's (`lodkit::reproject::new_to_old_matrix`).
     pub new_to_old: Mat4,
+    /// The t-instance ids drawn this frame (the groups in transition): each gets a record in
+    /// the combine's data (`lodkit::combine_coverage::CombineData`).
+    pub transition_ids: Vec<u32>,
     /// Per t-instance id whose group moved since last frame, the same matrix with the group's
     /// motion. Without motion vectors its pixels are reprojected with it; with them, the combine
     /// uses it only to tell where the group moved away from a pixel.
@@ -57,22 +60,4 @@ pub struct OlderLevel {
     pub world_from_local: Mat4,
     /// The level material's face culling (the pass culls as the main pass does).
     pub cull_mode: Option<Face>,
-}
-
-/// The uniform of combine.wesl (one dynamic-offset slot per camera, written by Bevy's
-/// `UniformComponentPlugin`).
-#[derive(Component, ShaderType, Clone, Copy, Debug)]
-pub struct CombineParams {
-    /// This frame's clip space to last frame's.
-    pub(super) new_to_old: Mat4,
-    /// x: motion vectors read; y: exact coverage.
-    pub(super) flags: UVec4,
-}
-
-impl CombineParams {
-    /// Whether the combine reads the older-level depth pass this frame (exact coverage, and
-    /// every older level drawn).
-    pub(super) fn set_exact_coverage(&mut self, on: bool) {
-        self.flags.y = u32::from(on);
-    }
 }
