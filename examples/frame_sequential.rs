@@ -217,14 +217,18 @@ fn main() -> Result<(), Box<dyn Error>> {
             };
             let eye = (view * model(p)).inverse().transform_point3(Vec3::ZERO);
             let segments = surfaces[*lod].silhouette(proj * view * model(p), eye, SIZE, true)?;
-            silhouettes.push((scheduler.draw(*key)?.id, segments));
+            // The older level is shown at this frame's threshold for it (the pattern is on the
+            // screen): exactly complementary to the level drawn now.
+            let d = scheduler.draw(*key)?;
+            let older_tau = scheduler.schedule().threshold(d.progress, !d.incoming);
+            silhouettes.push((d.id, older_tau, segments));
         }
         let objects: Vec<CombineObjectData> = silhouettes
             .iter()
-            .map(|(id, segments)| CombineObjectData {
+            .map(|(id, older_tau, segments)| CombineObjectData {
                 id: *id,
                 new_to_old,
-                older_tau: None,
+                older_tau: Some(*older_tau),
                 route: CoverageRoute::Silhouette(segments),
             })
             .collect();
@@ -244,6 +248,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             coverage: CombineCoverage::Known {
                 data: &data,
                 level_depth: None,
+                pattern: Some(renderer.visibility_view()),
             },
         };
         combine.record(&gpu, &mut encoder, &frame_to_combine)?;

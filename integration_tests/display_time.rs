@@ -483,7 +483,7 @@ fn combine_at_twins_match_on_two_lod_images() {
 
 /// Blue share b / (r + b) of the object's pixels (LOD 0 pure red, LOD 1 pure blue, so lighting
 /// cancels) and the number of object pixels.
-fn blue_share(pixels: &[u8]) -> (f32, usize) {
+pub fn blue_share(pixels: &[u8]) -> (f32, usize) {
     let object: Vec<(f32, f32)> = pixels
         .chunks(4)
         .map(|p| (f32::from(p[0]), f32::from(p[2])))

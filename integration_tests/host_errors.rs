@@ -410,17 +410,22 @@ fn passes_given_mismatched_inputs_name_both() {
         .unwrap();
     gpu.queue.submit([e.finish()]);
     // Combine told the older levels' coverage: data that does not fill its texture, an object
-    // displayed at an older_tau (the pass reads no pattern), a depth pass read but not given,
-    // one of another size.
-    let known = |data, level_depth| {
+    // displayed at an older_tau with no pattern to display it by, a depth pass read but not
+    // given, one of another size.
+    let known_with = |data, level_depth, pattern| {
         let frame = CombineFrame {
-            coverage: CombineCoverage::Known { data, level_depth },
+            coverage: CombineCoverage::Known {
+                data,
+                level_depth,
+                pattern,
+            },
             ..whole(&buffers, 0, &right)
         };
         no_panic("CombinePass::record", || {
             combine.record(gpu, &mut encoder(), &frame).map(drop)
         })
     };
+    let known = |data, level_depth| known_with(data, level_depth, None);
     let square = [
         [2.0, 2.0, 2.0, 6.0],
         [2.0, 6.0, 6.0, 6.0],
@@ -449,7 +454,22 @@ fn passes_given_mismatched_inputs_name_both() {
         &[object(Some(0.5), CoverageRoute::Silhouette(&square))],
         false,
     );
-    mismatch(known(&anchored, None), "coverage.data", "id 3", "older_tau");
+    mismatch(
+        known(&anchored, None),
+        "coverage.pattern",
+        "id 3",
+        "older_tau",
+    );
+    let pattern = texture_2d(
+        gpu,
+        (4, 4),
+        wgpu::TextureFormat::R32Float,
+        wgpu::TextureUsages::TEXTURE_BINDING,
+        "pattern",
+    )
+    .unwrap()
+    .create_view(&Default::default());
+    known_with(&anchored, None, Some(&pattern)).unwrap();
     let depth_pass = data(&[object(None, CoverageRoute::DepthPass)], true);
     mismatch(
         known(&depth_pass, None),

@@ -26,6 +26,7 @@ mod host_errors;
 mod house;
 mod lod_chain;
 mod object_motion;
+mod older_threshold;
 mod packed_gbuffer;
 mod portability;
 mod robustness;

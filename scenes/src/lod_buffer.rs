@@ -288,6 +288,13 @@ impl LodBufferRenderer {
         Ok(())
     }
 
+    /// The visibility texture the levels are drawn with (`R32Float`): where the pattern is
+    /// anchored to the screen, what `CombineCoverage::Known::pattern` takes, so the combine shows
+    /// an older level at this frame's threshold.
+    pub fn visibility_view(&self) -> &wgpu::TextureView {
+        &self.vis_view
+    }
+
     /// Where the visibility pattern is anchored ([`VisibilitySpace::Screen`] unless set).
     pub fn visibility_space(&self) -> VisibilitySpace {
         self.space

@@ -22,7 +22,10 @@
 //   holding 0 for buffers without a motion target: every pixel reads its one texel), 7 params:
 //   CombineParams, 8 data texture_2d<u32> (lodkit::combine_coverage::CombineData; read with
 //   LODKIT_COMBINE_KNOWN), 9 level_depth texture_2d<f32> (the older-level depth pass at the
-//   target's size, or a 1x1 texture when the data says it is not read).
+//   target's size, or a 1x1 texture when the data says it is not read), 10 pattern
+//   texture_2d<f32> (the visibility pattern the LOD pass anchors to the screen, red channel, read
+//   with LODKIT_COMBINE_KNOWN at each pixel for the older levels the data displays at an
+//   older_tau; a 1x1 texture when none is).
 // Shader defs: LODKIT_REVERSE_Z (bool, default off) — passed on to lodkit::combine.
 //   LODKIT_COMBINE_STILL (bool, default off) — for buffers without object motion: combine_at,
 //   which does not read binding 6 and whose 3x3 search is dead code once the driver folds the
@@ -32,6 +35,7 @@
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 #import lodkit::combine::{combine_at, combine_at_moved}
 #import lodkit::combine_coverage::{CombineNewer, combine_pixel}
+#import lodkit::visibility::visibility_screen_texel
 
 /// Per-frame parameters.
 struct CombineParams {
@@ -49,6 +53,7 @@ struct CombineParams {
 @group(0) @binding(7) var<uniform> params: CombineParams;
 @group(0) @binding(8) var data: texture_2d<u32>;
 @group(0) @binding(9) var level_depth: texture_2d<f32>;
+@group(0) @binding(10) var pattern: texture_2d<f32>;
 
 /// Fullscreen triangle.
 @vertex
@@ -63,7 +68,8 @@ fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
 #ifdef LODKIT_COMBINE_KNOWN
     let motion = textureLoad(object_motion, min(pixel, textureDimensions(object_motion, 0) - 1u), 0).xy;
     let level = textureLoad(level_depth, min(pixel, textureDimensions(level_depth, 0) - 1u), 0).x;
-    let newer = CombineNewer(textureLoad(newer_color, pixel, 0), textureLoad(newer_id, pixel, 0).x, textureLoad(newer_depth, pixel, 0).x, motion, 0.0, level);
+    let shown = textureLoad(pattern, visibility_screen_texel(textureDimensions(pattern, 0), v.position.xy), 0).r;
+    let newer = CombineNewer(textureLoad(newer_color, pixel, 0), textureLoad(newer_id, pixel, 0).x, textureLoad(newer_depth, pixel, 0).x, motion, shown, level);
     return combine_pixel(newer, pixel, older_color, older_id, older_depth, data);
 #else ifdef LODKIT_COMBINE_STILL
     return combine_at(newer_color, newer_id, newer_depth, older_color, older_id, older_depth, pixel, params.new_to_old);

@@ -76,12 +76,19 @@ pub enum CombineCoverage<'a> {
     /// the route docs/frame-sequential.md recommends.
     Known {
         /// The frame's data ([`CombineData::new`]) with its `new_to_old` equal to the
-        /// recording's. Objects with `older_tau` are refused: this pass reads no visibility
-        /// pattern, so the older buffer's display flags stand.
+        /// recording's.
         data: &'a CombineData,
         /// The older-level depth pass (`LOD_DEPTH_FORMAT`, the buffers' size, cleared to the far
         /// depth), required when the data's `level_depth` is set.
         level_depth: Option<&'a wgpu::Texture>,
+        /// The visibility pattern the LOD pass anchors to the screen (one texel per pixel, red
+        /// channel, any float format; `LodBufferRenderer::visibility_view` in lodkit-scenes),
+        /// required when the data displays an object's older level at an `older_tau`: the
+        /// combine then takes that level's shown flag from the pattern at the pixel displayed,
+        /// at this frame's threshold, instead of the flag its fragment predicted last frame, so
+        /// the two levels stay exactly complementary however the pixel moved. `None`: the older
+        /// buffer's flags stand.
+        pattern: Option<&'a wgpu::TextureView>,
     },
 }
 
@@ -149,6 +156,7 @@ impl CombinePass {
             entries.push(uniform_entry(7, false));
             entries.push(texture_entry(8, wgpu::TextureSampleType::Uint));
             entries.push(Self::motion_layout_entry(9));
+            entries.push(Self::motion_layout_entry(10));
             let (group, layout) = one_group_layout(gpu, &entries, "lodkit combine");
             let pipeline = |def: Option<&'static str>| {
                 let defs: Vec<&str> = reverse.into_iter().chain(def).collect();
@@ -291,11 +299,16 @@ impl CombinePass {
     }
 
     /// Refuses [`CombineCoverage::Known`] data this pass cannot honour: texels that do not fill
-    /// its size, objects displayed at an `older_tau` (the pass reads no visibility pattern), a
+    /// its size, objects displayed at an `older_tau` with no pattern to display them by, a
     /// depth pass the data reads but the frame does not give, or one of another size.
     fn check_coverage(&self, frame: &CombineFrame) -> Result<(), GpuError> {
         const CALL: &str = "CombinePass::record";
-        let CombineCoverage::Known { data, level_depth } = frame.coverage else {
+        let CombineCoverage::Known {
+            data,
+            level_depth,
+            pattern,
+        } = frame.coverage
+        else {
             return Ok(());
         };
         let texels = u64::from(data.width) * u64::from(data.height);
@@ -312,15 +325,15 @@ impl CombinePass {
         }
         let records = combine_object(&data.texels, 0);
         let slots = silhouette_texel(&data.texels, 5).z;
-        if let Some(k) =
-            (1..slots).find(|&k| combine_object(&data.texels, k).flags & COMBINE_ANCHORED != 0)
-        {
+        let anchored =
+            (1..slots).find(|&k| combine_object(&data.texels, k).flags & COMBINE_ANCHORED != 0);
+        if let (Some(k), None) = (anchored, pattern) {
             return Err(GpuError::Mismatch {
                 call: CALL,
-                parameter: "coverage.data",
-                found: format!("id {k} displayed at an older_tau"),
-                expected: "no older_tau: the pass reads no visibility pattern, so the older \
-                           buffer's display flags are used"
+                parameter: "coverage.pattern",
+                found: format!("None, with id {k} displayed at an older_tau"),
+                expected: "the visibility pattern the LOD pass anchors to the screen (or no \
+                           older_tau: the older buffer's display flags stand)"
                     .into(),
             });
         }
@@ -359,9 +372,13 @@ impl CombinePass {
                 new_to_old: frame.new_to_old.to_cols_array_2d(),
             };
             self.params.write(encoder, &params)?;
-            let known = match frame.coverage {
-                CombineCoverage::Known { data, level_depth } => Some((data, level_depth)),
-                CombineCoverage::Estimated => None,
+            let (known, pattern) = match frame.coverage {
+                CombineCoverage::Known {
+                    data,
+                    level_depth,
+                    pattern,
+                } => (Some((data, level_depth)), pattern),
+                CombineCoverage::Estimated => (None, None),
             };
             let data = known.map(|(data, _)| {
                 gpu.device.create_texture_with_data(
@@ -396,13 +413,19 @@ impl CombinePass {
                 data.as_ref().unwrap_or(&self.unused_data),
                 level_depth.unwrap_or(&self.unused_depth),
             ];
-            let views: Vec<wgpu::TextureView> = textures
+            let mut views: Vec<wgpu::TextureView> = textures
                 .iter()
                 .map(|t| t.create_view(&Default::default()))
                 .collect();
+            // Not read where no older level is displayed at an older_tau: the 1x1 zero motion.
+            views.push(
+                pattern
+                    .cloned()
+                    .unwrap_or_else(|| self.still.create_view(&Default::default())),
+            );
             let entries: Vec<wgpu::BindGroupEntry> = views
                 .iter()
-                .zip([0, 1, 2, 3, 4, 5, 6, 8, 9])
+                .zip([0, 1, 2, 3, 4, 5, 6, 8, 9, 10])
                 .map(|(view, binding)| wgpu::BindGroupEntry {
                     binding,
                     resource: wgpu::BindingResource::TextureView(view),
