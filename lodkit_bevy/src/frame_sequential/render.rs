@@ -181,7 +181,7 @@ pub struct FrameSequentialTextures {
     /// The id words the combine writes over its region (0 elsewhere).
     ids: [(Texture, TextureView); 2],
     /// The older-level depth pass's target: the camera's size with exact coverage, else one
-    /// texel (bound, never read).
+    /// texel (bound, and read at every pixel, but ignored: the data says it is not read).
     older_level_depth: (Texture, TextureView),
     /// Whether the textures were made for exact coverage.
     exact_coverage: bool,
@@ -293,7 +293,12 @@ fn prepare_bind_groups(
     images: Res<RenderAssets<GpuImage>>,
     views: Query<BindGroupView>,
 ) {
+    // A camera with no bind group this frame runs no combine: last frame's group would bind
+    // the id target this frame writes.
     let Some(visibility) = images.get(&super::VISIBILITY_TEXTURE) else {
+        for (entity, ..) in &views {
+            commands.entity(entity).remove::<CombineBindGroup>();
+        }
         return;
     };
     for (entity, view, textures, prepass, older) in &views {
@@ -301,6 +306,7 @@ fn prepare_bind_groups(
             Some(motion) => motion,
             None if view.motion_vectors => {
                 warn_once!("FrameSequentialLod: the motion-vector prepass has no texture yet");
+                commands.entity(entity).remove::<CombineBindGroup>();
                 continue;
             }
             // Not read (no COMBINE_OBJECT_MOTION): any texture of the layout's type.

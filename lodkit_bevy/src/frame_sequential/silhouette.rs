@@ -1,8 +1,9 @@
 //! The older levels' silhouettes for the combine (`OlderCoverage::Silhouette`): each level
 //! mesh's [`Surface`] (lodkit::silhouette: positions welded, edges linked to their twins), built
 //! once from the Bevy `Mesh` and kept until the mesh changes; each frame the plugin asks it for
-//! the silhouette under this frame's camera and the group's transform, and the combine tests
-//! its segments per pixel (`lodkit::silhouette::silhouette_crossing`).
+//! the silhouette under this frame's camera and the group's transform, which the combine's data
+//! holds binned by pixel row (`lodkit::combine_coverage::CombineData`) and tests at each pixel
+//! against its row's segments (`lodkit::silhouette::silhouette_covers`).
 
 use std::sync::Arc;
 
