@@ -5,7 +5,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, LodSample, PixelSource, combine_shown};
-use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
+use lodkit::frame_sequential::{Drive, InstanceKey, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
     CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
 };
@@ -481,6 +481,32 @@ fn combine_at_twins_match_on_two_lod_images() {
     }
 }
 
+/// Frame `f` (at 60 frames a second) of a transition of `key` from LOD 0 to 1 that begins at
+/// frame `start` and lasts `frames` frames: progress `(f - start) / frames`, and as the next
+/// frame's progress the one `ahead` frames on where given (else the scheduler predicts it).
+pub fn step_transition(
+    s: &mut TransitionScheduler,
+    key: InstanceKey,
+    f: u64,
+    start: u64,
+    frames: u32,
+    ahead: Option<u64>,
+) {
+    if f > 0 {
+        s.advance(1.0 / 60.0);
+    }
+    if f == start {
+        s.begin_transition(key, 1, Drive::Progress).unwrap();
+    }
+    if f >= start {
+        let p = |f: u64| ((f - start) as f32 / frames as f32).min(1.0);
+        s.set_progress(key, p(f)).unwrap();
+        if let Some(ahead) = ahead {
+            s.set_next_progress(key, p(f + ahead)).unwrap();
+        }
+    }
+}
+
 /// Blue share b / (r + b) of the object's pixels (LOD 0 pure red, LOD 1 pure blue, so lighting
 /// cancels) and the number of object pixels.
 pub fn blue_share(pixels: &[u8]) -> (f32, usize) {
@@ -591,20 +617,9 @@ fn each_lod_is_shown_as_it_is_at_the_frame_displayed() {
             let key = s.insert(0);
             let (mut shares, mut coverage) = (Vec::new(), Vec::new());
             for f in 0..start + u64::from(FRAMES) + 2 {
-                if f > 0 {
-                    s.advance(1.0 / 60.0);
-                }
-                if f == start {
-                    s.begin_transition(key, 1, Drive::Progress).unwrap();
-                }
-                if f >= start {
-                    let p = |f: u64| ((f - start) as f32 / FRAMES as f32).min(1.0);
-                    s.set_progress(key, p(f)).unwrap();
-                    // One start knows the next frame's progress, the other lets it be predicted.
-                    if start == 3 {
-                        s.set_next_progress(key, p(f + 1)).unwrap();
-                    }
-                }
+                // One start knows the next frame's progress, the other lets it be predicted.
+                let ahead = (start == 3).then_some(1);
+                step_transition(&mut s, key, f, start, FRAMES, ahead);
                 let d = s.draw(key).unwrap();
                 let color = lods.colors[usize::from(d.lod)];
                 let item = LodDrawItem::from_draw(&lods.sphere, Mat4::IDENTITY, color, &d);

@@ -8,7 +8,7 @@ use glam::{Mat4, Vec3};
 use lodkit::combine_coverage::{
     CombineData, CombineDataDescriptor, CombineObjectData, CoverageRoute,
 };
-use lodkit::frame_sequential::{Drive, Schedule, TransitionScheduler};
+use lodkit::frame_sequential::{Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
     CombineCoverage, CombineFrame, CombinePass, CombineRegions, LodBuffers,
 };
@@ -16,7 +16,7 @@ use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::reproject::new_to_old_matrix;
 use lodkit_scenes::lod_buffer::{LodBufferFrame, LodDrawItem};
 
-use crate::display_time::{SphereLods, blue_share};
+use crate::display_time::{SphereLods, blue_share, step_transition};
 use crate::support::say;
 
 const W: u32 = 64;
@@ -32,19 +32,11 @@ fn shares(gpu: &lodkit::gpu::GpuContext, lods: &SphereLods, display: bool) -> Ve
     let buffers = LodBuffers::new(gpu, W, W, SphereLods::FORMAT).unwrap();
     let mut s = TransitionScheduler::with_schedule(Schedule::Complementary);
     let key = s.insert(0);
-    let p = |f: u64| ((f - START) as f32 / FRAMES as f32).min(1.0);
     let mut out = Vec::new();
     for f in 0..START + u64::from(FRAMES) + 1 {
-        if f > 0 {
-            s.advance(1.0 / 60.0);
-        }
-        if f == START {
-            s.begin_transition(key, 1, Drive::Progress).unwrap();
-        }
-        if f >= START {
-            s.set_progress(key, p(f)).unwrap();
-            s.set_next_progress(key, (p(f) + 0.5).min(1.0)).unwrap();
-        }
+        // The next frame's progress mispredicted: half a transition ahead.
+        let ahead = Some(u64::from(FRAMES / 2));
+        step_transition(&mut s, key, f, START, FRAMES, ahead);
         let d = s.draw(key).unwrap();
         let item = LodDrawItem::from_draw(
             &lods.sphere,

@@ -6,6 +6,7 @@ use lodkit::combine_coverage::{
     CombineData, CombineDataDescriptor, CombineDataError, CombineObjectData, CoverageRoute,
 };
 
+use super::rects::to_lodkit;
 use super::view::FrameSequentialView;
 
 /// What the combine knows this frame, laid out by lodkit (`CombineData`): the camera's
@@ -19,7 +20,6 @@ pub(super) fn combine_data(
     exact: bool,
     height: u32,
 ) -> Result<CombineData, CombineDataError> {
-    let matrix = |m: Mat4| glam::Mat4::from_cols_array(&m.to_cols_array());
     let found = |list: &[(u32, Mat4)], id| list.iter().find(|&&(i, _)| i == id).map(|&(_, m)| m);
     let objects: Vec<CombineObjectData> = view
         .transition_ids
@@ -33,7 +33,9 @@ pub(super) fn combine_data(
             };
             CombineObjectData {
                 id,
-                new_to_old: matrix(found(&view.object_new_to_old, id).unwrap_or(view.new_to_old)),
+                new_to_old: to_lodkit(
+                    found(&view.object_new_to_old, id).unwrap_or(view.new_to_old),
+                ),
                 older_tau: view
                     .older_tau
                     .iter()
@@ -44,7 +46,7 @@ pub(super) fn combine_data(
         })
         .collect();
     CombineData::new(&CombineDataDescriptor {
-        new_to_old: matrix(view.new_to_old),
+        new_to_old: to_lodkit(view.new_to_old),
         object_motion: view.motion_vectors,
         level_depth: exact,
         height,
