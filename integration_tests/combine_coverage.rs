@@ -16,10 +16,9 @@ use lodkit::combine_coverage::{
 };
 use lodkit::lod_buffer::{lod_buffer_id, lod_buffer_word};
 use lodkit::reproject::{reproject, reproject_base};
-use lodkit::shaders::SourceLanguage;
 use lodkit::silhouette::silhouette_covers;
 
-use crate::harness::{Probe, Route, Word, assert_twin, floats, run_on, words};
+use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words};
 
 const W: u32 = 16;
 const H: u32 = 12;
@@ -427,23 +426,9 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     // a fused multiply-add on the GPU (an ulp apart, ~1.2e-7 near 1): 1e-6.
     kinds.extend([Word::Float(1e-6); 2]);
     kinds.push(Word::Exact);
-    // The fragment route on every device (GL 3.3 and WebGL2 class contexts have no compute), and
-    // the compute route where compute shaders work.
-    let mut routes = vec![Route::Fragment];
-    if gpu.capabilities().compute_shaders() {
-        routes.push(Route::Compute);
-    }
-    for (route, (language, header, body)) in routes.iter().flat_map(|&r| {
-        [
-            (SourceLanguage::Wgsl, wgsl_header, wgsl.as_str()),
-            (
-                SourceLanguage::Glsl(naga::ShaderStage::Compute),
-                glsl_header,
-                glsl.as_str(),
-            ),
-        ]
-        .map(|l| (r, l))
-    }) {
+    for (route, language, header, body) in
+        twin_runs(gpu, (wgsl_header, &wgsl), (glsl_header, &glsl))
+    {
         let probe = Probe {
             header,
             body,

@@ -288,10 +288,7 @@ fn the_fragment_probe_gives_the_words_the_compute_probe_gives() {
     let gpu = lodkit_test_gpu!(device);
     let (wgsl, glsl, cases) = wide_probe();
     let want = wide_want(&cases);
-    let mut routes = vec![Route::Fragment];
-    if gpu.capabilities().compute_shaders() {
-        routes.push(Route::Compute);
-    }
+    let routes = Route::every(gpu);
     for &route in &routes {
         // run_on holds the WESL form to the WGSL one's words.
         let got = run_on(gpu, route, &wgsl, &cases, SourceLanguage::Wgsl, &[]);

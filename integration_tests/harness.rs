@@ -30,6 +30,36 @@ impl Route {
             Self::Fragment
         }
     }
+
+    /// Every route a twin test runs on: fragments on every device (GL 3.3 and WebGL2 class
+    /// contexts have no compute), compute where the device's compute shaders work.
+    pub fn every(gpu: &GpuContext) -> Vec<Self> {
+        let mut routes = vec![Self::Fragment];
+        if gpu.capabilities().compute_shaders() {
+            routes.push(Self::Compute);
+        }
+        routes
+    }
+}
+
+/// Every run of a twin test, as (route, language, header, body): on each of [`Route::every`],
+/// the WGSL probe and the GLSL probe (compiled as a compute shader's source; the fragment route
+/// wraps it the same way).
+pub fn twin_runs<'a>(
+    gpu: &GpuContext,
+    wgsl: (&'a str, &'a str),
+    glsl: (&'a str, &'a str),
+) -> Vec<(Route, SourceLanguage, &'a str, &'a str)> {
+    let glsl_language = SourceLanguage::Glsl(naga::ShaderStage::Compute);
+    Route::every(gpu)
+        .into_iter()
+        .flat_map(|r| {
+            [
+                (r, SourceLanguage::Wgsl, wgsl.0, wgsl.1),
+                (r, glsl_language, glsl.0, glsl.1),
+            ]
+        })
+        .collect()
 }
 
 /// Runs `program` (which must not fail to spawn) or, if it is missing, fails under

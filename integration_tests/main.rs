@@ -7,6 +7,7 @@
 mod support;
 mod alpha_tested;
 mod combine_coverage;
+mod combine_ray;
 mod composition;
 mod cost;
 mod cost_bounds;

@@ -24,9 +24,14 @@ use crate::reproject::{
 use crate::silhouette::{SILHOUETTE_ON, silhouette_covers, silhouette_texel};
 
 mod data;
+mod ray;
 pub use data::{
     COMBINE_DATA_WIDTH, COMBINE_MAX_HEIGHT, COMBINE_MAX_ID, CombineData, CombineDataDescriptor,
     CombineDataError, CombineObjectData, CoverageRoute,
+};
+pub use ray::{
+    COMBINE_RAY_REACH, COMBINE_RAY_STEPS, combine_behind_texel, combine_ray_texel,
+    combine_read_known,
 };
 
 /// Texels per id in the data texture ([`CombineData`]): the record of t-instance `id` starts at
@@ -342,9 +347,9 @@ pub fn combine_read(
                 return found(older, combine_texel(read_at, size));
             }
             if own == 1 {
-                return combine_read_own(older, id, uv, depth, m, motion, COMBINE_BLOCK_REACH);
+                return combine_read_known(older, id, uv, depth, m, motion);
             }
-            let texel = combine_other_texel(older, id, combine_texel(read_at, size), read_at);
+            let texel = combine_behind_texel(older, id, read_at, base, depth, m, motion);
             return found(older, texel);
         }
         if object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)

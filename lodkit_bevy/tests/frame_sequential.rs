@@ -329,16 +329,24 @@ fn depth_pass_coverage_leaves_no_ghost_and_no_hole() {
     }
 }
 
-/// Without reprojection the moving camera reads the older frame at the wrong place: the
-/// background shows through the objects, so the figures above fail.
+/// Without reprojection the moving camera reads the older frame at the wrong place, and the
+/// figures above fail. Where a read finds none of the older level it shows the level drawn now
+/// (`combine_read_known`), not the background, so the pixels flip between the levels instead of
+/// showing holes: measured 1.989 / 5.555 against the limits 1.94 / 5.25 (and Bevy's 1.973 /
+/// 5.516), 22,119 / 23,712 reversals, see-through 0. Before the reads along the ray it showed
+/// the background through the objects.
 #[test]
-fn a_combine_without_reprojection_shows_the_background() {
+fn a_combine_without_reprojection_fails_the_flicker_limits() {
     let Some(r) = report(&["--no-reprojection", "--without-prepass-only"]) else {
         return;
     };
-    let holes = num(&r, "see_through_frame_sequential");
-    assert!(holes > 0.0, "no reprojection, yet no see-through: {r}");
-    assert!(num(&r, "min_coverage_frame_sequential") < 1.0, "{r}");
+    for (path, limit) in ["static", "moving"].into_iter().zip([1.94, 5.25]) {
+        let f = num(&r, &format!("flicker_frame_sequential_{path}"));
+        assert!(
+            f > limit,
+            "no reprojection, yet flicker {path} {f} within {limit}: {r}"
+        );
+    }
 }
 
 /// The frame-sequential runs' frames in `dir` (`--frames`), per folder: its name and its PNG

@@ -21,6 +21,14 @@
 //   lodkit_combine_object(id) -> lodkit_CombineObject   the record of id (unknown past the records)
 //   lodkit_combine_new_to_old(id) -> mat4   the matrix reprojecting a pixel holding id
 //   lodkit_combine_far_depth() -> float   the far clip depth (an older-level depth pass's clear)
+//   LODKIT_COMBINE_RAY_STEPS, LODKIT_COMBINE_RAY_REACH   how far and how close to the ray
+//       lodkit_combine_ray_texel looks
+//   lodkit_combine_ray_texel(id, owned, base, depth, new_to_old, motion) -> uvec3   the older
+//       texel on the pixel's ray holding id (owned) or another id; z: found
+//   lodkit_combine_read_known(owner, uv, depth, new_to_old, motion) -> lodkit_CombineRead   the
+//       read of owner's older level where its coverage is known; not found where none is held
+//   lodkit_combine_behind_texel(id, at, base, depth, new_to_old, motion) -> uvec2   what lies
+//       behind id's older level, on the ray
 //   lodkit_combine_read_estimated(uv, depth, base, old, new_to_old, motion) -> lodkit_CombineRead
 //   lodkit_combine_read_level_depth(level, id, uv, depth, old, motion) -> lodkit_CombineRead
 //   lodkit_combine_hidden(owner, at, depth) -> bool   whether the older texel at `at` holds
@@ -119,6 +127,74 @@ float lodkit_combine_far_depth() {
 #else
     return 1.0;
 #endif
+}
+
+/// Texels lodkit_combine_ray_texel steps along the pixel's ray, each way.
+const uint LODKIT_COMBINE_RAY_STEPS = 6u;
+/// How far (texels, the larger axis) an older sample may lie from the pixel's ray for
+/// lodkit_combine_ray_texel to take it.
+const float LODKIT_COMBINE_RAY_REACH = 0.75;
+
+/// The older texel on the pixel's ray (`base` = lodkit_reproject_base under `new_to_old`, moved
+/// by `motion`) that holds `id` (`owned`) or any other id (`!owned`): stepping a texel at a time
+/// along the ray's image in the older buffer from the reprojection of `depth`, both ways, nearest
+/// first, up to LODKIT_COMBINE_RAY_STEPS; the first whose older sample, refined at its own depth,
+/// lies within LODKIT_COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is.
+uvec3 lodkit_combine_ray_texel(uint id, bool owned, vec4 base, float depth, mat4 new_to_old, vec2 motion) {
+    uvec2 size = lodkit_combine_fetch_size();
+    vec2 texels = vec2(size);
+    vec2 a = lodkit_reproject_from_base(base, depth, new_to_old).xy + motion;
+    // A second point of the ray at another finite depth gives the ray's image its direction.
+    float other = depth < 0.5 ? depth * 0.5 + 0.5 : depth * 0.5;
+    vec2 along = (lodkit_reproject_from_base(base, other, new_to_old).xy + motion - a) * texels;
+    float length_texels = length(along);
+    vec2 stride = (length_texels > 1.0e-3 ? along / max(length_texels, 1.0e-3) : vec2(0.0)) / texels;
+    for (uint k = 0u; k <= 2u * LODKIT_COMBINE_RAY_STEPS; k++) {
+        float j = float((k + 1u) / 2u) * ((k & 1u) == 1u ? 1.0 : -1.0);
+        vec2 at = a + j * stride;
+        if (!lodkit_in_viewport(at)) {
+            continue;
+        }
+        uvec2 t = lodkit_combine_texel(at, size);
+        if ((lodkit_lod_buffer_id(lodkit_combine_fetch_word(t)) == id) != owned) {
+            continue;
+        }
+        vec2 ray = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(t), new_to_old).xy + motion;
+        if (lodkit_combine_ray_offset(ray, t, size) < LODKIT_COMBINE_RAY_REACH) {
+            return uvec3(t, 1u);
+        }
+    }
+    return uvec3(0u);
+}
+
+/// The read of `owner`'s older level where its coverage is known to include the pixel:
+/// lodkit_combine_read_own within the 3x3 block; where that finds no texel of `owner`, the one
+/// lodkit_combine_ray_texel finds on the pixel's ray; none: not found (the older buffer does not
+/// hold that part of the level, and another object's texel would show through it).
+lodkit_CombineRead lodkit_combine_read_known(uint owner, vec2 uv, float depth, mat4 new_to_old, vec2 motion) {
+    lodkit_CombineRead read = lodkit_combine_read_own(owner, uv, depth, new_to_old, motion, LODKIT_COMBINE_BLOCK_REACH);
+    if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(read.texel)) == owner) {
+        return read;
+    }
+    vec4 base = lodkit_reproject_base(uv, new_to_old);
+    uvec3 hit = lodkit_combine_ray_texel(owner, true, base, depth, new_to_old, motion);
+    if (hit.z == 0u) {
+        return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
+    }
+    vec2 at = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(hit.xy), new_to_old).xy + motion;
+    vec4 color = lodkit_combine_own_color(owner, at, lodkit_combine_fetch_color(hit.xy));
+    return lodkit_CombineRead(hit.xy, color, true);
+}
+
+/// The older texel showing what lies behind `id`'s older level at the pixel, where that level is
+/// known not to cover it: lodkit_combine_ray_texel's texel of another id on the pixel's ray
+/// (`base`, `depth`: the newer level's); none: lodkit_combine_other_texel around `at`.
+uvec2 lodkit_combine_behind_texel(uint id, vec2 at, vec4 base, float depth, mat4 new_to_old, vec2 motion) {
+    uvec3 hit = lodkit_combine_ray_texel(id, false, base, depth, new_to_old, motion);
+    if (hit.z == 1u) {
+        return hit.xy;
+    }
+    return lodkit_combine_other_texel(id, lodkit_combine_texel(at, lodkit_combine_fetch_size()), at);
 }
 
 /// The estimated read of a pixel showing no known t-instance; a known t-instance's texel only
@@ -255,9 +331,9 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
                 return lodkit_CombineRead(hidden, lodkit_combine_fetch_color(hidden), true);
             }
             if (own == 1) {
-                return lodkit_combine_read_own(id, uv, newer.depth, m, newer.motion, LODKIT_COMBINE_BLOCK_REACH);
+                return lodkit_combine_read_known(id, uv, newer.depth, m, newer.motion);
             }
-            uvec2 texel = lodkit_combine_other_texel(id, lodkit_combine_texel(at, size), at);
+            uvec2 texel = lodkit_combine_behind_texel(id, at, base, newer.depth, m, newer.motion);
             return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
         }
         if ((object.flags & depth_pass) == depth_pass) {

@@ -21,6 +21,16 @@
 //   combine_object(data, id) -> CombineObject   the record of id (unknown past the records)
 //   combine_new_to_old(data, id) -> mat4x4<f32>   the matrix reprojecting a pixel holding id
 //   combine_far_depth() -> f32   the far clip depth (an older-level depth pass's clear)
+//   COMBINE_RAY_STEPS, COMBINE_RAY_REACH   how far and how close to the ray combine_ray_texel
+//       looks
+//   combine_ray_texel(older_id, older_depth, id, owned, base, depth, new_to_old, motion)
+//       -> vec3<u32>   the older texel on the pixel's ray holding id (owned) or another id; z:
+//       found
+//   combine_read_known(older_color, older_id, older_depth, owner, uv, depth, new_to_old, motion)
+//       -> CombineRead   the read of owner's older level where its coverage is known; not
+//       found where none is held
+//   combine_behind_texel(older_id, older_depth, id, at, base, depth, new_to_old, motion)
+//       -> vec2<u32>   what lies behind id's older level, on the ray
 //   combine_read_estimated(older_color, older_id, older_depth, data, uv, depth, base, old,
 //       new_to_old, motion) -> CombineRead   a pixel showing no known t-instance, estimated
 //   combine_read_level_depth(older_color, older_id, older_depth, data, level, id, uv, depth, old,
@@ -117,6 +127,74 @@ fn combine_far_depth() -> f32 {
 #else
     return 1.0;
 #endif
+}
+
+/// Texels combine_ray_texel steps along the pixel's ray, each way.
+const COMBINE_RAY_STEPS: u32 = 6u;
+/// How far (texels, the larger axis) an older sample may lie from the pixel's ray for
+/// combine_ray_texel to take it.
+const COMBINE_RAY_REACH: f32 = 0.75;
+
+/// The older texel on the pixel's ray (`base` = reproject_base under `new_to_old`, moved by
+/// `motion`) that holds `id` (`owned`) or any other id (`!owned`): stepping a texel at a time
+/// along the ray's image in the older buffer from the reprojection of `depth`, both ways, nearest
+/// first, up to COMBINE_RAY_STEPS; the first whose older sample, refined at its own depth, lies
+/// within COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is.
+fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, id: u32, owned: bool, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec3<u32> {
+    let size = textureDimensions(older_id, 0);
+    let texels = vec2<f32>(size);
+    let a = reproject_from_base(base, depth, new_to_old).xy + motion;
+    // A second point of the ray at another finite depth gives the ray's image its direction.
+    let other = select(depth * 0.5, depth * 0.5 + 0.5, depth < 0.5);
+    let along = (reproject_from_base(base, other, new_to_old).xy + motion - a) * texels;
+    let length_texels = length(along);
+    let stride = select(vec2<f32>(0.0), along / max(length_texels, 1.0e-3), length_texels > 1.0e-3) / texels;
+    for (var k = 0u; k <= 2u * COMBINE_RAY_STEPS; k++) {
+        let j = f32((k + 1u) / 2u) * select(-1.0, 1.0, (k & 1u) == 1u);
+        let at = a + j * stride;
+        if (!in_viewport(at)) {
+            continue;
+        }
+        let t = combine_texel(at, size);
+        if ((lod_buffer_id(textureLoad(older_id, t, 0).x) == id) != owned) {
+            continue;
+        }
+        let ray = reproject_refine(base, depth, textureLoad(older_depth, t, 0).x, new_to_old).xy + motion;
+        if (combine_ray_offset(ray, t, size) < COMBINE_RAY_REACH) {
+            return vec3<u32>(t, 1u);
+        }
+    }
+    return vec3<u32>(0u);
+}
+
+/// The read of `owner`'s older level where its coverage is known to include the pixel:
+/// combine_read_own within the 3x3 block; where that finds no texel of `owner`, the one
+/// combine_ray_texel finds on the pixel's ray; none: not found (the older buffer does not hold
+/// that part of the level, and another object's texel would show through it).
+fn combine_read_known(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> CombineRead {
+    let read = combine_read_own(older_color, older_id, older_depth, owner, uv, depth, new_to_old, motion, COMBINE_BLOCK_REACH);
+    if (lod_buffer_id(textureLoad(older_id, read.texel, 0).x) == owner) {
+        return read;
+    }
+    let base = reproject_base(uv, new_to_old);
+    let hit = combine_ray_texel(older_id, older_depth, owner, true, base, depth, new_to_old, motion);
+    if (hit.z == 0u) {
+        return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
+    }
+    let at = reproject_refine(base, depth, textureLoad(older_depth, hit.xy, 0).x, new_to_old).xy + motion;
+    let color = combine_own_color(older_color, older_id, owner, at, textureLoad(older_color, hit.xy, 0));
+    return CombineRead(hit.xy, color, true);
+}
+
+/// The older texel showing what lies behind `id`'s older level at the pixel, where that level is
+/// known not to cover it: combine_ray_texel's texel of another id on the pixel's ray (`base`,
+/// `depth`: the newer level's); none: combine_other_texel around `at`.
+fn combine_behind_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, id: u32, at: vec2<f32>, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec2<u32> {
+    let hit = combine_ray_texel(older_id, older_depth, id, false, base, depth, new_to_old, motion);
+    if (hit.z == 1u) {
+        return hit.xy;
+    }
+    return combine_other_texel(older_id, id, combine_texel(at, textureDimensions(older_id, 0)), at);
 }
 
 /// The estimated read of a pixel showing no known t-instance; a known t-instance's texel only
@@ -248,9 +326,9 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
                 return CombineRead(texel, textureLoad(older_color, texel, 0), true);
             }
             if (own == 1) {
-                return combine_read_own(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion, COMBINE_BLOCK_REACH);
+                return combine_read_known(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion);
             }
-            let texel = combine_other_texel(older_id, id, combine_texel(at, size), at);
+            let texel = combine_behind_texel(older_id, older_depth, id, at, base, newer.depth, m, newer.motion);
             return CombineRead(texel, textureLoad(older_color, texel, 0), true);
         }
         if ((object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) == (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) {

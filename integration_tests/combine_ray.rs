@@ -1,0 +1,227 @@
+//! The reads along the pixel's ray (`lodkit::combine_coverage::combine_ray_texel`,
+//! `combine_read_known`, `combine_behind_texel`) on the GPU, WGSL and GLSL, against the Rust
+//! twins, on a hand-made older buffer seen from a camera whose motion moves each depth by another
+//! amount (parallax): the texel a read wants lies several texels along the ray's image from where
+//! the newer depth reprojects, out of reach of the 3x3 block.
+
+use glam::{Mat4, UVec2, Vec2, Vec4};
+use lodkit::combine::{LodImage, combine_uv};
+use lodkit::combine_coverage::{combine_behind_texel, combine_ray_texel, combine_read_known};
+use lodkit::reproject::{reproject, reproject_base};
+
+use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words};
+
+const W: u32 = 16;
+const H: u32 = 4;
+/// Output words per case.
+const OUT: usize = 12;
+/// The t-instance whose older level the reads look for, on texels 10..=12 of every row, depth 0.5.
+const OWNER: u32 = 3;
+/// The camera's parallax: old NDC x = x + B (z - 0.9), so depth 0.9 stays in place and depth 0.5
+/// moves 6 texels right (8 texels per NDC unit), depth 1 1.5 texels left.
+const B: f32 = -1.875;
+const B_Z0: f32 = 1.6875;
+
+fn new_to_old() -> Mat4 {
+    Mat4::from_cols(
+        Vec4::new(1.0, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, 1.0, 0.0, 0.0),
+        Vec4::new(B, 0.0, 1.0, 0.0),
+        Vec4::new(B_Z0, 0.0, 0.0, 1.0),
+    )
+}
+
+/// Older buffer: OWNER on 10..=12 (depth 0.5); background (id 0) at depth 0.9 on rows 0 and 1,
+/// at depth 1 on rows 2 and 3.
+fn older() -> LodImage {
+    let n = (W * H) as usize;
+    let noise = lodkit::noise::white_noise(3 * n, 7);
+    let ids: Vec<u32> = (0..n as u32)
+        .map(|p| {
+            if (10..=12).contains(&(p % W)) {
+                OWNER
+            } else {
+                0
+            }
+        })
+        .collect();
+    LodImage {
+        width: W,
+        height: H,
+        colors: (0..n)
+            .map(|i| Vec4::new(noise[i], noise[n + i], noise[2 * n + i], 1.0))
+            .collect(),
+        depths: (0..n)
+            .map(|i| match (ids[i], i as u32 / W) {
+                (OWNER, _) => 0.5,
+                (_, 0 | 1) => 0.9,
+                _ => 1.0,
+            })
+            .collect(),
+        ids,
+        flags: vec![3; n],
+        motion: Vec::new(),
+    }
+}
+
+/// The cases: pixel and newer depth.
+const CASES: [(u32, u32, f32); 5] = [
+    // Background at depth 0.9 shows; OWNER's older texels lie 6 texels along the ray.
+    (4, 1, 0.9),
+    // The same 8 texels along: past COMBINE_RAY_STEPS.
+    (2, 1, 0.9),
+    // OWNER's newer level at depth 0.5: its read lands on OWNER's texel 11 at once.
+    (5, 1, 0.5),
+    // Behind OWNER's level at 0.5: the background at depth 0.9, 6 texels back along the ray.
+    (4, 1, 0.5),
+    // Behind it the background at depth 1, 7.5 texels back: out of reach.
+    (4, 2, 0.5),
+];
+
+/// The Rust twins' words for each case.
+fn twin_words(older: &LodImage) -> Vec<u32> {
+    let size = UVec2::new(W, H);
+    let m = new_to_old();
+    CASES
+        .iter()
+        .flat_map(|&(x, y, depth)| {
+            let uv = combine_uv(UVec2::new(x, y), size);
+            let base = reproject_base(uv, &m);
+            let known = combine_read_known(older, OWNER, uv, depth, &m, Vec2::ZERO);
+            let hit = |owned| {
+                combine_ray_texel(older, OWNER, owned, base, depth, &m, Vec2::ZERO)
+                    .map_or([0, 0, 0], |t| [t.x, t.y, 1])
+            };
+            let at = reproject(uv, depth, &m).truncate();
+            let behind = combine_behind_texel(older, OWNER, at, base, depth, &m, Vec2::ZERO);
+            let mut w = vec![known.texel.x, known.texel.y, u32::from(known.found)];
+            w.extend(words(&known.color.to_array()));
+            w.extend(hit(true));
+            w.extend([behind.x, behind.y]);
+            w
+        })
+        .collect()
+}
+
+/// Holds the words of one language (or of the Rust twins) to the answers worked out by hand from
+/// the texels above (not by the code under test).
+fn check_known(out: &[u32], older: &LodImage, who: &str) {
+    let case = |k: usize| &out[k * OUT..(k + 1) * OUT];
+    let color = |w: &[u32]| Vec4::from_slice(&floats(&w[3..7]));
+    let texel = |x: u32, y: u32| older.colors[(y * W + x) as usize];
+    let close = |a: Vec4, b: Vec4| (a - b).abs().max_element() <= 1e-5;
+    // (4, 1): the ray at depth 0.5 reprojects onto texel 10's center: that texel alone.
+    assert_eq!(case(0)[0..3], [10, 1, 1], "{who}: known read at (4, 1)");
+    assert!(
+        close(color(case(0)), texel(10, 1)),
+        "{who}: color at (4, 1)"
+    );
+    assert_eq!(case(0)[7..10], [10, 1, 1], "{who}: ray texel at (4, 1)");
+    // (2, 1): not found; no texel of OWNER within reach.
+    assert_eq!(
+        case(1)[2],
+        0,
+        "{who}: known read at (2, 1) must not be found"
+    );
+    assert_eq!(
+        case(1)[9],
+        0,
+        "{who}: ray texel at (2, 1) must not be found"
+    );
+    // (5, 1): the read lands on texel 11 at once.
+    assert_eq!(case(2)[0..3], [11, 1, 1], "{who}: known read at (5, 1)");
+    assert!(
+        close(color(case(2)), texel(11, 1)),
+        "{who}: color at (5, 1)"
+    );
+    // (4, 1) behind depth 0.5: the background texel (4, 1), where the ray meets depth 0.9; the
+    // 3x3 block's nearest other texel, (9, 1), shows background 5 texels off the ray.
+    assert_eq!(case(3)[10..12], [4, 1], "{who}: behind texel at (4, 1)");
+    // (4, 2): out of reach, the 3x3 block's nearest texel not holding OWNER.
+    assert_eq!(case(4)[10..12], [9, 2], "{who}: behind texel at (4, 2)");
+}
+
+#[test]
+fn ray_reads_give_the_hand_made_answers() {
+    let older = older();
+    check_known(&twin_words(&older), &older, "Rust twins");
+    // The scene is what it says: depth 0.5 at pixel 4 reprojects onto texel 10's center.
+    let uv = combine_uv(UVec2::new(4, 1), UVec2::new(W, H));
+    let at = reproject(uv, 0.5, &new_to_old()).truncate() * Vec2::new(W as f32, H as f32);
+    assert!((at - Vec2::new(10.5, 1.5)).length() < 1e-4, "{at}");
+}
+
+#[test]
+fn ray_read_twins_match() {
+    let gpu = lodkit_test_gpu!();
+    let older = older();
+    let want = twin_words(&older);
+    let inputs: Vec<u32> = CASES
+        .iter()
+        .flat_map(|&(x, y, depth)| [x, y, depth.to_bits()])
+        .collect();
+    let depths: Vec<Vec4> = older.depths.iter().map(|d| Vec4::splat(*d)).collect();
+    let ids: Vec<[u32; 4]> = (0..(W * H) as usize)
+        .map(|p| [older.word(p), 0, 0, 0])
+        .collect();
+    let matrix = format!("vec4({B:?}, 0.0, 1.0, 0.0), vec4({B_Z0:?}, 0.0, 0.0, 1.0)");
+    let wgsl = format!(
+        "let px = vec2(inp_u(0u), inp_u(1u));
+        let depth = inp_f(2u);
+        let m = mat4x4<f32>(vec4(1.0, 0.0, 0.0, 0.0), vec4(0.0, 1.0, 0.0, 0.0), {matrix});
+        let uv = combine_uv(px, vec2({W}u, {H}u));
+        let base = reproject_base(uv, m);
+        let known = combine_read_known(probe_rgba0, probe_urgba0, probe_rgba1, {OWNER}u, uv, depth, m, vec2(0.0));
+        out_u(0u, known.texel.x); out_u(1u, known.texel.y); out_u(2u, u32(known.found));
+        out_f(3u, known.color.x); out_f(4u, known.color.y); out_f(5u, known.color.z); out_f(6u, known.color.w);
+        let hit = combine_ray_texel(probe_urgba0, probe_rgba1, {OWNER}u, true, base, depth, m, vec2(0.0));
+        out_u(7u, hit.x); out_u(8u, hit.y); out_u(9u, hit.z);
+        let behind = combine_behind_texel(probe_urgba0, probe_rgba1, {OWNER}u, reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
+        out_u(10u, behind.x); out_u(11u, behind.y);"
+    );
+    let glsl = format!(
+        "uvec2 px = uvec2(inp_u(0u), inp_u(1u));
+        float depth = inp_f(2u);
+        mat4 m = mat4(vec4(1.0, 0.0, 0.0, 0.0), vec4(0.0, 1.0, 0.0, 0.0), {matrix});
+        vec2 uv = lodkit_combine_uv(px, uvec2({W}u, {H}u));
+        vec4 base = lodkit_reproject_base(uv, m);
+        lodkit_CombineRead known = lodkit_combine_read_known({OWNER}u, uv, depth, m, vec2(0.0));
+        out_u(0u, known.texel.x); out_u(1u, known.texel.y); out_u(2u, uint(known.found));
+        out_f(3u, known.color.x); out_f(4u, known.color.y); out_f(5u, known.color.z); out_f(6u, known.color.w);
+        uvec3 hit = lodkit_combine_ray_texel({OWNER}u, true, base, depth, m, vec2(0.0));
+        out_u(7u, hit.x); out_u(8u, hit.y); out_u(9u, hit.z);
+        uvec2 behind = lodkit_combine_behind_texel({OWNER}u, lodkit_reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
+        out_u(10u, behind.x); out_u(11u, behind.y);"
+    );
+    let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
+vec4 lodkit_combine_fetch_color(uvec2 t) { return texelFetch(sampler2D(probe_rgba0, probe_sampler), ivec2(t), 0); }
+uint lodkit_combine_fetch_word(uvec2 t) { return texelFetch(usampler2D(probe_urgba0, probe_sampler), ivec2(t), 0).x; }
+float lodkit_combine_fetch_depth(uvec2 t) { return texelFetch(sampler2D(probe_rgba1, probe_sampler), ivec2(t), 0).x; }
+uvec2 lodkit_combine_fetch_size() { return uvec2(textureSize(sampler2D(probe_rgba0, probe_sampler), 0)); }
+uvec4 lodkit_silhouette_fetch(uint i) { return uvec4(0u); }";
+    let wgsl_header = "#import lodkit::combine::combine_uv
+#import lodkit::combine_coverage::{combine_read_known, combine_ray_texel, combine_behind_texel}
+#import lodkit::reproject::{reproject, reproject_base}";
+    // Texels and flags exact; the colors are single texels (a weight of exactly 1): 1e-5.
+    let mut kinds = vec![Word::Exact; 3];
+    kinds.extend([Word::Float(1e-5); 4]);
+    kinds.extend([Word::Exact; 5]);
+    let colors = older.colors.clone();
+    for (route, language, header, body) in
+        twin_runs(gpu, (wgsl_header, &wgsl), (glsl_header, &glsl))
+    {
+        let probe = Probe {
+            header,
+            body,
+            inputs: 3,
+            outputs: OUT,
+            texture: None,
+            rgba: &[(W, H, &colors), (W, H, &depths)],
+            urgba: &[(W, H, &ids)],
+        };
+        let got = run_on(gpu, route, &probe, &inputs, language, &[]);
+        let who = format!("{route:?} {language:?}");
+        check_known(&got, &older, &who);
+        assert_twin(&got, &want, &kinds, &format!("{who} combine ray reads"));
+    }
+}
