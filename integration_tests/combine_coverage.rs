@@ -2,7 +2,8 @@
 //! of `lodkit::combine` it is built from) on the GPU, WGSL and GLSL, against the Rust twins, on a
 //! hand-made pair of LOD buffers whose answers are known: the older level's silhouette covers a
 //! pixel the older buffer's read misses, a neighbour is taken only where its sample lies on the
-//! pixel's ray, and the older color is the bilinear blend of the same object's texels.
+//! pixel's ray, the older color is the bilinear blend of the same object's texels, and an object
+//! in front of the older level hides it only by more than `COMBINE_HIDDEN_MARGIN`.
 
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 use lodkit::combine::{
@@ -107,11 +108,16 @@ fn scene() -> Scene {
             motion: Vec::new(),
         }
     };
-    let older = image(&older_id, 0);
+    let mut older = image(&older_id, 0);
+    // FRONT touches the silhouette t-instance's older level at texel (5, 8): 0.0002 in front,
+    // within COMBINE_HIDDEN_MARGIN (0.01 of 1 - 0.95: 0.0005).
+    older.depths[at(5, 8)] = 0.9498;
     let newer = image(&newer_id, 3);
     let mut pattern: Vec<f32> = noise[6 * n..7 * n].to_vec();
-    // Where the silhouette test is checked, the older level is displayed (pattern <= tau 0.5).
+    // Where the silhouette test and the touching texel are checked, the older level is
+    // displayed (pattern <= tau 0.5).
     pattern[at(3, 5)] = 0.1;
+    pattern[at(5, 8)] = 0.1;
     // The older level's silhouette under this frame's camera: the square from (3, 3) to (10, 9)
     // in pixels (its texels 4..=9 moved 0.3 texel left by the camera, widened by its edges),
     // which covers pixel column 3 where the older buffer's read finds background.
@@ -297,6 +303,18 @@ fn check_known(out: &[u32], s: &Scene, who: &str) {
         close(got, older(6, 7), 1e-5),
         "{who}: pixel (6, 7) shows {got}, not the older object in front, {}",
         older(6, 7)
+    );
+    // Touching: pixel (5, 8) reads x 5.8 and finds FRONT at texel (5, 8), in front of the
+    // t-instance's older level by less than COMBINE_HIDDEN_MARGIN: not hidden. The read takes the
+    // t-instance's texel (4, 8) (the block's first at 1.3 texels from the ray; (4, 7) ties), whose
+    // 2x2 blend holds no texel of it; both levels are shown and have one id: their average.
+    let got = color(pixel(5, 8), 0);
+    let want = 0.5 * (s.newer.colors[at(5, 8)] + older(4, 8));
+    assert!(
+        close(got, want, 1e-5),
+        "{who}: pixel (5, 8) shows {got}, not the average of its newer color and texel (4, 8), {want} \
+         (FRONT's older color: {})",
+        older(5, 8)
     );
     // combine_known_covers: only the silhouette t-instance has a known silhouette, the square
     // from (3, 3) to (10, 9), which holds the centers of pixels 3..=9 x 3..=8 (a center is never

@@ -2,11 +2,15 @@
 //! `combine_read_known`, `combine_behind_texel`) on the GPU, WGSL and GLSL, against the Rust
 //! twins, on a hand-made older buffer seen from a camera whose motion moves each depth by another
 //! amount (parallax): the texel a read wants lies several texels along the ray's image from where
-//! the newer depth reprojects, out of reach of the 3x3 block.
+//! the newer depth reprojects, out of reach of the 3x3 block. A pixel that shows no t-instance
+//! reads a level whose silhouette covers it the same way (`combine_read_silhouettes`).
 
 use glam::{Mat4, UVec2, Vec2, Vec4};
-use lodkit::combine::{LodImage, combine_uv};
-use lodkit::combine_coverage::{combine_behind_texel, combine_ray_texel, combine_read_known};
+use lodkit::combine::{DepthConvention, LodImage, combine_uv};
+use lodkit::combine_coverage::{
+    CombineData, CombineDataDescriptor, CombineObjectData, CoverageRoute, combine_behind_texel,
+    combine_ray_texel, combine_read_known, combine_read_silhouettes,
+};
 use lodkit::reproject::{reproject, reproject_base};
 
 use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words};
@@ -14,7 +18,7 @@ use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words}
 const W: u32 = 16;
 const H: u32 = 4;
 /// Output words per case.
-const OUT: usize = 12;
+const OUT: usize = 15;
 /// The t-instance whose older level the reads look for, on texels 10..=12 of every row, depth 0.5.
 const OWNER: u32 = 3;
 /// The camera's parallax: old NDC x = x + B (z - 0.9), so depth 0.9 stays in place and depth 0.5
@@ -64,6 +68,31 @@ fn older() -> LodImage {
     }
 }
 
+/// The data texture: OWNER's older level known by its silhouette, a rectangle over the whole
+/// target (every pixel center lies inside it, none on it).
+fn data() -> CombineData {
+    let (w, h) = (W as f32, H as f32);
+    let square = [
+        [0.0, 0.0, 0.0, h],
+        [0.0, h, w, h],
+        [w, h, w, 0.0],
+        [w, 0.0, 0.0, 0.0],
+    ];
+    let objects = [CombineObjectData {
+        id: OWNER,
+        new_to_old: new_to_old(),
+        older_tau: None,
+        route: CoverageRoute::Silhouette(&square),
+    }];
+    CombineData::new(&CombineDataDescriptor {
+        new_to_old: new_to_old(),
+        height: H,
+        objects: &objects,
+        ..Default::default()
+    })
+    .expect("one record")
+}
+
 /// The cases: pixel and newer depth.
 const CASES: [(u32, u32, f32); 5] = [
     // Background at depth 0.9 shows; OWNER's older texels lie 6 texels along the ray.
@@ -79,7 +108,7 @@ const CASES: [(u32, u32, f32); 5] = [
 ];
 
 /// The Rust twins' words for each case.
-fn twin_words(older: &LodImage) -> Vec<u32> {
+fn twin_words(older: &LodImage, data: &CombineData) -> Vec<u32> {
     let size = UVec2::new(W, H);
     let m = new_to_old();
     CASES
@@ -98,6 +127,16 @@ fn twin_words(older: &LodImage) -> Vec<u32> {
             w.extend(words(&known.color.to_array()));
             w.extend(hit(true));
             w.extend([behind.x, behind.y]);
+            let p = UVec2::new(x, y).as_vec2() + 0.5;
+            let covered = combine_read_silhouettes(
+                older,
+                &data.texels,
+                uv,
+                depth,
+                p,
+                DepthConvention::Standard,
+            );
+            w.extend([covered.texel.x, covered.texel.y, u32::from(covered.found)]);
             w
         })
         .collect()
@@ -139,12 +178,25 @@ fn check_known(out: &[u32], older: &LodImage, who: &str) {
     assert_eq!(case(3)[10..12], [4, 1], "{who}: behind texel at (4, 1)");
     // (4, 2): out of reach, the 3x3 block's nearest texel not holding OWNER.
     assert_eq!(case(4)[10..12], [9, 2], "{who}: behind texel at (4, 2)");
+    // A pixel showing the background (depth 0.9) inside OWNER's older silhouette reads that
+    // level along the ray: at (4, 1) texel 10; at (2, 1) none within reach, so not found
+    // (combine_read goes on to the estimate, not to the background texel the read lands on).
+    assert_eq!(
+        case(0)[12..15],
+        [10, 1, 1],
+        "{who}: silhouette read at (4, 1)"
+    );
+    assert_eq!(
+        case(1)[14],
+        0,
+        "{who}: silhouette read at (2, 1) must not be found"
+    );
 }
 
 #[test]
 fn ray_reads_give_the_hand_made_answers() {
     let older = older();
-    check_known(&twin_words(&older), &older, "Rust twins");
+    check_known(&twin_words(&older, &data()), &older, "Rust twins");
     // The scene is what it says: depth 0.5 at pixel 4 reprojects onto texel 10's center.
     let uv = combine_uv(UVec2::new(4, 1), UVec2::new(W, H));
     let at = reproject(uv, 0.5, &new_to_old()).truncate() * Vec2::new(W as f32, H as f32);
@@ -155,7 +207,8 @@ fn ray_reads_give_the_hand_made_answers() {
 fn ray_read_twins_match() {
     let gpu = lodkit_test_gpu!();
     let older = older();
-    let want = twin_words(&older);
+    let data = data();
+    let want = twin_words(&older, &data);
     let inputs: Vec<u32> = CASES
         .iter()
         .flat_map(|&(x, y, depth)| [x, y, depth.to_bits()])
@@ -177,7 +230,9 @@ fn ray_read_twins_match() {
         let hit = combine_ray_texel(probe_urgba0, probe_rgba1, {OWNER}u, true, base, depth, m, vec2(0.0));
         out_u(7u, hit.x); out_u(8u, hit.y); out_u(9u, hit.z);
         let behind = combine_behind_texel(probe_urgba0, probe_rgba1, {OWNER}u, reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
-        out_u(10u, behind.x); out_u(11u, behind.y);"
+        out_u(10u, behind.x); out_u(11u, behind.y);
+        let covered = combine_read_silhouettes(probe_rgba0, probe_urgba0, probe_rgba1, probe_urgba1, uv, depth, vec2<f32>(px) + 0.5);
+        out_u(12u, covered.texel.x); out_u(13u, covered.texel.y); out_u(14u, u32(covered.found));"
     );
     let glsl = format!(
         "uvec2 px = uvec2(inp_u(0u), inp_u(1u));
@@ -191,21 +246,26 @@ fn ray_read_twins_match() {
         uvec3 hit = lodkit_combine_ray_texel({OWNER}u, true, base, depth, m, vec2(0.0));
         out_u(7u, hit.x); out_u(8u, hit.y); out_u(9u, hit.z);
         uvec2 behind = lodkit_combine_behind_texel({OWNER}u, lodkit_reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
-        out_u(10u, behind.x); out_u(11u, behind.y);"
+        out_u(10u, behind.x); out_u(11u, behind.y);
+        lodkit_CombineRead covered = lodkit_combine_read_silhouettes(uv, depth, vec2(px) + 0.5);
+        out_u(12u, covered.texel.x); out_u(13u, covered.texel.y); out_u(14u, uint(covered.found));"
     );
     let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
 vec4 lodkit_combine_fetch_color(uvec2 t) { return texelFetch(sampler2D(probe_rgba0, probe_sampler), ivec2(t), 0); }
 uint lodkit_combine_fetch_word(uvec2 t) { return texelFetch(usampler2D(probe_urgba0, probe_sampler), ivec2(t), 0).x; }
 float lodkit_combine_fetch_depth(uvec2 t) { return texelFetch(sampler2D(probe_rgba1, probe_sampler), ivec2(t), 0).x; }
 uvec2 lodkit_combine_fetch_size() { return uvec2(textureSize(sampler2D(probe_rgba0, probe_sampler), 0)); }
-uvec4 lodkit_silhouette_fetch(uint i) { return uvec4(0u); }";
+uvec4 lodkit_silhouette_fetch(uint i) {
+    uint w = uint(textureSize(usampler2D(probe_urgba1, probe_sampler), 0).x);
+    return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
+}";
     let wgsl_header = "#import lodkit::combine::combine_uv
-#import lodkit::combine_coverage::{combine_read_known, combine_ray_texel, combine_behind_texel}
+#import lodkit::combine_coverage::{combine_read_known, combine_ray_texel, combine_behind_texel, combine_read_silhouettes}
 #import lodkit::reproject::{reproject, reproject_base}";
     // Texels and flags exact; the colors are single texels (a weight of exactly 1): 1e-5.
     let mut kinds = vec![Word::Exact; 3];
     kinds.extend([Word::Float(1e-5); 4]);
-    kinds.extend([Word::Exact; 5]);
+    kinds.extend([Word::Exact; 8]);
     let colors = older.colors.clone();
     for (route, language, header, body) in
         twin_runs(gpu, (wgsl_header, &wgsl), (glsl_header, &glsl))
@@ -217,7 +277,7 @@ uvec4 lodkit_silhouette_fetch(uint i) { return uvec4(0u); }";
             outputs: OUT,
             texture: None,
             rgba: &[(W, H, &colors), (W, H, &depths)],
-            urgba: &[(W, H, &ids)],
+            urgba: &[(W, H, &ids), (data.width, data.height, &data.texels)],
         };
         let got = run_on(gpu, route, &probe, &inputs, language, &[]);
         let who = format!("{route:?} {language:?}");

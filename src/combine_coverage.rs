@@ -241,10 +241,38 @@ pub fn combine_read_level_depth(
     )
 }
 
-/// Whether the older texel at texture-space `at` holds an object other than `owner` closer than
-/// clip depth `depth` (Rust twin of `combine_hidden`): there the older frame drew that object in
-/// front of `owner`'s older level, so the older level's silhouette covering the pixel does not
-/// make it visible.
+/// How far in front of a level's point, as a share of the point's view distance, an older object
+/// must lie for [`combine_hidden`] to take it as hiding the level. Where two surfaces touch (a
+/// trunk entering the ground), interpolated and reprojected depths put them a fraction of a
+/// percent apart either way; a bare comparison then shows the ground through the trunk.
+pub const COMBINE_HIDDEN_MARGIN: f32 = 0.01;
+
+/// Whether clip depth `a` lies closer to the camera than `b` by more than
+/// [`COMBINE_HIDDEN_MARGIN`] of `b`'s view distance (Rust twin of `combine_clearly_closer`).
+/// Under a perspective projection whose far plane lies well past the scene (or at infinity),
+/// 1 - depth (reversed Z: depth) is inversely proportional to the view distance, so the margin
+/// is taken on that.
+///
+/// ```
+/// # use lodkit::combine::DepthConvention::{Reversed, Standard};
+/// # use lodkit::combine_coverage::combine_clearly_closer;
+/// // 0.95 leaves 0.05 to the far plane: the margin is 0.0005 of depth.
+/// assert!(!combine_clearly_closer(0.9498, 0.95, Standard)); // touching
+/// assert!(combine_clearly_closer(0.949, 0.95, Standard));
+/// assert!(!combine_clearly_closer(0.0504, 0.05, Reversed)); // 1 % closer needs 0.0505
+/// assert!(combine_clearly_closer(0.051, 0.05, Reversed));
+/// ```
+pub fn combine_clearly_closer(a: f32, b: f32, convention: DepthConvention) -> bool {
+    match convention {
+        DepthConvention::Standard => a < b - COMBINE_HIDDEN_MARGIN * (1.0 - b),
+        DepthConvention::Reversed => a > b * (1.0 + COMBINE_HIDDEN_MARGIN),
+    }
+}
+
+/// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
+/// closer than clip depth `depth` ([`combine_clearly_closer`]; Rust twin of `combine_hidden`):
+/// there the older frame drew that object in front of `owner`'s older level, so the older
+/// level's silhouette covering the pixel does not make it visible.
 pub fn combine_hidden(
     older: &LodImage,
     owner: u32,
@@ -255,7 +283,7 @@ pub fn combine_hidden(
     let texel = combine_texel(at, size_of(older));
     in_viewport(at)
         && id_at(older, texel) != owner
-        && depth_closer(depth_at(older, texel), depth, convention)
+        && combine_clearly_closer(depth_at(older, texel), depth, convention)
 }
 
 /// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
@@ -267,10 +295,11 @@ pub fn combine_known_covers(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
     id != 0 && o.flags & wanted == wanted && silhouette_covers(data, o.silhouette, p) != 0
 }
 
-/// For a pixel that shows no t-instance: the older read of the first t-instance whose older
-/// level's silhouette covers the pixel center `p` (pixels) and that no other t-instance whose
-/// silhouette covers it too hides there ([`combine_hidden`], [`combine_known_covers`]), read with that t-instance's own matrix and no motion
-/// (such a pixel has none of its own); not found where none does. A center on a silhouette
+/// For a pixel that shows no t-instance: the older read ([`combine_read_known`]) of the first
+/// t-instance whose older level's silhouette covers the pixel center `p` (pixels), that no other
+/// t-instance whose silhouette covers it too hides there ([`combine_hidden`],
+/// [`combine_known_covers`]), and whose older level the read finds, read with that t-instance's
+/// own matrix and no motion (such a pixel has none of its own); not found where none does. A center on a silhouette
 /// ([`SILHOUETTE_ON`]) is covered as last frame's picture has it.
 pub fn combine_read_silhouettes(
     older: &LodImage,
@@ -303,7 +332,10 @@ pub fn combine_read_silhouettes(
         let hidden = combine_hidden(older, g, point.truncate(), point.z, convention)
             && combine_known_covers(data, front, p);
         if covers == 1 && !hidden {
-            return combine_read_own(older, g, uv, depth, &m, Vec2::ZERO, COMBINE_BLOCK_REACH);
+            let read = combine_read_known(older, g, uv, depth, &m, Vec2::ZERO);
+            if read.found {
+                return read;
+            }
         }
     }
     NOT_FOUND

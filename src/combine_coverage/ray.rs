@@ -6,7 +6,7 @@
 
 use glam::{Mat4, UVec2, Vec2, Vec4};
 
-use crate::combine::older::{NOT_FOUND, depth_at, id_at, size_of};
+use crate::combine::older::{NOT_FOUND, depth_at, found, id_at, size_of};
 use crate::combine::{
     COMBINE_BLOCK_REACH, CombineRead, LodImage, combine_other_texel, combine_own_color,
     combine_ray_offset, combine_read_own, combine_texel,
@@ -103,7 +103,7 @@ pub fn combine_read_known(
         return NOT_FOUND;
     };
     let at = reproject_refine(base, depth, depth_at(older, hit), new_to_old).truncate() + motion;
-    let mut read = crate::combine::older::found(older, hit);
+    let mut read = found(older, hit);
     read.color = combine_own_color(older, owner, at, read.color);
     read
 }

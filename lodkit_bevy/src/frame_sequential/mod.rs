@@ -17,8 +17,8 @@
 //! crossfade's on lavapipe (the example reports `gpu_ms_<run>` per pass). The combine is
 //! lodkit's (`lodkit::combine_coverage::combine_pixel`); the plugin's shader holds only what is
 //! Bevy's. It
-//! pops less (0.031 / 0.028 against 0.043 / 0.035, still / moving camera), shows no background
-//! through an object, and flickers less on the change-over-net measure (1.91 / 5.17 against
+//! pops less (0.031 / 0.029 against 0.043 / 0.035, still / moving camera), shows no background
+//! through an object, and flickers less on the change-over-net measure (1.89 / 5.06 against
 //! 1.97 / 5.52): the level not drawn is placed exactly by its silhouette
 //! ([`OlderCoverage::Silhouette`], found on the CPU), and where the paper's schedule shows both
 //! levels a pixel shows their average, a true half blend the crossfade's dither cannot make

@@ -31,8 +31,12 @@
 //       behind id's older level, on the ray
 //   lodkit_combine_read_estimated(uv, depth, base, old, new_to_old, motion) -> lodkit_CombineRead
 //   lodkit_combine_read_level_depth(level, id, uv, depth, old, motion) -> lodkit_CombineRead
+//   LODKIT_COMBINE_HIDDEN_MARGIN   how far in front (a share of the view distance) an older
+//       object must lie to hide a level
+//   lodkit_combine_clearly_closer(a, b) -> bool   whether clip depth a lies closer than b by
+//       more than LODKIT_COMBINE_HIDDEN_MARGIN of b's view distance
 //   lodkit_combine_hidden(owner, at, depth) -> bool   whether the older texel at `at` holds
-//       another object closer than clip depth `depth`
+//       another object clearly closer than clip depth `depth`
 //   lodkit_combine_known_covers(id, p) -> bool   whether id's older silhouette is known and
 //       covers the pixel center p
 //   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   the routes' reads
@@ -261,12 +265,31 @@ lodkit_CombineRead lodkit_combine_read_level_depth(float level, uint id, vec2 uv
     return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
 }
 
-/// Whether the older texel at texture-space `at` holds an object other than `owner` closer than
-/// clip depth `depth`: there the older frame drew that object in front of `owner`'s older level.
+/// How far in front of a level's point, as a share of the point's view distance, an older object
+/// must lie for lodkit_combine_hidden to take it as hiding the level. Where two surfaces touch (a
+/// trunk entering the ground), interpolated and reprojected depths put them a fraction of a
+/// percent apart either way; a bare comparison then shows the ground through the trunk.
+const float LODKIT_COMBINE_HIDDEN_MARGIN = 0.01;
+
+/// Whether clip depth `a` lies closer to the camera than `b` by more than
+/// LODKIT_COMBINE_HIDDEN_MARGIN of `b`'s view distance. Under a perspective projection whose far
+/// plane lies well past the scene (or at infinity), 1 - depth (reversed Z: depth) is inversely
+/// proportional to the view distance, so the margin is taken on that.
+bool lodkit_combine_clearly_closer(float a, float b) {
+#ifdef LODKIT_REVERSE_Z
+    return a > b * (1.0 + LODKIT_COMBINE_HIDDEN_MARGIN);
+#else
+    return a < b - LODKIT_COMBINE_HIDDEN_MARGIN * (1.0 - b);
+#endif
+}
+
+/// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
+/// closer than clip depth `depth` (lodkit_combine_clearly_closer): there the older frame drew that
+/// object in front of `owner`'s older level.
 bool lodkit_combine_hidden(uint owner, vec2 at, float depth) {
     uvec2 texel = lodkit_combine_texel(at, lodkit_combine_fetch_size());
     uint held = lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel));
-    return lodkit_in_viewport(at) && held != owner && lodkit_depth_closer(lodkit_combine_fetch_depth(texel), depth);
+    return lodkit_in_viewport(at) && held != owner && lodkit_combine_clearly_closer(lodkit_combine_fetch_depth(texel), depth);
 }
 
 /// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
@@ -277,10 +300,11 @@ bool lodkit_combine_known_covers(uint id, vec2 p) {
     return id != 0u && (o.flags & wanted) == wanted && lodkit_silhouette_covers(o.silhouette, p) != 0;
 }
 
-/// For a pixel showing no t-instance: the read of the first t-instance whose older silhouette
-/// covers the pixel center `p` (on it: as last frame's picture has it) and is not hidden there
-/// by another t-instance whose silhouette covers it too (lodkit_combine_hidden,
-/// lodkit_combine_known_covers); none: not found.
+/// For a pixel showing no t-instance: the read (lodkit_combine_read_known) of the first
+/// t-instance whose older silhouette covers the pixel center `p` (on it: as last frame's picture
+/// has it), is not hidden there by another t-instance whose silhouette covers it too
+/// (lodkit_combine_hidden, lodkit_combine_known_covers), and whose older level the read finds;
+/// none: not found.
 lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p) {
     uvec2 size = lodkit_combine_fetch_size();
     uint slots = lodkit_silhouette_texel(5u).z;
@@ -303,7 +327,10 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
         uint front = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(point.xy, size)));
         bool hidden = lodkit_combine_hidden(g, point.xy, point.z) && lodkit_combine_known_covers(front, p);
         if (covers == 1 && !hidden) {
-            return lodkit_combine_read_own(g, uv, depth, m, vec2(0.0), LODKIT_COMBINE_BLOCK_REACH);
+            lodkit_CombineRead read = lodkit_combine_read_known(g, uv, depth, m, vec2(0.0));
+            if (read.found) {
+                return read;
+            }
         }
     }
     return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);

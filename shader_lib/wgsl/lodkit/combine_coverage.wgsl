@@ -35,8 +35,13 @@
 //       new_to_old, motion) -> CombineRead   a pixel showing no known t-instance, estimated
 //   combine_read_level_depth(older_color, older_id, older_depth, data, level, id, uv, depth, old,
 //       motion) -> CombineRead   by the older-level depth pass
+//   COMBINE_HIDDEN_MARGIN   how far in front (a share of the view distance) an older object must
+//       lie to hide a level
+//   combine_clearly_closer(a, b) -> bool   whether clip depth a lies closer than b by more than
+//       COMBINE_HIDDEN_MARGIN of b's view distance
 //   combine_hidden(older_id, older_depth, owner, at, depth) -> bool   whether the older texel at
-//       `at` holds another object closer than clip depth `depth` (owner's older level hidden)
+//       `at` holds another object clearly closer than clip depth `depth` (owner's older level
+//       hidden)
 //   combine_known_covers(data, id, p) -> bool   whether id's older silhouette is known and covers
 //       the pixel center p
 //   combine_read_silhouettes(older_color, older_id, older_depth, data, uv, depth, p)
@@ -258,12 +263,31 @@ fn combine_read_level_depth(older_color: texture_2d<f32>, older_id: texture_2d<u
     return CombineRead(texel, textureLoad(older_color, texel, 0), true);
 }
 
-/// Whether the older texel at texture-space `at` holds an object other than `owner` closer than
-/// clip depth `depth`: there the older frame drew that object in front of `owner`'s older level.
+/// How far in front of a level's point, as a share of the point's view distance, an older object
+/// must lie for combine_hidden to take it as hiding the level. Where two surfaces touch (a trunk
+/// entering the ground), interpolated and reprojected depths put them a fraction of a percent
+/// apart either way; a bare comparison then shows the ground through the trunk.
+const COMBINE_HIDDEN_MARGIN: f32 = 0.01;
+
+/// Whether clip depth `a` lies closer to the camera than `b` by more than COMBINE_HIDDEN_MARGIN
+/// of `b`'s view distance. Under a perspective projection whose far plane lies well past the
+/// scene (or at infinity), 1 - depth (reversed Z: depth) is inversely proportional to the view
+/// distance, so the margin is taken on that.
+fn combine_clearly_closer(a: f32, b: f32) -> bool {
+#ifdef LODKIT_REVERSE_Z
+    return a > b * (1.0 + COMBINE_HIDDEN_MARGIN);
+#else
+    return a < b - COMBINE_HIDDEN_MARGIN * (1.0 - b);
+#endif
+}
+
+/// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
+/// closer than clip depth `depth` (combine_clearly_closer): there the older frame drew that
+/// object in front of `owner`'s older level.
 fn combine_hidden(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, at: vec2<f32>, depth: f32) -> bool {
     let texel = combine_texel(at, textureDimensions(older_id, 0));
     let held = lod_buffer_id(textureLoad(older_id, texel, 0).x);
-    return in_viewport(at) && held != owner && depth_closer(textureLoad(older_depth, texel, 0).x, depth);
+    return in_viewport(at) && held != owner && combine_clearly_closer(textureLoad(older_depth, texel, 0).x, depth);
 }
 
 /// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
@@ -274,10 +298,10 @@ fn combine_known_covers(data: texture_2d<u32>, id: u32, p: vec2<f32>) -> bool {
     return id != 0u && (o.flags & wanted) == wanted && silhouette_covers(data, o.silhouette, p) != 0;
 }
 
-/// For a pixel showing no t-instance: the read of the first t-instance whose older silhouette
-/// covers the pixel center `p` (on it: as last frame's picture has it) and is not hidden there
-/// by another t-instance whose silhouette covers it too (combine_hidden, combine_known_covers);
-/// none: not found.
+/// For a pixel showing no t-instance: the read (combine_read_known) of the first t-instance
+/// whose older silhouette covers the pixel center `p` (on it: as last frame's picture has it),
+/// is not hidden there by another t-instance whose silhouette covers it too (combine_hidden,
+/// combine_known_covers), and whose older level the read finds; none: not found.
 fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, uv: vec2<f32>, depth: f32, p: vec2<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     let slots = silhouette_texel(data, 5u).z;
@@ -300,7 +324,10 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
         let front = lod_buffer_id(textureLoad(older_id, combine_texel(point.xy, size), 0).x);
         let hidden = combine_hidden(older_id, older_depth, g, point.xy, point.z) && combine_known_covers(data, front, p);
         if (covers == 1 && !hidden) {
-            return combine_read_own(older_color, older_id, older_depth, g, uv, depth, m, vec2<f32>(0.0), COMBINE_BLOCK_REACH);
+            let read = combine_read_known(older_color, older_id, older_depth, g, uv, depth, m, vec2<f32>(0.0));
+            if (read.found) {
+                return read;
+            }
         }
     }
     return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
