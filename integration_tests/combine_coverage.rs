@@ -12,8 +12,9 @@ use lodkit::combine::{
     combine_snap, combine_texel, combine_uv,
 };
 use lodkit::combine_coverage::{
-    CombineData, CombineDataDescriptor, CombineNewer, CombineObjectData, CoverageRoute,
-    combine_far_depth, combine_known_covers, combine_new_to_old, combine_object, combine_pixel,
+    COMBINE_EDGE_REACH, CombineData, CombineDataDescriptor, CombineNewer, CombineObjectData,
+    CoverageRoute, combine_edge_uv, combine_far_depth, combine_known_covers, combine_new_to_old,
+    combine_object, combine_pixel,
 };
 use lodkit::lod_buffer::{lod_buffer_id, lod_buffer_word};
 use lodkit::reproject::{reproject, reproject_base};
@@ -24,7 +25,7 @@ use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words}
 const W: u32 = 16;
 const H: u32 = 12;
 /// Output words per pixel.
-const OUT: usize = 21;
+const OUT: usize = 24;
 /// The camera moved so that every pixel's center reprojects 0.3 texel right of its own texel's
 /// center (NDC x + 0.3 * 2 / 16): a read lands at x + 0.8 texels, 0.2 texel from any edge.
 const SHIFT: f32 = 0.0375;
@@ -169,6 +170,16 @@ fn newer_at(s: &Scene, p: usize) -> CombineNewer {
     }
 }
 
+/// The uv each pixel hands `combine_edge_uv`: 5 texels left of its own column, on its row's
+/// center, so columns 0..=4 lie 5.5..=1.5 texels outside the view from the left edge texel's
+/// center (the probes compute the same: `(x - 5) / 16`, `(y + 0.5) / 12`).
+fn edge_probe_uv(px: UVec2) -> Vec2 {
+    Vec2::new(
+        (px.x as f32 - 5.0) / W as f32,
+        (px.y as f32 + 0.5) / H as f32,
+    )
+}
+
 /// The Rust twins' words for every pixel (the probe's outputs).
 fn twin_words(s: &Scene) -> Vec<u32> {
     let size = UVec2::new(W, H);
@@ -230,6 +241,9 @@ fn twin_words(s: &Scene) -> Vec<u32> {
                     .map(|(k, &id)| u32::from(combine_known_covers(texels, id, p)) << k)
                     .sum(),
             );
+            let edge = combine_edge_uv(edge_probe_uv(px), size);
+            w.extend(words(&edge.unwrap_or(Vec2::ZERO).to_array()));
+            w.push(u32::from(edge.is_some()));
             w
         })
         .collect()
@@ -327,6 +341,28 @@ fn check_known(out: &[u32], s: &Scene, who: &str) {
             "{who}: combine_known_covers at pixel ({x}, {y}) (bits: SIL, EST, FRONT, id 0)"
         );
     }
+    // combine_edge_uv: columns 0 and 1 lie 5.5 and 4.5 texels out, past COMBINE_EDGE_REACH (4):
+    // nothing to read; 2..=4 (3.5 to 1.5 out) read the left column's center, x 0.5 / 16; 5 and
+    // on lie in the view and keep their uv.
+    assert_eq!(COMBINE_EDGE_REACH, 4.0);
+    for (x, y) in (0..W).flat_map(|x| (0..H).map(move |y| (x, y))) {
+        let w = pixel(x, y);
+        let row = (y as f32 + 0.5) / H as f32;
+        let want = match x {
+            0 | 1 => None,
+            2..=4 => Some(Vec2::new(0.5 / W as f32, row)),
+            _ => Some(Vec2::new((x as f32 - 5.0) / W as f32, row)),
+        };
+        let got = (w[23] == 1).then(|| Vec2::from_slice(&floats(&w[21..23])));
+        let agree = match (got, want) {
+            (Some(g), Some(e)) => (g - e).abs().max_element() <= 1e-6,
+            (g, e) => g.is_none() && e.is_none(),
+        };
+        assert!(
+            agree,
+            "{who}: combine_edge_uv at pixel ({x}, {y}): {got:?}, not {want:?}"
+        );
+    }
     // The ray offset of every read is 0.3 texel; the snap keeps 0.3 and takes 0.995 as 1.
     assert!(
         (f32::from_bits(pixel(0, 0)[16]) - 0.3).abs() < 1e-4,
@@ -342,6 +378,65 @@ fn combine_coverage_pieces_give_the_hand_made_answers() {
     // The scene's words are what it says.
     assert_eq!(lod_buffer_id(s.newer.word(at(14, 3))), EST);
     assert_eq!(s.newer.word(at(3, 5)), lod_buffer_word(0, 3));
+}
+
+/// A camera that moved sideways brings a strip of the picture into view: where a pixel's
+/// reprojection lands within COMBINE_EDGE_REACH texels outside last frame's picture, its older
+/// level is read at the picture's edge, not left to the level drawn now (a full switch between
+/// the two levels there on every other frame).
+#[test]
+fn combine_pixel_reads_the_older_edge_for_a_strip_coming_into_view() {
+    const T: u32 = 2;
+    let (w, h) = (8u32, 2u32);
+    let n = (w * h) as usize;
+    // Every pixel's center reprojects 2 texels left of itself (NDC x - 2 * 2 / 8).
+    let camera = Mat4::from_translation(Vec3::new(-0.5, 0.0, 0.0));
+    let image = |red: f32| LodImage {
+        width: w,
+        height: h,
+        colors: (0..n)
+            .map(|i| Vec4::new(red, i as f32 / 16.0, 0.5, 1.0))
+            .collect(),
+        depths: vec![0.5; n],
+        ids: vec![T; n],
+        flags: vec![3; n],
+        motion: Vec::new(),
+    };
+    let (older, newer) = (image(0.25), image(0.75));
+    let objects = [CombineObjectData {
+        id: T,
+        new_to_old: camera,
+        older_tau: None,
+        route: CoverageRoute::Estimate,
+    }];
+    let data = CombineData::new(&CombineDataDescriptor {
+        new_to_old: camera,
+        height: h,
+        objects: &objects,
+        ..Default::default()
+    })
+    .unwrap();
+    for p in 0..n {
+        let px = UVec2::new(p as u32 % w, p as u32 / w);
+        let pixel = CombineNewer {
+            color: newer.colors[p],
+            word: newer.word(p),
+            depth: 0.5,
+            motion: Vec2::ZERO,
+            pattern: 0.0,
+            level_depth: combine_far_depth(DepthConvention::Standard),
+        };
+        let got =
+            combine_pixel(&pixel, px, &older, &data.texels, DepthConvention::Standard).unwrap();
+        // Both levels shown, one id: their average. Columns 0 and 1 reproject 1.5 and 0.5
+        // texels left of the picture and read its left column, as column 2 does.
+        let texel = (px.y * w + px.x.saturating_sub(2)) as usize;
+        let want = 0.5 * (newer.colors[p] + older.colors[texel]);
+        assert!(
+            (got - want).abs().max_element() <= 1e-6,
+            "pixel {px}: {got}, not the average {want} of its newer color and older texel {texel}"
+        );
+    }
 }
 
 #[test]
@@ -389,7 +484,10 @@ fn combine_coverage_twins_match() {
         let snap = combine_snap(vec2(newer.pattern, 1.0 - newer.pattern * 0.02));
         out_f(18u, snap.x); out_f(19u, snap.y);
         let p = vec2<f32>(px) + 0.5;
-        out_u(20u, select(0u, 1u, combine_known_covers(probe_urgba1, {SIL}u, p)) | select(0u, 2u, combine_known_covers(probe_urgba1, {EST}u, p)) | select(0u, 4u, combine_known_covers(probe_urgba1, {FRONT}u, p)) | select(0u, 8u, combine_known_covers(probe_urgba1, 0u, p)));"
+        out_u(20u, select(0u, 1u, combine_known_covers(probe_urgba1, {SIL}u, p)) | select(0u, 2u, combine_known_covers(probe_urgba1, {EST}u, p)) | select(0u, 4u, combine_known_covers(probe_urgba1, {FRONT}u, p)) | select(0u, 8u, combine_known_covers(probe_urgba1, 0u, p)));
+        let edge = combine_edge_uv(vec2((f32(px.x) - 5.0) / {W}.0, (f32(px.y) + 0.5) / {H}.0), size);
+        let edge_uv = select(vec2(0.0), edge.xy, edge.z == 1.0);
+        out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, select(0u, 1u, edge.z == 1.0));"
     );
     let glsl = format!(
         "uvec2 px = uvec2(inp_u(0u), inp_u(1u));
@@ -416,7 +514,10 @@ fn combine_coverage_twins_match() {
         vec2 snap = lodkit_combine_snap(vec2(newer.pattern, 1.0 - newer.pattern * 0.02));
         out_f(18u, snap.x); out_f(19u, snap.y);
         vec2 p = vec2(px) + 0.5;
-        out_u(20u, (lodkit_combine_known_covers({SIL}u, p) ? 1u : 0u) | (lodkit_combine_known_covers({EST}u, p) ? 2u : 0u) | (lodkit_combine_known_covers({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_known_covers(0u, p) ? 8u : 0u));"
+        out_u(20u, (lodkit_combine_known_covers({SIL}u, p) ? 1u : 0u) | (lodkit_combine_known_covers({EST}u, p) ? 2u : 0u) | (lodkit_combine_known_covers({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_known_covers(0u, p) ? 8u : 0u));
+        vec3 edge = lodkit_combine_edge_uv(vec2((float(px.x) - 5.0) / {W}.0, (float(px.y) + 0.5) / {H}.0), size);
+        vec2 edge_uv = edge.z == 1.0 ? edge.xy : vec2(0.0);
+        out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, edge.z == 1.0 ? 1u : 0u);"
     );
     // The GLSL twins read the textures through the hooks the includer defines.
     let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
@@ -429,7 +530,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
 }";
     let wgsl_header = "#import lodkit::combine::{combine_uv, combine_texel, combine_read_own, combine_cover_texel, combine_other_texel, combine_ray_offset, combine_displayed_word, combine_snap, COMBINE_BLOCK_REACH, COMBINE_COVER_REACH}
-#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers}
+#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers, combine_edge_uv}
 #import lodkit::reproject::{reproject, reproject_base}
 #import lodkit::silhouette::silhouette_covers";
     // Texels, flags and ids exact; colors are sums of at most four weighted texels (weights
@@ -442,6 +543,9 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     kinds.push(Word::Exact);
     // The snap passes its input through or rounds it; the input 1 - 0.02 p may be computed with
     // a fused multiply-add on the GPU (an ulp apart, ~1.2e-7 near 1): 1e-6.
+    kinds.extend([Word::Float(1e-6); 2]);
+    kinds.push(Word::Exact);
+    // The edge uv: a quotient (WGSL's division: 2.5 ulp) or the edge texel's center.
     kinds.extend([Word::Float(1e-6); 2]);
     kinds.push(Word::Exact);
     for (route, language, header, body) in

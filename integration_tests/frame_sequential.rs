@@ -552,6 +552,31 @@ proptest! {
     }
 }
 
+/// The frame a transition reaches progress 1 draws the incoming LOD whole under both schedules,
+/// even where the phase would draw the outgoing one, which is shown nowhere by then.
+#[test]
+fn the_last_frame_draws_the_incoming_lod_whole() {
+    for schedule in [Schedule::Paper, Schedule::Complementary] {
+        let mut s = TransitionScheduler::with_schedule(schedule);
+        let key = s.insert(0);
+        s.begin_transition(key, 1, Drive::Progress).unwrap();
+        for (frame, progress) in [(1, 0.4), (2, 1.0)] {
+            s.advance(1.0 / 60.0);
+            s.set_progress(key, progress).unwrap();
+            let d = s.draw(key).unwrap();
+            // Frame 1 is the incoming phase; frame 2 the outgoing one, but at progress 1.
+            assert!(
+                d.incoming && d.lod == 1,
+                "{schedule:?} frame {frame}: {d:?}"
+            );
+        }
+        let last = s.draw(key).unwrap();
+        assert_eq!((last.tau, last.progress), (1.0, 1.0), "{schedule:?}");
+        s.advance(1.0 / 60.0);
+        assert!(!s.in_transition(key));
+    }
+}
+
 proptest! {
     /// With a steady frame time, the threshold a LOD is drawn with for the next frame is exactly
     /// the one it has there, under both schedules, so the older buffer is shown as the frame

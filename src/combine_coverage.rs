@@ -423,11 +423,42 @@ pub fn combine_read(
     combine_read_estimated(older, data, uv, depth, base, old, m, motion)
 }
 
+/// How far (texels, the larger axis) outside the older view a pixel's reprojection may land and
+/// still be read at the older buffer's edge ([`combine_edge_uv`]).
+pub const COMBINE_EDGE_REACH: f32 = 4.0;
+
+/// Where the combine reads for texture-space `uv` of an older buffer of `size` texels (Rust twin
+/// of `combine_edge_uv`, whose z is 1 where this is `Some`): `uv` itself inside the view;
+/// outside it, within [`COMBINE_EDGE_REACH`] texels, the nearest edge texel's center; `None`
+/// farther out. A camera that turns or moves sideways brings a strip of the picture into view
+/// each frame; its older level is read from the edge of last frame's picture instead of being
+/// left to the level drawn now on every other frame.
+///
+/// ```
+/// # use glam::{UVec2, Vec2};
+/// # use lodkit::combine_coverage::combine_edge_uv;
+/// let size = UVec2::new(10, 10);
+/// assert_eq!(combine_edge_uv(Vec2::new(0.42, 0.5), size), Some(Vec2::new(0.42, 0.5)));
+/// // 2 texels left of the view: the left column's center, on the same row.
+/// assert_eq!(combine_edge_uv(Vec2::new(-0.2, 0.5), size), Some(Vec2::new(0.05, 0.5)));
+/// assert_eq!(combine_edge_uv(Vec2::new(-0.5, 0.5), size), None); // 5 texels out
+/// ```
+pub fn combine_edge_uv(uv: Vec2, size: UVec2) -> Option<Vec2> {
+    if in_viewport(uv) {
+        return Some(uv);
+    }
+    let half = 0.5 / size.as_vec2();
+    let inside = uv.clamp(half, Vec2::ONE - half);
+    let beyond = (uv - inside).abs() * size.as_vec2();
+    (beyond.max_element() <= COMBINE_EDGE_REACH).then_some(inside)
+}
+
 /// The whole per-pixel combine of frame-sequential LOD with the older level's coverage known
 /// (the Rust twin of `combine_pixel`): `newer` as read at `pixel`, the older buffer `older`
 /// (last frame's picture), the frame's data texture `data` ([`CombineData`](super::CombineData):
 /// the camera's matrix, per t-instance its matrix, display threshold and coverage route, the
-/// silhouettes). Outside the older view, or where no older level is found, the newer color;
+/// silhouettes). Reprojected farther than [`COMBINE_EDGE_REACH`] texels outside the older view
+/// ([`combine_edge_uv`]), or where no older level is found, the newer color;
 /// else [`combine_texels`] with the older word displayed at this frame's threshold
 /// ([`combine_displayed_word`]). `None` when `pixel` lies outside `older` or `older` lacks texels.
 pub fn combine_pixel(
@@ -446,10 +477,11 @@ pub fn combine_pixel(
     let id = lod_buffer_id(newer.word);
     let m = combine_new_to_old(data, id);
     let base = reproject_base(combine_uv(pixel, size), &m);
-    let old = reproject_from_base(base, newer.depth, &m);
-    if !in_viewport(old.truncate()) {
+    let reprojected = reproject_from_base(base, newer.depth, &m);
+    let Some(edge) = combine_edge_uv(reprojected.truncate(), size) else {
         return Some(newer.color);
-    }
+    };
+    let old = edge.extend(reprojected.z);
     let read = combine_read(older, data, newer, pixel, base, old, &m, convention);
     if !read.found {
         return Some(newer.color);

@@ -8,8 +8,10 @@
 //! complementary) and the threshold the same LOD will have next frame (display-time visibility:
 //! the combine shows each LOD as it is at the frame displayed). A transition may begin on any
 //! frame: its first frame draws the outgoing LOD whole (both schedules show all of it at
-//! progress 0), so the object never drops out of the newer buffer. The combine pass merges this
-//! frame's LOD buffer with last frame's. Pure math, no wgpu.
+//! progress 0), so the object never drops out of the newer buffer. Its last frame (progress 1)
+//! draws the incoming LOD whole whatever the phase: the outgoing one is shown nowhere by then, and
+//! drawing it would leave the whole object to last frame's picture, resampled. The combine pass
+//! merges this frame's LOD buffer with last frame's. Pure math, no wgpu.
 //!
 //! ```
 //! use lodkit::frame_sequential::{Drive, TransitionScheduler};
@@ -365,7 +367,9 @@ impl TransitionScheduler {
         }
     }
 
-    /// How to draw `key` this frame.
+    /// How to draw `key` this frame: for a t-instance, the outgoing LOD on the frames of its
+    /// transition's phase and the incoming one between them, and the incoming one on the frame
+    /// its progress reaches 1.
     pub fn draw(&self, key: InstanceKey) -> Result<FrameDraw, ScheduleError> {
         let slot = self.slot(key)?;
         Ok(match &slot.transition {
@@ -378,7 +382,7 @@ impl TransitionScheduler {
                 incoming: false,
             },
             Some(t) => {
-                let incoming = (self.frame - t.start) % 2 == 1;
+                let incoming = (self.frame - t.start) % 2 == 1 || t.progress >= 1.0;
                 let next = match (t.next, t.drive) {
                     (Some(next), _) => next,
                     (None, Drive::Time { seconds }) => t.progress + self.last_dt / seconds,

@@ -42,6 +42,9 @@
 //   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   the routes' reads
 //   lodkit_combine_read(newer, pixel, base, old, m) -> lodkit_CombineRead   by the route of what
 //       the pixel shows
+//   LODKIT_COMBINE_EDGE_REACH   how far outside the older view a reprojection is read at its edge
+//   lodkit_combine_edge_uv(uv, size) -> vec3   uv inside the view, the nearest edge texel's center
+//       within LODKIT_COMBINE_EDGE_REACH texels outside it; z: 1 read, 0 too far out
 //   lodkit_combine_pixel(newer, pixel) -> vec4   the whole per-pixel combine
 // Hooks: the older buffer through lodkit/combine.glsl's (lodkit_combine_fetch_color, _word,
 //   _depth, _size), the data texture through lodkit/silhouette.glsl's lodkit_silhouette_fetch.
@@ -379,17 +382,37 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
     return lodkit_combine_read_estimated(uv, newer.depth, base, old, m, newer.motion);
 }
 
+/// How far (texels, the larger axis) outside the older view a pixel's reprojection may land and
+/// still be read at the older buffer's edge (lodkit_combine_edge_uv).
+const float LODKIT_COMBINE_EDGE_REACH = 4.0;
+
+/// Where the combine reads for texture-space uv of the older buffer (size texels): uv itself
+/// inside the view; outside it, within LODKIT_COMBINE_EDGE_REACH texels, the nearest edge texel's
+/// center (z 1); farther out, z 0 (nothing to read).
+vec3 lodkit_combine_edge_uv(vec2 uv, uvec2 size) {
+    if (lodkit_in_viewport(uv)) {
+        return vec3(uv, 1.0);
+    }
+    vec2 half_texel = 0.5 / vec2(size);
+    vec2 inside = clamp(uv, half_texel, 1.0 - half_texel);
+    vec2 beyond = abs(uv - inside) * vec2(size);
+    return vec3(inside, max(beyond.x, beyond.y) <= LODKIT_COMBINE_EDGE_REACH ? 1.0 : 0.0);
+}
+
 /// The per-pixel combine with the older level's coverage known, for a pass drawn over the
 /// levels' silhouettes: `newer` as read at `pixel`; the older buffer and the data texture through
-/// the hooks. No older level found: the newer color; else lodkit_combine_texels.
+/// the hooks. Reprojected farther than LODKIT_COMBINE_EDGE_REACH texels outside the older view, or
+/// no older level found: the newer color; else lodkit_combine_texels.
 vec4 lodkit_combine_pixel(lodkit_CombineNewer newer, uvec2 pixel) {
     uvec2 size = lodkit_combine_fetch_size();
     mat4 m = lodkit_combine_new_to_old(lodkit_lod_buffer_id(newer.word));
     vec4 base = lodkit_reproject_base(lodkit_combine_uv(pixel, size), m);
-    vec3 old = lodkit_reproject_from_base(base, newer.depth, m);
-    if (!lodkit_in_viewport(old.xy)) {
+    vec3 reprojected = lodkit_reproject_from_base(base, newer.depth, m);
+    vec3 edge = lodkit_combine_edge_uv(reprojected.xy, size);
+    if (edge.z == 0.0) {
         return newer.color;
     }
+    vec3 old = vec3(edge.xy, reprojected.z);
     lodkit_CombineRead read = lodkit_combine_read(newer, pixel, base, old, m);
     if (!read.found) {
         return newer.color;

@@ -48,8 +48,12 @@
 //       -> CombineRead   a pixel showing no t-instance, covered by a level's silhouette
 //   combine_read(older_color, older_id, older_depth, data, newer, pixel, base, old, m)
 //       -> CombineRead   by the route of what the pixel shows
+//   COMBINE_EDGE_REACH   how far outside the older view a reprojection is read at its edge
+//   combine_edge_uv(uv, size) -> vec3<f32>   uv inside the view, the nearest edge texel's center
+//       within COMBINE_EDGE_REACH texels outside it; z: 1 read, 0 too far out
 //   combine_pixel(newer, pixel, older_color, older_id, older_depth, data) -> vec4<f32>   the
-//       whole per-pixel combine (older depth: the depth attachment as texture_2d<f32>)
+//       whole per-pixel combine (older depth: the depth attachment as texture_2d<f32>); a
+//       reprojection outside the older view within COMBINE_EDGE_REACH is read at its edge
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z); off: 0 near.
 #define_import_path lodkit::combine_coverage
@@ -374,17 +378,39 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
     return combine_read_estimated(older_color, older_id, older_depth, data, uv, newer.depth, base, old, m, newer.motion);
 }
 
+/// How far (texels, the larger axis) outside the older view a pixel's reprojection may land and
+/// still be read at the older buffer's edge (combine_edge_uv).
+const COMBINE_EDGE_REACH: f32 = 4.0;
+
+/// Where the combine reads for texture-space `uv` of the older buffer (`size` texels): `uv` itself
+/// inside the view; outside it, within COMBINE_EDGE_REACH texels, the nearest edge texel's center
+/// (z 1); farther out, z 0 (nothing to read). A camera that turns or moves sideways brings a strip
+/// of the picture into view each frame; its level is read from the edge of last frame's picture,
+/// not left to the level drawn now on every other frame.
+fn combine_edge_uv(uv: vec2<f32>, size: vec2<u32>) -> vec3<f32> {
+    if (in_viewport(uv)) {
+        return vec3<f32>(uv, 1.0);
+    }
+    let half = 0.5 / vec2<f32>(size);
+    let inside = clamp(uv, half, 1.0 - half);
+    let beyond = abs(uv - inside) * vec2<f32>(size);
+    return vec3<f32>(inside, select(0.0, 1.0, max(beyond.x, beyond.y) <= COMBINE_EDGE_REACH));
+}
+
 /// The per-pixel combine with the older level's coverage known, for a pass drawn over the
 /// levels' silhouettes: `newer` as read at `pixel`, the older color, id words and depth, the
-/// frame's `data`. No older level found: the newer color; else combine_texels.
+/// frame's `data`. Reprojected farther than COMBINE_EDGE_REACH texels outside the older view, or
+/// no older level found: the newer color; else combine_texels.
 fn combine_pixel(newer: CombineNewer, pixel: vec2<u32>, older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>) -> vec4<f32> {
     let size = textureDimensions(older_color, 0);
     let m = combine_new_to_old(data, lod_buffer_id(newer.word));
     let base = reproject_base(combine_uv(pixel, size), m);
-    let old = reproject_from_base(base, newer.depth, m);
-    if (!in_viewport(old.xy)) {
+    let reprojected = reproject_from_base(base, newer.depth, m);
+    let edge = combine_edge_uv(reprojected.xy, size);
+    if (edge.z == 0.0) {
         return newer.color;
     }
+    let old = vec3<f32>(edge.xy, reprojected.z);
     let read = combine_read(older_color, older_id, older_depth, data, newer, pixel, base, old, m);
     if (!read.found) {
         return newer.color;
