@@ -3,7 +3,8 @@
 //! hand-made pair of LOD buffers whose answers are known: the older level's silhouette covers a
 //! pixel the older buffer's read misses, a neighbour is taken only where its sample lies on the
 //! pixel's ray, the older color is the bilinear blend of the same object's texels, and an object
-//! in front of the older level hides it only by more than `COMBINE_HIDDEN_MARGIN`.
+//! in front of the older level hides it only by more than `COMBINE_HIDDEN_MARGIN`, and only
+//! where it is a t-instance whose older level may still cover the pixel (`combine_may_cover`).
 
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 use lodkit::combine::{
@@ -13,8 +14,8 @@ use lodkit::combine::{
 };
 use lodkit::combine_coverage::{
     COMBINE_EDGE_REACH, CombineData, CombineDataDescriptor, CombineNewer, CombineObjectData,
-    CoverageRoute, combine_edge_uv, combine_far_depth, combine_known_covers, combine_new_to_old,
-    combine_object, combine_pixel,
+    CoverageRoute, combine_edge_uv, combine_far_depth, combine_known_covers, combine_may_cover,
+    combine_new_to_old, combine_object, combine_pixel,
 };
 use lodkit::lod_buffer::{lod_buffer_id, lod_buffer_word};
 use lodkit::reproject::{reproject, reproject_base};
@@ -25,7 +26,7 @@ use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words}
 const W: u32 = 16;
 const H: u32 = 12;
 /// Output words per pixel.
-const OUT: usize = 24;
+const OUT: usize = 25;
 /// The camera moved so that every pixel's center reprojects 0.3 texel right of its own texel's
 /// center (NDC x + 0.3 * 2 / 16): a read lands at x + 0.8 texels, 0.2 texel from any edge.
 const SHIFT: f32 = 0.0375;
@@ -36,9 +37,12 @@ const SIL_X: std::ops::RangeInclusive<u32> = 4..=9;
 const SIL_Y: std::ops::RangeInclusive<u32> = 3..=8;
 /// The t-instance whose older level is estimated from last frame's picture.
 const EST: u32 = 5;
-/// An object of the older frame in front of the silhouette t-instance's older level, on texels
-/// 5..=7 x 7..=8 (no record: the combine knows nothing of it).
+/// A t-instance of the older frame in front of the silhouette t-instance's older level, on
+/// texels 5..=7 x 7..=8, whose older coverage is estimated: it may cover those pixels now.
 const FRONT: u32 = 7;
+/// An object in no transition (no record), in front of the silhouette t-instance's older level
+/// on texel (7, 4) of the older frame: drawn this frame too, it is not in front of it now.
+const STILL: u32 = 9;
 
 /// The scene: older and newer LOD buffers, the newer words, the screen pattern per pixel.
 struct Scene {
@@ -67,11 +71,13 @@ fn scene() -> Scene {
             })
             .collect()
     };
-    // Older: the silhouette t-instance on texels 4..=9 x 3..=8 but for FRONT's, the estimated
-    // one on 11..=13 x 2..=5, background elsewhere.
+    // Older: the silhouette t-instance on texels 4..=9 x 3..=8 but for FRONT's and STILL's, the
+    // estimated one on 11..=13 x 2..=5, background elsewhere.
     let older_id = |x: u32, y: u32| {
         if (5..=7).contains(&x) && (7..=8).contains(&y) {
             FRONT
+        } else if (x, y) == (7, 4) {
+            STILL
         } else if SIL_X.contains(&x) && SIL_Y.contains(&y) {
             SIL
         } else if (11..=13).contains(&x) && (2..=5).contains(&y) {
@@ -92,7 +98,7 @@ fn scene() -> Scene {
         }
     };
     let depth = |id: u32| match id {
-        FRONT => 0.9,
+        FRONT | STILL => 0.9,
         SIL => 0.95,
         EST => 0.97,
         _ => 1.0,
@@ -119,6 +125,7 @@ fn scene() -> Scene {
     // displayed (pattern <= tau 0.5).
     pattern[at(3, 5)] = 0.1;
     pattern[at(5, 8)] = 0.1;
+    pattern[at(7, 4)] = 0.1;
     // The older level's silhouette under this frame's camera: the square from (3, 3) to (10, 9)
     // in pixels (its texels 4..=9 moved 0.3 texel left by the camera, widened by its edges),
     // which covers pixel column 3 where the older buffer's read finds background.
@@ -139,6 +146,12 @@ fn scene() -> Scene {
         },
         CombineObjectData {
             id: EST,
+            new_to_old: camera,
+            older_tau: None,
+            route: CoverageRoute::Estimate,
+        },
+        CombineObjectData {
+            id: FRONT,
             new_to_old: camera,
             older_tau: None,
             route: CoverageRoute::Estimate,
@@ -244,6 +257,13 @@ fn twin_words(s: &Scene) -> Vec<u32> {
             let edge = combine_edge_uv(edge_probe_uv(px), size);
             w.extend(words(&edge.unwrap_or(Vec2::ZERO).to_array()));
             w.push(u32::from(edge.is_some()));
+            w.push(
+                [SIL, EST, FRONT, STILL, 0]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &id)| u32::from(combine_may_cover(texels, id, p)) << k)
+                    .sum(),
+            );
             w
         })
         .collect()
@@ -309,9 +329,10 @@ fn check_known(out: &[u32], s: &Scene, who: &str) {
         older(9, 5)
     );
     // Hidden: pixel (6, 7) shows the silhouette t-instance, whose older silhouette covers it,
-    // but the read (x 6.8) finds the object in front of that level in the older frame (depth 0.9
-    // against 0.95): the pixel shows that object, as last frame did, not the t-instance's own
-    // texels around it (combine_hidden).
+    // but the read (x 6.8) finds FRONT in front of that level in the older frame (depth 0.9
+    // against 0.95), a t-instance whose older level may cover the pixel now (combine_may_cover):
+    // the pixel shows FRONT, as last frame did, not the t-instance's own texels around it
+    // (combine_hidden).
     let got = color(pixel(6, 7), 0);
     assert!(
         close(got, older(6, 7), 1e-5),
@@ -330,9 +351,32 @@ fn check_known(out: &[u32], s: &Scene, who: &str) {
          (FRONT's older color: {})",
         older(5, 8)
     );
+    // Still: pixel (7, 4) shows the silhouette t-instance and reads x 7.8, texel (7, 4), where
+    // STILL, in no transition, lay in front of its older level (depth 0.9 against 0.95). STILL is
+    // drawn this frame and lost the depth test to the t-instance here: it hides nothing now. The
+    // read takes the t-instance's own texels: the 2x2 blend around x 7.8 holds (7, 4) (STILL) at
+    // 0.7 and (8, 4) at 0.3, so (8, 4) alone; both levels are shown and have one id: their average.
+    let got = color(pixel(7, 4), 0);
+    let want = 0.5 * (s.newer.colors[at(7, 4)] + older(8, 4));
+    assert!(
+        close(got, want, 1e-5),
+        "{who}: pixel (7, 4) shows {got}, not the average of its newer color and texel (8, 4), {want} \
+         (STILL's older color, as if it hid the level: {})",
+        older(7, 4)
+    );
+    // combine_may_cover: the silhouette t-instance inside its square (pixels 3..=9 x 3..=8), the
+    // estimated t-instances (EST, FRONT) everywhere, STILL (no record) and id 0 nowhere.
+    for (x, y) in (0..W).flat_map(|x| (0..H).map(move |y| (x, y))) {
+        let inside = (3..=9).contains(&x) && (3..=8).contains(&y);
+        assert_eq!(
+            pixel(x, y)[24],
+            u32::from(inside) | 2 | 4,
+            "{who}: combine_may_cover at pixel ({x}, {y}) (bits: SIL, EST, FRONT, STILL, id 0)"
+        );
+    }
     // combine_known_covers: only the silhouette t-instance has a known silhouette, the square
     // from (3, 3) to (10, 9), which holds the centers of pixels 3..=9 x 3..=8 (a center is never
-    // on its integer edges); the estimated t-instance, FRONT (no record) and id 0 never.
+    // on its integer edges); the estimated t-instances (EST, FRONT) and id 0 never.
     for (x, y) in (0..W).flat_map(|x| (0..H).map(move |y| (x, y))) {
         let inside = (3..=9).contains(&x) && (3..=8).contains(&y);
         assert_eq!(
@@ -487,7 +531,8 @@ fn combine_coverage_twins_match() {
         out_u(20u, select(0u, 1u, combine_known_covers(probe_urgba1, {SIL}u, p)) | select(0u, 2u, combine_known_covers(probe_urgba1, {EST}u, p)) | select(0u, 4u, combine_known_covers(probe_urgba1, {FRONT}u, p)) | select(0u, 8u, combine_known_covers(probe_urgba1, 0u, p)));
         let edge = combine_edge_uv(vec2((f32(px.x) - 5.0) / {W}.0, (f32(px.y) + 0.5) / {H}.0), size);
         let edge_uv = select(vec2(0.0), edge.xy, edge.z == 1.0);
-        out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, select(0u, 1u, edge.z == 1.0));"
+        out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, select(0u, 1u, edge.z == 1.0));
+        out_u(24u, select(0u, 1u, combine_may_cover(probe_urgba1, {SIL}u, p)) | select(0u, 2u, combine_may_cover(probe_urgba1, {EST}u, p)) | select(0u, 4u, combine_may_cover(probe_urgba1, {FRONT}u, p)) | select(0u, 8u, combine_may_cover(probe_urgba1, {STILL}u, p)) | select(0u, 16u, combine_may_cover(probe_urgba1, 0u, p)));"
     );
     let glsl = format!(
         "uvec2 px = uvec2(inp_u(0u), inp_u(1u));
@@ -517,7 +562,8 @@ fn combine_coverage_twins_match() {
         out_u(20u, (lodkit_combine_known_covers({SIL}u, p) ? 1u : 0u) | (lodkit_combine_known_covers({EST}u, p) ? 2u : 0u) | (lodkit_combine_known_covers({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_known_covers(0u, p) ? 8u : 0u));
         vec3 edge = lodkit_combine_edge_uv(vec2((float(px.x) - 5.0) / {W}.0, (float(px.y) + 0.5) / {H}.0), size);
         vec2 edge_uv = edge.z == 1.0 ? edge.xy : vec2(0.0);
-        out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, edge.z == 1.0 ? 1u : 0u);"
+        out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, edge.z == 1.0 ? 1u : 0u);
+        out_u(24u, (lodkit_combine_may_cover({SIL}u, p) ? 1u : 0u) | (lodkit_combine_may_cover({EST}u, p) ? 2u : 0u) | (lodkit_combine_may_cover({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_may_cover({STILL}u, p) ? 8u : 0u) | (lodkit_combine_may_cover(0u, p) ? 16u : 0u));"
     );
     // The GLSL twins read the textures through the hooks the includer defines.
     let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
@@ -530,7 +576,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
 }";
     let wgsl_header = "#import lodkit::combine::{combine_uv, combine_texel, combine_read_own, combine_cover_texel, combine_other_texel, combine_ray_offset, combine_displayed_word, combine_snap, COMBINE_BLOCK_REACH, COMBINE_COVER_REACH}
-#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers, combine_edge_uv}
+#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers, combine_may_cover, combine_edge_uv}
 #import lodkit::reproject::{reproject, reproject_base}
 #import lodkit::silhouette::silhouette_covers";
     // Texels, flags and ids exact; colors are sums of at most four weighted texels (weights
@@ -547,7 +593,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     kinds.push(Word::Exact);
     // The edge uv: a quotient (WGSL's division: 2.5 ulp) or the edge texel's center.
     kinds.extend([Word::Float(1e-6); 2]);
-    kinds.push(Word::Exact);
+    kinds.extend([Word::Exact; 2]);
     for (route, language, header, body) in
         twin_runs(gpu, (wgsl_header, &wgsl), (glsl_header, &glsl))
     {

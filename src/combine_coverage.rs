@@ -295,6 +295,19 @@ pub fn combine_known_covers(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
     id != 0 && o.flags & wanted == wanted && silhouette_covers(data, o.silhouette, p) != 0
 }
 
+/// Whether `id`'s older level may cover the pixel center `p` under this frame's camera: `id` is
+/// a t-instance (its record is known) whose coverage is not its silhouette, or whose silhouette
+/// covers (or passes through) `p`. Any other object is drawn this frame at its own level: where
+/// a pixel shows a t-instance, it lost the depth test there and is not in front of it now (Rust
+/// twin of `combine_may_cover`).
+pub fn combine_may_cover(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
+    let o = combine_object(data, id);
+    if id == 0 || o.flags & COMBINE_KNOWN == 0 {
+        return false;
+    }
+    o.flags & COMBINE_ROUTE_SILHOUETTE == 0 || silhouette_covers(data, o.silhouette, p) != 0
+}
+
 /// For a pixel that shows no t-instance: the older read ([`combine_read_known`]) of the first
 /// t-instance whose older level's silhouette covers the pixel center `p` (pixels), that no other
 /// t-instance whose silhouette covers it too hides there ([`combine_hidden`],
@@ -344,8 +357,9 @@ pub fn combine_read_silhouettes(
 /// The older read of the pixel `pixel` showing `newer`, by the coverage route of what it shows
 /// (`m`, `base`, `old`: its reprojection, [`combine_new_to_old`]): a t-instance's own older
 /// level by its record's route (its silhouette, the depth pass, or estimated; estimated for a
-/// t-instance without a record); for a pixel showing none, a level the depth pass drew there,
-/// else a level whose silhouette covers it, else the estimate.
+/// t-instance without a record; by its silhouette, the texel in front where [`combine_hidden`]
+/// finds another object there that [`combine_may_cover`]); for a pixel showing none, a level the
+/// depth pass drew there, else a level whose silhouette covers it, else the estimate.
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
@@ -375,8 +389,12 @@ pub fn combine_read(
                 own = i32::from(id_at(older, combine_texel(old.truncate() + motion, size)) == id);
             }
             let read_at = old.truncate() + motion;
-            if own == 1 && combine_hidden(older, id, read_at, old.z, convention) {
-                return found(older, combine_texel(read_at, size));
+            let held = combine_texel(read_at, size);
+            if own == 1
+                && combine_hidden(older, id, read_at, old.z, convention)
+                && combine_may_cover(data, id_at(older, held), p)
+            {
+                return found(older, held);
             }
             if own == 1 {
                 return combine_read_known(older, id, uv, depth, m, motion);

@@ -39,6 +39,8 @@
 //       another object clearly closer than clip depth `depth`
 //   lodkit_combine_known_covers(id, p) -> bool   whether id's older silhouette is known and
 //       covers the pixel center p
+//   lodkit_combine_may_cover(id, p) -> bool   whether id is a t-instance whose older level may
+//       cover the pixel center p (coverage not its silhouette, or its silhouette covers p)
 //   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   the routes' reads
 //   lodkit_combine_read(newer, pixel, base, old, m) -> lodkit_CombineRead   by the route of what
 //       the pixel shows
@@ -303,6 +305,18 @@ bool lodkit_combine_known_covers(uint id, vec2 p) {
     return id != 0u && (o.flags & wanted) == wanted && lodkit_silhouette_covers(o.silhouette, p) != 0;
 }
 
+/// Whether `id`'s older level may cover the pixel center `p` under this frame's camera: `id` is
+/// a t-instance (its record is known) whose coverage is not its silhouette, or whose silhouette
+/// covers (or passes through) `p`. Any other object is drawn this frame at its own level: where
+/// a pixel shows a t-instance, it lost the depth test there and is not in front of it now.
+bool lodkit_combine_may_cover(uint id, vec2 p) {
+    lodkit_CombineObject o = lodkit_combine_object(id);
+    if (id == 0u || (o.flags & LODKIT_COMBINE_KNOWN) == 0u) {
+        return false;
+    }
+    return (o.flags & LODKIT_COMBINE_ROUTE_SILHOUETTE) == 0u || lodkit_silhouette_covers(o.silhouette, p) != 0;
+}
+
 /// For a pixel showing no t-instance: the read (lodkit_combine_read_known) of the first
 /// t-instance whose older silhouette covers the pixel center `p` (on it: as last frame's picture
 /// has it), is not hidden there by another t-instance whose silhouette covers it too
@@ -340,7 +354,9 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
 }
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
-/// (estimated without one); else the depth pass's level, a covering silhouette, the estimate.
+/// (estimated without one; with its silhouette, the texel in front where lodkit_combine_hidden
+/// finds another object there that lodkit_combine_may_cover); else the depth pass's level, a
+/// covering silhouette, the estimate.
 lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, vec4 base, vec3 old, mat4 m) {
     uvec2 size = lodkit_combine_fetch_size();
     uint id = lodkit_lod_buffer_id(newer.word);
@@ -356,9 +372,10 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
                 own = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(old.xy + newer.motion, size))) == id ? 1 : 0;
             }
             vec2 at = old.xy + newer.motion;
-            if (own == 1 && lodkit_combine_hidden(id, at, old.z)) {
-                uvec2 hidden = lodkit_combine_texel(at, size);
-                return lodkit_CombineRead(hidden, lodkit_combine_fetch_color(hidden), true);
+            uvec2 held = lodkit_combine_texel(at, size);
+            uint front = lodkit_lod_buffer_id(lodkit_combine_fetch_word(held));
+            if (own == 1 && lodkit_combine_hidden(id, at, old.z) && lodkit_combine_may_cover(front, p)) {
+                return lodkit_CombineRead(held, lodkit_combine_fetch_color(held), true);
             }
             if (own == 1) {
                 return lodkit_combine_read_known(id, uv, newer.depth, m, newer.motion);

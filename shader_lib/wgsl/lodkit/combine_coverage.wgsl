@@ -44,6 +44,8 @@
 //       hidden)
 //   combine_known_covers(data, id, p) -> bool   whether id's older silhouette is known and covers
 //       the pixel center p
+//   combine_may_cover(data, id, p) -> bool   whether id is a t-instance whose older level may
+//       cover the pixel center p (coverage not its silhouette, or its silhouette covers p)
 //   combine_read_silhouettes(older_color, older_id, older_depth, data, uv, depth, p)
 //       -> CombineRead   a pixel showing no t-instance, covered by a level's silhouette
 //   combine_read(older_color, older_id, older_depth, data, newer, pixel, base, old, m)
@@ -302,6 +304,18 @@ fn combine_known_covers(data: texture_2d<u32>, id: u32, p: vec2<f32>) -> bool {
     return id != 0u && (o.flags & wanted) == wanted && silhouette_covers(data, o.silhouette, p) != 0;
 }
 
+/// Whether `id`'s older level may cover the pixel center `p` under this frame's camera: `id` is
+/// a t-instance (its record is known) whose coverage is not its silhouette, or whose silhouette
+/// covers (or passes through) `p`. Any other object is drawn this frame at its own level: where
+/// a pixel shows a t-instance, it lost the depth test there and is not in front of it now.
+fn combine_may_cover(data: texture_2d<u32>, id: u32, p: vec2<f32>) -> bool {
+    let o = combine_object(data, id);
+    if (id == 0u || (o.flags & COMBINE_KNOWN) == 0u) {
+        return false;
+    }
+    return (o.flags & COMBINE_ROUTE_SILHOUETTE) == 0u || silhouette_covers(data, o.silhouette, p) != 0;
+}
+
 /// For a pixel showing no t-instance: the read (combine_read_known) of the first t-instance
 /// whose older silhouette covers the pixel center `p` (on it: as last frame's picture has it),
 /// is not hidden there by another t-instance whose silhouette covers it too (combine_hidden,
@@ -338,7 +352,9 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
 }
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
-/// (estimated without one); else the depth pass's level, a covering silhouette, the estimate.
+/// (estimated without one; with its silhouette, the texel in front where combine_hidden finds
+/// another object there that combine_may_cover); else the depth pass's level, a covering
+/// silhouette, the estimate.
 fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, newer: CombineNewer, pixel: vec2<u32>, base: vec4<f32>, old: vec3<f32>, m: mat4x4<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     let id = lod_buffer_id(newer.word);
@@ -352,9 +368,10 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
                 own = select(0, 1, lod_buffer_id(textureLoad(older_id, combine_texel(old.xy + newer.motion, size), 0).x) == id);
             }
             let at = old.xy + newer.motion;
-            if (own == 1 && combine_hidden(older_id, older_depth, id, at, old.z)) {
-                let texel = combine_texel(at, size);
-                return CombineRead(texel, textureLoad(older_color, texel, 0), true);
+            let held = combine_texel(at, size);
+            let front = lod_buffer_id(textureLoad(older_id, held, 0).x);
+            if (own == 1 && combine_hidden(older_id, older_depth, id, at, old.z) && combine_may_cover(data, front, p)) {
+                return CombineRead(held, textureLoad(older_color, held, 0), true);
             }
             if (own == 1) {
                 return combine_read_known(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion);
