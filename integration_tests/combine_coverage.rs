@@ -14,19 +14,23 @@ use lodkit::combine::{
 };
 use lodkit::combine_coverage::{
     COMBINE_EDGE_REACH, CombineData, CombineDataDescriptor, CombineNewer, CombineObjectData,
-    CoverageRoute, combine_edge_uv, combine_far_depth, combine_known_covers, combine_may_cover,
-    combine_new_to_old, combine_object, combine_pixel,
+    CoverageRoute, combine_edge_uv, combine_far_depth, combine_hider, combine_known_covers,
+    combine_may_cover, combine_new_to_old, combine_object, combine_pixel,
 };
 use lodkit::lod_buffer::{lod_buffer_id, lod_buffer_word};
 use lodkit::reproject::{reproject, reproject_base};
-use lodkit::silhouette::silhouette_covers;
+use lodkit::silhouette::{SILHOUETTE_ON, silhouette_covers};
 
 use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words};
+
+#[path = "combine_coverage_known.rs"]
+mod known;
+use known::check_known;
 
 const W: u32 = 16;
 const H: u32 = 12;
 /// Output words per pixel.
-const OUT: usize = 25;
+const OUT: usize = 26;
 /// The camera moved so that every pixel's center reprojects 0.3 texel right of its own texel's
 /// center (NDC x + 0.3 * 2 / 16): a read lands at x + 0.8 texels, 0.2 texel from any edge.
 const SHIFT: f32 = 0.0375;
@@ -43,6 +47,9 @@ const FRONT: u32 = 7;
 /// An object in no transition (no record), in front of the silhouette t-instance's older level
 /// on texel (7, 4) of the older frame: drawn this frame too, it is not in front of it now.
 const STILL: u32 = 9;
+/// A t-instance that did not move (its matrix the identity) on older texels 1..=2 x 9..=10,
+/// whose silhouette's left edge passes through the centers of pixel column 1.
+const TIE: u32 = 11;
 
 /// The scene: older and newer LOD buffers, the newer words, the screen pattern per pixel.
 struct Scene {
@@ -82,6 +89,8 @@ fn scene() -> Scene {
             SIL
         } else if (11..=13).contains(&x) && (2..=5).contains(&y) {
             EST
+        } else if (1..=2).contains(&x) && (9..=10).contains(&y) {
+            TIE
         } else {
             0
         }
@@ -99,7 +108,7 @@ fn scene() -> Scene {
     };
     let depth = |id: u32| match id {
         FRONT | STILL => 0.9,
-        SIL => 0.95,
+        SIL | TIE => 0.95,
         EST => 0.97,
         _ => 1.0,
     };
@@ -126,10 +135,13 @@ fn scene() -> Scene {
     pattern[at(3, 5)] = 0.1;
     pattern[at(5, 8)] = 0.1;
     pattern[at(7, 4)] = 0.1;
-    // The older level's silhouette under this frame's camera: the square from (3, 3) to (10, 9)
-    // in pixels (its texels 4..=9 moved 0.3 texel left by the camera, widened by its edges),
-    // which covers pixel column 3 where the older buffer's read finds background.
-    let (x0, y0, x1, y1) = (3.0, 3.0, 10.0, 9.0);
+    pattern[at(9, 5)] = 0.1;
+    pattern[at(1, 9)] = 0.1;
+    // The older level's silhouette under this frame's camera: the rectangle from (3, 3) to
+    // (9.5, 9) in pixels (its texels 4..=9 moved 0.3 texel left by the camera, widened on the
+    // left), which covers pixel column 3 where the older buffer's read finds background, and
+    // whose right edge passes through the centers of column 9 where it finds the level.
+    let (x0, y0, x1, y1) = (3.0, 3.0, 9.5, 9.0);
     let square = [
         [x0, y0, x0, y1],
         [x0, y1, x1, y1],
@@ -137,6 +149,14 @@ fn scene() -> Scene {
         [x1, y0, x0, y0],
     ];
     let camera = Mat4::from_translation(Vec3::new(SHIFT, 0.0, 0.0));
+    // TIE's silhouette: the rectangle from (1.5, 9) to (3, 11), its left edge on the centers of
+    // pixel column 1.
+    let tie = [
+        [1.5, 9.0, 1.5, 11.0],
+        [1.5, 11.0, 3.0, 11.0],
+        [3.0, 11.0, 3.0, 9.0],
+        [3.0, 9.0, 1.5, 9.0],
+    ];
     let objects = [
         CombineObjectData {
             id: SIL,
@@ -155,6 +175,12 @@ fn scene() -> Scene {
             new_to_old: camera,
             older_tau: None,
             route: CoverageRoute::Estimate,
+        },
+        CombineObjectData {
+            id: TIE,
+            new_to_old: Mat4::IDENTITY,
+            older_tau: Some(0.5),
+            route: CoverageRoute::Silhouette(&tie),
         },
     ];
     let data = CombineData::new(&CombineDataDescriptor {
@@ -264,154 +290,17 @@ fn twin_words(s: &Scene) -> Vec<u32> {
                     .map(|(k, &id)| u32::from(combine_may_cover(texels, id, p)) << k)
                     .sum(),
             );
+            let point = reproject(uv, newer.depth, &m);
+            w.push(combine_hider(
+                &s.older,
+                SIL,
+                a,
+                point.z,
+                DepthConvention::Standard,
+            ));
             w
         })
         .collect()
-}
-
-/// Holds the words of one language (or of the Rust twins) to what the scene was made to give,
-/// worked out by hand from its texels (not by the code under test).
-fn check_known(out: &[u32], s: &Scene, who: &str) {
-    let pixel = |x: u32, y: u32| &out[at(x, y) * OUT..(at(x, y) + 1) * OUT];
-    let color = |w: &[u32], k: usize| Vec4::from_slice(&floats(&w[k..k + 4]));
-    let close = |a: Vec4, b: Vec4, tol: f32| (a - b).abs().max_element() <= tol;
-    let older = |x: u32, y: u32| s.older.colors[at(x, y)];
-    // Silhouette: pixel (3, 5) shows background and reads older background at x 3.8; the older
-    // level's silhouette covers it, so it shows that level: its texel (4, 5), 0.7 texel from the
-    // ray (the bilinear blend of texels 3 and 4 keeps only 4, the same object's).
-    let got = color(pixel(3, 5), 0);
-    assert!(
-        close(got, older(4, 5), 1e-5),
-        "{who}: pixel (3, 5) inside the older silhouette shows {got}, not the older level's {}",
-        older(4, 5)
-    );
-    for (x, want) in [(2, 0), (3, 1), (9, 1), (10, 0)] {
-        assert_eq!(
-            pixel(x, 5)[15],
-            want,
-            "{who}: silhouette_covers at pixel ({x}, 5)"
-        );
-    }
-    // On the ray: pixel (14, 3) reads background at x 14.8; the estimated t-instance's texel
-    // (13, 3) lies 1.3 texels from the ray, past COMBINE_COVER_REACH: not taken, and the pixel
-    // keeps its newer color (closer than the background). At pixel (10, 3) the read x 10.8 has
-    // (11, 3) 0.7 texel away: taken.
-    assert_eq!(
-        pixel(14, 3)[11..13],
-        [14, 3],
-        "{who}: cover texel at (14, 3)"
-    );
-    assert_eq!(
-        pixel(10, 3)[11..13],
-        [11, 3],
-        "{who}: cover texel at (10, 3)"
-    );
-    let got = color(pixel(14, 3), 0);
-    let want = s.newer.colors[at(14, 3)];
-    assert!(
-        close(got, want, 1e-5),
-        "{who}: pixel (14, 3) shows {got}, not its newer color {want}"
-    );
-    // The blend: the read of the silhouette t-instance at pixel (5, 5) lies at x 5.8, y on the
-    // texel row's center: 0.7 of texel 5 and 0.3 of texel 6. At (9, 5) (x 9.8) texel 10 is
-    // background: texel 9 alone.
-    let blend = 0.7 * older(5, 5) + 0.3 * older(6, 5);
-    let got = color(pixel(5, 5), 6);
-    assert_eq!(pixel(5, 5)[4..6], [5, 5], "{who}: read texel at (5, 5)");
-    assert!(
-        close(got, blend, 1e-4),
-        "{who}: older color at (5, 5) {got}, not the blend {blend}"
-    );
-    let got = color(pixel(9, 5), 6);
-    assert!(
-        close(got, older(9, 5), 1e-5),
-        "{who}: older color at (9, 5) {got}, not texel 9's {}",
-        older(9, 5)
-    );
-    // Hidden: pixel (6, 7) shows the silhouette t-instance, whose older silhouette covers it,
-    // but the read (x 6.8) finds FRONT in front of that level in the older frame (depth 0.9
-    // against 0.95), a t-instance whose older level may cover the pixel now (combine_may_cover):
-    // the pixel shows FRONT, as last frame did, not the t-instance's own texels around it
-    // (combine_hidden).
-    let got = color(pixel(6, 7), 0);
-    assert!(
-        close(got, older(6, 7), 1e-5),
-        "{who}: pixel (6, 7) shows {got}, not the older object in front, {}",
-        older(6, 7)
-    );
-    // Touching: pixel (5, 8) reads x 5.8 and finds FRONT at texel (5, 8), in front of the
-    // t-instance's older level by less than COMBINE_HIDDEN_MARGIN: not hidden. The read takes the
-    // t-instance's texel (4, 8) (the block's first at 1.3 texels from the ray; (4, 7) ties), whose
-    // 2x2 blend holds no texel of it; both levels are shown and have one id: their average.
-    let got = color(pixel(5, 8), 0);
-    let want = 0.5 * (s.newer.colors[at(5, 8)] + older(4, 8));
-    assert!(
-        close(got, want, 1e-5),
-        "{who}: pixel (5, 8) shows {got}, not the average of its newer color and texel (4, 8), {want} \
-         (FRONT's older color: {})",
-        older(5, 8)
-    );
-    // Still: pixel (7, 4) shows the silhouette t-instance and reads x 7.8, texel (7, 4), where
-    // STILL, in no transition, lay in front of its older level (depth 0.9 against 0.95). STILL is
-    // drawn this frame and lost the depth test to the t-instance here: it hides nothing now. The
-    // read takes the t-instance's own texels: the 2x2 blend around x 7.8 holds (7, 4) (STILL) at
-    // 0.7 and (8, 4) at 0.3, so (8, 4) alone; both levels are shown and have one id: their average.
-    let got = color(pixel(7, 4), 0);
-    let want = 0.5 * (s.newer.colors[at(7, 4)] + older(8, 4));
-    assert!(
-        close(got, want, 1e-5),
-        "{who}: pixel (7, 4) shows {got}, not the average of its newer color and texel (8, 4), {want} \
-         (STILL's older color, as if it hid the level: {})",
-        older(7, 4)
-    );
-    // combine_may_cover: the silhouette t-instance inside its square (pixels 3..=9 x 3..=8), the
-    // estimated t-instances (EST, FRONT) everywhere, STILL (no record) and id 0 nowhere.
-    for (x, y) in (0..W).flat_map(|x| (0..H).map(move |y| (x, y))) {
-        let inside = (3..=9).contains(&x) && (3..=8).contains(&y);
-        assert_eq!(
-            pixel(x, y)[24],
-            u32::from(inside) | 2 | 4,
-            "{who}: combine_may_cover at pixel ({x}, {y}) (bits: SIL, EST, FRONT, STILL, id 0)"
-        );
-    }
-    // combine_known_covers: only the silhouette t-instance has a known silhouette, the square
-    // from (3, 3) to (10, 9), which holds the centers of pixels 3..=9 x 3..=8 (a center is never
-    // on its integer edges); the estimated t-instances (EST, FRONT) and id 0 never.
-    for (x, y) in (0..W).flat_map(|x| (0..H).map(move |y| (x, y))) {
-        let inside = (3..=9).contains(&x) && (3..=8).contains(&y);
-        assert_eq!(
-            pixel(x, y)[20],
-            u32::from(inside),
-            "{who}: combine_known_covers at pixel ({x}, {y}) (bits: SIL, EST, FRONT, id 0)"
-        );
-    }
-    // combine_edge_uv: columns 0 and 1 lie 5.5 and 4.5 texels out, past COMBINE_EDGE_REACH (4):
-    // nothing to read; 2..=4 (3.5 to 1.5 out) read the left column's center, x 0.5 / 16; 5 and
-    // on lie in the view and keep their uv.
-    assert_eq!(COMBINE_EDGE_REACH, 4.0);
-    for (x, y) in (0..W).flat_map(|x| (0..H).map(move |y| (x, y))) {
-        let w = pixel(x, y);
-        let row = (y as f32 + 0.5) / H as f32;
-        let want = match x {
-            0 | 1 => None,
-            2..=4 => Some(Vec2::new(0.5 / W as f32, row)),
-            _ => Some(Vec2::new((x as f32 - 5.0) / W as f32, row)),
-        };
-        let got = (w[23] == 1).then(|| Vec2::from_slice(&floats(&w[21..23])));
-        let agree = match (got, want) {
-            (Some(g), Some(e)) => (g - e).abs().max_element() <= 1e-6,
-            (g, e) => g.is_none() && e.is_none(),
-        };
-        assert!(
-            agree,
-            "{who}: combine_edge_uv at pixel ({x}, {y}): {got:?}, not {want:?}"
-        );
-    }
-    // The ray offset of every read is 0.3 texel; the snap keeps 0.3 and takes 0.995 as 1.
-    assert!(
-        (f32::from_bits(pixel(0, 0)[16]) - 0.3).abs() < 1e-4,
-        "{who}: ray offset"
-    );
 }
 
 #[test]
@@ -532,7 +421,8 @@ fn combine_coverage_twins_match() {
         let edge = combine_edge_uv(vec2((f32(px.x) - 5.0) / {W}.0, (f32(px.y) + 0.5) / {H}.0), size);
         let edge_uv = select(vec2(0.0), edge.xy, edge.z == 1.0);
         out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, select(0u, 1u, edge.z == 1.0));
-        out_u(24u, select(0u, 1u, combine_may_cover(probe_urgba1, {SIL}u, p)) | select(0u, 2u, combine_may_cover(probe_urgba1, {EST}u, p)) | select(0u, 4u, combine_may_cover(probe_urgba1, {FRONT}u, p)) | select(0u, 8u, combine_may_cover(probe_urgba1, {STILL}u, p)) | select(0u, 16u, combine_may_cover(probe_urgba1, 0u, p)));"
+        out_u(24u, select(0u, 1u, combine_may_cover(probe_urgba1, {SIL}u, p)) | select(0u, 2u, combine_may_cover(probe_urgba1, {EST}u, p)) | select(0u, 4u, combine_may_cover(probe_urgba1, {FRONT}u, p)) | select(0u, 8u, combine_may_cover(probe_urgba1, {STILL}u, p)) | select(0u, 16u, combine_may_cover(probe_urgba1, 0u, p)));
+        out_u(25u, combine_hider(probe_urgba0, probe_rgba1, {SIL}u, a, reproject(uv, newer.depth, m).z));"
     );
     let glsl = format!(
         "uvec2 px = uvec2(inp_u(0u), inp_u(1u));
@@ -563,7 +453,8 @@ fn combine_coverage_twins_match() {
         vec3 edge = lodkit_combine_edge_uv(vec2((float(px.x) - 5.0) / {W}.0, (float(px.y) + 0.5) / {H}.0), size);
         vec2 edge_uv = edge.z == 1.0 ? edge.xy : vec2(0.0);
         out_f(21u, edge_uv.x); out_f(22u, edge_uv.y); out_u(23u, edge.z == 1.0 ? 1u : 0u);
-        out_u(24u, (lodkit_combine_may_cover({SIL}u, p) ? 1u : 0u) | (lodkit_combine_may_cover({EST}u, p) ? 2u : 0u) | (lodkit_combine_may_cover({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_may_cover({STILL}u, p) ? 8u : 0u) | (lodkit_combine_may_cover(0u, p) ? 16u : 0u));"
+        out_u(24u, (lodkit_combine_may_cover({SIL}u, p) ? 1u : 0u) | (lodkit_combine_may_cover({EST}u, p) ? 2u : 0u) | (lodkit_combine_may_cover({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_may_cover({STILL}u, p) ? 8u : 0u) | (lodkit_combine_may_cover(0u, p) ? 16u : 0u));
+        out_u(25u, lodkit_combine_hider({SIL}u, a, lodkit_reproject(uv, newer.depth, m).z));"
     );
     // The GLSL twins read the textures through the hooks the includer defines.
     let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
@@ -576,7 +467,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
 }";
     let wgsl_header = "#import lodkit::combine::{combine_uv, combine_texel, combine_read_own, combine_cover_texel, combine_other_texel, combine_ray_offset, combine_displayed_word, combine_snap, COMBINE_BLOCK_REACH, COMBINE_COVER_REACH}
-#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers, combine_may_cover, combine_edge_uv}
+#import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers, combine_may_cover, combine_hider, combine_edge_uv}
 #import lodkit::reproject::{reproject, reproject_base}
 #import lodkit::silhouette::silhouette_covers";
     // Texels, flags and ids exact; colors are sums of at most four weighted texels (weights
@@ -593,7 +484,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     kinds.push(Word::Exact);
     // The edge uv: a quotient (WGSL's division: 2.5 ulp) or the edge texel's center.
     kinds.extend([Word::Float(1e-6); 2]);
-    kinds.extend([Word::Exact; 2]);
+    kinds.extend([Word::Exact; 3]);
     for (route, language, header, body) in
         twin_runs(gpu, (wgsl_header, &wgsl), (glsl_header, &glsl))
     {

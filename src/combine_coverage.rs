@@ -13,7 +13,7 @@ use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
 use crate::combine::older::{NOT_FOUND, depth_at, found, id_at, index_of, size_of};
 use crate::combine::{
-    COMBINE_BLOCK_REACH, COMBINE_COVER_REACH, CombineRead, DepthConvention, LodImage,
+    COMBINE_BLOCK_REACH, COMBINE_COVER_REACH, COMBINE_SNAP, CombineRead, DepthConvention, LodImage,
     combine_cover_texel, combine_displayed_word, combine_other_texel, combine_own_color,
     combine_ray_offset, combine_read_own, combine_texel, combine_texels, combine_uv, depth_closer,
 };
@@ -269,10 +269,30 @@ pub fn combine_clearly_closer(a: f32, b: f32, convention: DepthConvention) -> bo
     }
 }
 
+/// The object other than `owner` (not the background) that the older texel at texture-space
+/// `at` holds clearly closer than clip depth `depth` ([`combine_clearly_closer`]; Rust twin of
+/// `combine_hider`): the older frame drew it in front of `owner`'s older level there. 0 where
+/// there is none (or `at` is outside the view).
+pub fn combine_hider(
+    older: &LodImage,
+    owner: u32,
+    at: Vec2,
+    depth: f32,
+    convention: DepthConvention,
+) -> u32 {
+    let texel = combine_texel(at, size_of(older));
+    let held = id_at(older, texel);
+    let hides = in_viewport(at)
+        && held != owner
+        && held != 0
+        && combine_clearly_closer(depth_at(older, texel), depth, convention);
+    if hides { held } else { 0 }
+}
+
 /// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
-/// closer than clip depth `depth` ([`combine_clearly_closer`]; Rust twin of `combine_hidden`):
-/// there the older frame drew that object in front of `owner`'s older level, so the older
-/// level's silhouette covering the pixel does not make it visible.
+/// closer than clip depth `depth` ([`combine_hider`]; Rust twin of `combine_hidden`): there the
+/// older frame drew that object in front of `owner`'s older level, so the older level's
+/// silhouette covering the pixel does not make it visible.
 pub fn combine_hidden(
     older: &LodImage,
     owner: u32,
@@ -280,10 +300,7 @@ pub fn combine_hidden(
     depth: f32,
     convention: DepthConvention,
 ) -> bool {
-    let texel = combine_texel(at, size_of(older));
-    in_viewport(at)
-        && id_at(older, texel) != owner
-        && combine_clearly_closer(depth_at(older, texel), depth, convention)
+    combine_hider(older, owner, at, depth, convention) != 0
 }
 
 /// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
@@ -310,10 +327,13 @@ pub fn combine_may_cover(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
 
 /// For a pixel that shows no t-instance: the older read ([`combine_read_known`]) of the first
 /// t-instance whose older level's silhouette covers the pixel center `p` (pixels), that no other
-/// t-instance whose silhouette covers it too hides there ([`combine_hidden`],
+/// t-instance whose silhouette covers it too hides there ([`combine_hider`],
 /// [`combine_known_covers`]), and whose older level the read finds, read with that t-instance's
-/// own matrix and no motion (such a pixel has none of its own); not found where none does. A center on a silhouette
-/// ([`SILHOUETTE_ON`]) is covered as last frame's picture has it.
+/// own matrix and no motion (such a pixel has none of its own); not found where none does. A
+/// center on a silhouette ([`SILHOUETTE_ON`]) is covered only where last frame's picture sampled this very point (its
+/// reprojection within [`COMBINE_SNAP`] of an older texel's center: camera and object still)
+/// and holds the level there; elsewhere the rasterizer may break the tie either way, and the
+/// older level taken where it would not draw it is a ghost.
 pub fn combine_read_silhouettes(
     older: &LodImage,
     data: &[[u32; 4]],
@@ -329,26 +349,29 @@ pub fn combine_read_silhouettes(
         if record_texel(data, g, 5).x & wanted != wanted {
             continue;
         }
-        let table = record_texel(data, g, 4);
-        let mut covers = silhouette_covers(data, table, p);
+        let mut covers = silhouette_covers(data, record_texel(data, g, 4), p);
         if covers == 0 {
             continue;
         }
         let m = combine_object(data, g).new_to_old;
         if covers == SILHOUETTE_ON {
             let read_at = reproject(uv, depth, &m).truncate();
-            let hit = in_viewport(read_at) && id_at(older, combine_texel(read_at, size)) == g;
-            covers = i32::from(hit);
+            let texel = combine_texel(read_at, size);
+            let sampled =
+                in_viewport(read_at) && combine_ray_offset(read_at, texel, size) < COMBINE_SNAP;
+            covers = i32::from(sampled && id_at(older, texel) == g);
+        }
+        if covers != 1 {
+            continue;
         }
         let point = reproject(uv, depth, &m);
-        let front = id_at(older, combine_texel(point.truncate(), size));
-        let hidden = combine_hidden(older, g, point.truncate(), point.z, convention)
-            && combine_known_covers(data, front, p);
-        if covers == 1 && !hidden {
-            let read = combine_read_known(older, g, uv, depth, &m, Vec2::ZERO);
-            if read.found {
-                return read;
-            }
+        let front = combine_hider(older, g, point.truncate(), point.z, convention);
+        if front != 0 && combine_known_covers(data, front, p) {
+            continue;
+        }
+        let read = combine_read_known(older, g, uv, depth, &m, Vec2::ZERO);
+        if read.found {
+            return read;
         }
     }
     NOT_FOUND
@@ -357,7 +380,7 @@ pub fn combine_read_silhouettes(
 /// The older read of the pixel `pixel` showing `newer`, by the coverage route of what it shows
 /// (`m`, `base`, `old`: its reprojection, [`combine_new_to_old`]): a t-instance's own older
 /// level by its record's route (its silhouette, the depth pass, or estimated; estimated for a
-/// t-instance without a record; by its silhouette, the texel in front where [`combine_hidden`]
+/// t-instance without a record; by its silhouette, the texel in front where [`combine_hider`]
 /// finds another object there that [`combine_may_cover`]); for a pixel showing none, a level the
 /// depth pass drew there, else a level whose silhouette covers it, else the estimate.
 ///
@@ -389,14 +412,11 @@ pub fn combine_read(
                 own = i32::from(id_at(older, combine_texel(old.truncate() + motion, size)) == id);
             }
             let read_at = old.truncate() + motion;
-            let held = combine_texel(read_at, size);
-            if own == 1
-                && combine_hidden(older, id, read_at, old.z, convention)
-                && combine_may_cover(data, id_at(older, held), p)
-            {
-                return found(older, held);
-            }
             if own == 1 {
+                let front = combine_hider(older, id, read_at, old.z, convention);
+                if front != 0 && combine_may_cover(data, front, p) {
+                    return found(older, combine_texel(read_at, size));
+                }
                 return combine_read_known(older, id, uv, depth, m, motion);
             }
             let texel = combine_behind_texel(older, id, read_at, base, depth, m, motion);

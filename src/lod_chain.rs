@@ -336,7 +336,8 @@ impl LodChain {
 }
 
 /// A unit UV sphere as positions and indices (`rings` x `segments` quads, a seam of duplicated
-/// vertices at u = 0), for examples and tests.
+/// vertices at u = 0), for examples and tests. Duplicated vertices (the seam's, each pole's) hold
+/// bit-identical positions, so a simplifier that welds by position sees a closed surface.
 pub fn uv_sphere(rings: u32, segments: u32) -> (Vec<[f32; 3]>, Vec<u32>) {
     use std::f32::consts::{PI, TAU};
     let (rings, segments) = (rings.max(2), segments.max(3));
@@ -344,12 +345,16 @@ pub fn uv_sphere(rings: u32, segments: u32) -> (Vec<[f32; 3]>, Vec<u32>) {
     for r in 0..=rings {
         let theta = PI * r as f32 / rings as f32;
         for s in 0..=segments {
-            let phi = TAU * s as f32 / segments as f32;
-            positions.push([
-                theta.sin() * phi.cos(),
-                theta.cos(),
-                -theta.sin() * phi.sin(),
-            ]);
+            let phi = TAU * (s % segments) as f32 / segments as f32;
+            positions.push(match r {
+                0 => [0.0, 1.0, 0.0],
+                r if r == rings => [0.0, -1.0, 0.0],
+                _ => [
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    -theta.sin() * phi.sin(),
+                ],
+            });
         }
     }
     let row = segments + 1;

@@ -28,10 +28,12 @@ use glam::{Mat4, Vec2, Vec3};
 use thiserror::Error;
 
 mod coverage;
+mod mask;
 pub use coverage::{
     SILHOUETTE_ON, SILHOUETTE_TIE, bin_silhouette, convex_hull, hull_triangles, polygon_area,
     silhouette_covers, silhouette_hull, silhouette_texel,
 };
+pub use mask::{MaskOutline, MaskOutlineError};
 
 /// One silhouette segment in pixels (x right, y down, pixel centers at `i + 0.5`): from
 /// `(x0, y0)` to `(x1, y1)`, its front face on the same side for every segment of a mesh.

@@ -359,3 +359,40 @@ fn levels_keep_their_source_attributes() {
     let d: Vec<f32> = group.levels().iter().map(|l| l.distance).collect();
     assert!(d.windows(2).all(|w| w[0] <= w[1]), "{d:?}");
 }
+
+/// A closed mesh (the UV sphere, whose seam and poles repeat positions bit for bit; the bulged
+/// box, with seams on every edge) keeps closed levels, with or without UVs: each level's
+/// coverage is then its silhouette (`lodkit::silhouette::Surface`), as frame-sequential LOD's
+/// combine takes it.
+#[test]
+fn closed_meshes_keep_closed_levels() {
+    for (name, (p, i, n, uv)) in [("sphere", sphere()), ("bulged box", bulged_box(6, 0.2))] {
+        for with_uvs in [true, false] {
+            let chain = LodChain::build(
+                &MeshData {
+                    positions: &p,
+                    indices: &i,
+                    normals: Some(&n),
+                    uvs: with_uvs.then_some(uv.as_slice()),
+                },
+                &LodChainDescriptor::default(),
+            )
+            .unwrap();
+            assert!(
+                chain.levels().len() >= 4,
+                "{name}: {} levels",
+                chain.levels().len()
+            );
+            for (k, level) in chain.levels().iter().enumerate() {
+                let surface =
+                    crate::silhouette::Surface::new(level.positions(), Some(level.indices()));
+                assert!(
+                    surface.is_ok(),
+                    "{name} (UVs: {with_uvs}) level {k} ({} triangles) is not closed: {:?}",
+                    level.triangles(),
+                    surface.err()
+                );
+            }
+        }
+    }
+}

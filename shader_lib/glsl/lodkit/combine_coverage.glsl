@@ -35,6 +35,8 @@
 //       object must lie to hide a level
 //   lodkit_combine_clearly_closer(a, b) -> bool   whether clip depth a lies closer than b by
 //       more than LODKIT_COMBINE_HIDDEN_MARGIN of b's view distance
+//   lodkit_combine_hider(owner, at, depth) -> uint   the object other than owner the older
+//       texel at `at` holds clearly closer than clip depth `depth`; 0: none
 //   lodkit_combine_hidden(owner, at, depth) -> bool   whether the older texel at `at` holds
 //       another object clearly closer than clip depth `depth`
 //   lodkit_combine_known_covers(id, p) -> bool   whether id's older silhouette is known and
@@ -288,13 +290,22 @@ bool lodkit_combine_clearly_closer(float a, float b) {
 #endif
 }
 
-/// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
-/// closer than clip depth `depth` (lodkit_combine_clearly_closer): there the older frame drew that
-/// object in front of `owner`'s older level.
-bool lodkit_combine_hidden(uint owner, vec2 at, float depth) {
+/// The object other than `owner` (not the background) that the older texel at texture-space `at`
+/// holds clearly closer than clip depth `depth` (lodkit_combine_clearly_closer): the older frame
+/// drew it in front of `owner`'s older level there. 0 where there is none (or `at` is outside
+/// the view).
+uint lodkit_combine_hider(uint owner, vec2 at, float depth) {
     uvec2 texel = lodkit_combine_texel(at, lodkit_combine_fetch_size());
     uint held = lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel));
-    return lodkit_in_viewport(at) && held != owner && lodkit_combine_clearly_closer(lodkit_combine_fetch_depth(texel), depth);
+    bool hides = lodkit_in_viewport(at) && held != owner && held != 0u && lodkit_combine_clearly_closer(lodkit_combine_fetch_depth(texel), depth);
+    return hides ? held : 0u;
+}
+
+/// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
+/// closer than clip depth `depth` (lodkit_combine_hider): there the older frame drew that object
+/// in front of `owner`'s older level.
+bool lodkit_combine_hidden(uint owner, vec2 at, float depth) {
+    return lodkit_combine_hider(owner, at, depth) != 0u;
 }
 
 /// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
@@ -318,10 +329,12 @@ bool lodkit_combine_may_cover(uint id, vec2 p) {
 }
 
 /// For a pixel showing no t-instance: the read (lodkit_combine_read_known) of the first
-/// t-instance whose older silhouette covers the pixel center `p` (on it: as last frame's picture
-/// has it), is not hidden there by another t-instance whose silhouette covers it too
-/// (lodkit_combine_hidden, lodkit_combine_known_covers), and whose older level the read finds;
-/// none: not found.
+/// t-instance whose older silhouette covers the pixel center `p` (on its outline, only where last
+/// frame's picture sampled this very point, within LODKIT_COMBINE_SNAP of an older texel's
+/// center, and holds the level there: elsewhere the rasterizer may break the tie either way, and
+/// a level taken where it would not draw it is a ghost), is not hidden there by another
+/// t-instance whose silhouette covers it too (lodkit_combine_hider, lodkit_combine_known_covers),
+/// and whose older level the read finds; none: not found.
 lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p) {
     uvec2 size = lodkit_combine_fetch_size();
     uint slots = lodkit_silhouette_texel(5u).z;
@@ -337,24 +350,28 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
         mat4 m = lodkit_combine_object(g).new_to_old;
         if (covers == LODKIT_SILHOUETTE_ON) {
             vec2 at = lodkit_reproject(uv, depth, m).xy;
-            bool hit = lodkit_in_viewport(at) && lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(at, size))) == g;
-            covers = hit ? 1 : 0;
+            uvec2 texel = lodkit_combine_texel(at, size);
+            bool sampled = lodkit_in_viewport(at) && lodkit_combine_ray_offset(at, texel, size) < LODKIT_COMBINE_SNAP;
+            covers = sampled && lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == g ? 1 : 0;
+        }
+        if (covers != 1) {
+            continue;
         }
         vec3 point = lodkit_reproject(uv, depth, m);
-        uint front = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(point.xy, size)));
-        bool hidden = lodkit_combine_hidden(g, point.xy, point.z) && lodkit_combine_known_covers(front, p);
-        if (covers == 1 && !hidden) {
-            lodkit_CombineRead read = lodkit_combine_read_known(g, uv, depth, m, vec2(0.0));
-            if (read.found) {
-                return read;
-            }
+        uint front = lodkit_combine_hider(g, point.xy, point.z);
+        if (front != 0u && lodkit_combine_known_covers(front, p)) {
+            continue;
+        }
+        lodkit_CombineRead read = lodkit_combine_read_known(g, uv, depth, m, vec2(0.0));
+        if (read.found) {
+            return read;
         }
     }
     return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
 }
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
-/// (estimated without one; with its silhouette, the texel in front where lodkit_combine_hidden
+/// (estimated without one; with its silhouette, the texel in front where lodkit_combine_hider
 /// finds another object there that lodkit_combine_may_cover); else the depth pass's level, a
 /// covering silhouette, the estimate.
 lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, vec4 base, vec3 old, mat4 m) {
@@ -372,12 +389,12 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
                 own = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(old.xy + newer.motion, size))) == id ? 1 : 0;
             }
             vec2 at = old.xy + newer.motion;
-            uvec2 held = lodkit_combine_texel(at, size);
-            uint front = lodkit_lod_buffer_id(lodkit_combine_fetch_word(held));
-            if (own == 1 && lodkit_combine_hidden(id, at, old.z) && lodkit_combine_may_cover(front, p)) {
-                return lodkit_CombineRead(held, lodkit_combine_fetch_color(held), true);
-            }
             if (own == 1) {
+                uint front = lodkit_combine_hider(id, at, old.z);
+                if (front != 0u && lodkit_combine_may_cover(front, p)) {
+                    uvec2 held = lodkit_combine_texel(at, size);
+                    return lodkit_CombineRead(held, lodkit_combine_fetch_color(held), true);
+                }
                 return lodkit_combine_read_known(id, uv, newer.depth, m, newer.motion);
             }
             uvec2 texel = lodkit_combine_behind_texel(id, at, base, newer.depth, m, newer.motion);

@@ -39,6 +39,8 @@
 //       lie to hide a level
 //   combine_clearly_closer(a, b) -> bool   whether clip depth a lies closer than b by more than
 //       COMBINE_HIDDEN_MARGIN of b's view distance
+//   combine_hider(older_id, older_depth, owner, at, depth) -> u32   the object other than owner
+//       the older texel at `at` holds clearly closer than clip depth `depth`; 0: none
 //   combine_hidden(older_id, older_depth, owner, at, depth) -> bool   whether the older texel at
 //       `at` holds another object clearly closer than clip depth `depth` (owner's older level
 //       hidden)
@@ -59,7 +61,7 @@
 // Shader defs:
 //   LODKIT_REVERSE_Z (bool, default off) — depth 1 is near and 0 far (reversed Z); off: 0 near.
 #define_import_path lodkit::combine_coverage
-#import lodkit::combine::{CombineRead, COMBINE_COVER_REACH, COMBINE_BLOCK_REACH, combine_texel, combine_uv, combine_texels, combine_ray_offset, combine_cover_texel, combine_own_color, combine_other_texel, combine_read_own, combine_displayed_word, depth_closer}
+#import lodkit::combine::{CombineRead, COMBINE_COVER_REACH, COMBINE_BLOCK_REACH, COMBINE_SNAP, combine_texel, combine_uv, combine_texels, combine_ray_offset, combine_cover_texel, combine_own_color, combine_other_texel, combine_read_own, combine_displayed_word, depth_closer}
 #import lodkit::lod_buffer::lod_buffer_id
 #import lodkit::reproject::{reproject, reproject_base, reproject_from_base, reproject_refine, in_viewport}
 #import lodkit::silhouette::{silhouette_texel, silhouette_covers, SILHOUETTE_ON}
@@ -287,13 +289,21 @@ fn combine_clearly_closer(a: f32, b: f32) -> bool {
 #endif
 }
 
-/// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
-/// closer than clip depth `depth` (combine_clearly_closer): there the older frame drew that
-/// object in front of `owner`'s older level.
-fn combine_hidden(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, at: vec2<f32>, depth: f32) -> bool {
+/// The object other than `owner` (not the background) that the older texel at texture-space `at`
+/// holds clearly closer than clip depth `depth` (combine_clearly_closer): the older frame drew it
+/// in front of `owner`'s older level there. 0 where there is none (or `at` is outside the view).
+fn combine_hider(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, at: vec2<f32>, depth: f32) -> u32 {
     let texel = combine_texel(at, textureDimensions(older_id, 0));
     let held = lod_buffer_id(textureLoad(older_id, texel, 0).x);
-    return in_viewport(at) && held != owner && combine_clearly_closer(textureLoad(older_depth, texel, 0).x, depth);
+    let hides = in_viewport(at) && held != owner && held != 0u && combine_clearly_closer(textureLoad(older_depth, texel, 0).x, depth);
+    return select(0u, held, hides);
+}
+
+/// Whether the older texel at texture-space `at` holds an object other than `owner` clearly
+/// closer than clip depth `depth` (combine_hider): there the older frame drew that object in
+/// front of `owner`'s older level.
+fn combine_hidden(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, at: vec2<f32>, depth: f32) -> bool {
+    return combine_hider(older_id, older_depth, owner, at, depth) != 0u;
 }
 
 /// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
@@ -317,8 +327,11 @@ fn combine_may_cover(data: texture_2d<u32>, id: u32, p: vec2<f32>) -> bool {
 }
 
 /// For a pixel showing no t-instance: the read (combine_read_known) of the first t-instance
-/// whose older silhouette covers the pixel center `p` (on it: as last frame's picture has it),
-/// is not hidden there by another t-instance whose silhouette covers it too (combine_hidden,
+/// whose older silhouette covers the pixel center `p` (on its outline, only where last frame's
+/// picture sampled this very point, within COMBINE_SNAP of an older texel's center, and holds the
+/// level there: elsewhere the rasterizer may break the tie either way, and a level taken where it
+/// would not draw it is a ghost),
+/// is not hidden there by another t-instance whose silhouette covers it too (combine_hider,
 /// combine_known_covers), and whose older level the read finds; none: not found.
 fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, uv: vec2<f32>, depth: f32, p: vec2<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
@@ -335,24 +348,28 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
         let m = combine_object(data, g).new_to_old;
         if (covers == SILHOUETTE_ON) {
             let at = reproject(uv, depth, m).xy;
-            let hit = in_viewport(at) && lod_buffer_id(textureLoad(older_id, combine_texel(at, size), 0).x) == g;
-            covers = select(0, 1, hit);
+            let texel = combine_texel(at, size);
+            let sampled = in_viewport(at) && combine_ray_offset(at, texel, size) < COMBINE_SNAP;
+            covers = select(0, 1, sampled && lod_buffer_id(textureLoad(older_id, texel, 0).x) == g);
+        }
+        if (covers != 1) {
+            continue;
         }
         let point = reproject(uv, depth, m);
-        let front = lod_buffer_id(textureLoad(older_id, combine_texel(point.xy, size), 0).x);
-        let hidden = combine_hidden(older_id, older_depth, g, point.xy, point.z) && combine_known_covers(data, front, p);
-        if (covers == 1 && !hidden) {
-            let read = combine_read_known(older_color, older_id, older_depth, g, uv, depth, m, vec2<f32>(0.0));
-            if (read.found) {
-                return read;
-            }
+        let front = combine_hider(older_id, older_depth, g, point.xy, point.z);
+        if (front != 0u && combine_known_covers(data, front, p)) {
+            continue;
+        }
+        let read = combine_read_known(older_color, older_id, older_depth, g, uv, depth, m, vec2<f32>(0.0));
+        if (read.found) {
+            return read;
         }
     }
     return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
 }
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
-/// (estimated without one; with its silhouette, the texel in front where combine_hidden finds
+/// (estimated without one; with its silhouette, the texel in front where combine_hider finds
 /// another object there that combine_may_cover); else the depth pass's level, a covering
 /// silhouette, the estimate.
 fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, newer: CombineNewer, pixel: vec2<u32>, base: vec4<f32>, old: vec3<f32>, m: mat4x4<f32>) -> CombineRead {
@@ -368,12 +385,12 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
                 own = select(0, 1, lod_buffer_id(textureLoad(older_id, combine_texel(old.xy + newer.motion, size), 0).x) == id);
             }
             let at = old.xy + newer.motion;
-            let held = combine_texel(at, size);
-            let front = lod_buffer_id(textureLoad(older_id, held, 0).x);
-            if (own == 1 && combine_hidden(older_id, older_depth, id, at, old.z) && combine_may_cover(data, front, p)) {
-                return CombineRead(held, textureLoad(older_color, held, 0), true);
-            }
             if (own == 1) {
+                let front = combine_hider(older_id, older_depth, id, at, old.z);
+                if (front != 0u && combine_may_cover(data, front, p)) {
+                    let held = combine_texel(at, size);
+                    return CombineRead(held, textureLoad(older_color, held, 0), true);
+                }
                 return combine_read_known(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion);
             }
             let texel = combine_behind_texel(older_id, older_depth, id, at, base, newer.depth, m, newer.motion);
