@@ -10,6 +10,14 @@ pub(super) fn check_known(out: &[u32], s: &Scene, who: &str) {
     let color = |w: &[u32], k: usize| Vec4::from_slice(&floats(&w[k..k + 4]));
     let close = |a: Vec4, b: Vec4, tol: f32| (a - b).abs().max_element() <= tol;
     let older = |x: u32, y: u32| s.older.colors[at(x, y)];
+    // The combined color at pixel (x, y) is `want` (within 1e-5: one texel or a blend of two).
+    let shows = |x: u32, y: u32, want: Vec4, what: String| {
+        let got = color(pixel(x, y), 0);
+        assert!(
+            close(got, want, 1e-5),
+            "{who}: pixel ({x}, {y}) shows {got}, not {what}"
+        );
+    };
     // Silhouette: pixel (3, 5) shows background and reads older background at x 3.8; the older
     // level's silhouette covers it, so it shows that level: its texel (4, 5), 0.7 texel from the
     // ray (the bilinear blend of texels 3 and 4 keeps only 4, the same object's).
@@ -67,62 +75,56 @@ pub(super) fn check_known(out: &[u32], s: &Scene, who: &str) {
     // against 0.95), a t-instance whose older level may cover the pixel now (combine_may_cover):
     // the pixel shows FRONT, as last frame did, not the t-instance's own texels around it
     // (combine_hidden).
-    let got = color(pixel(6, 7), 0);
-    assert!(
-        close(got, older(6, 7), 1e-5),
-        "{who}: pixel (6, 7) shows {got}, not the older object in front, {}",
-        older(6, 7)
+    shows(
+        6,
+        7,
+        older(6, 7),
+        format!("the older object in front, {}", older(6, 7)),
     );
     // Touching: pixel (5, 8) reads x 5.8 and finds FRONT at texel (5, 8), in front of the
     // t-instance's older level by less than COMBINE_HIDDEN_MARGIN: not hidden. The read takes the
     // t-instance's texel (4, 8) (the block's first at 1.3 texels from the ray; (4, 7) ties), whose
     // 2x2 blend holds no texel of it; both levels are shown and have one id: their average.
-    let got = color(pixel(5, 8), 0);
     let want = 0.5 * (s.newer.colors[at(5, 8)] + older(4, 8));
-    assert!(
-        close(got, want, 1e-5),
-        "{who}: pixel (5, 8) shows {got}, not the average of its newer color and texel (4, 8), {want} \
-         (FRONT's older color: {})",
+    let what = format!(
+        "the average of its newer color and texel (4, 8), {want} (FRONT's older color: {})",
         older(5, 8)
     );
+    shows(5, 8, want, what);
     // Still: pixel (7, 4) shows the silhouette t-instance and reads x 7.8, texel (7, 4), where
     // STILL, in no transition, lay in front of its older level (depth 0.9 against 0.95). STILL is
     // drawn this frame and lost the depth test to the t-instance here: it hides nothing now. The
     // read takes the t-instance's own texels: the 2x2 blend around x 7.8 holds (7, 4) (STILL) at
     // 0.7 and (8, 4) at 0.3, so (8, 4) alone; both levels are shown and have one id: their average.
-    let got = color(pixel(7, 4), 0);
     let want = 0.5 * (s.newer.colors[at(7, 4)] + older(8, 4));
-    assert!(
-        close(got, want, 1e-5),
-        "{who}: pixel (7, 4) shows {got}, not the average of its newer color and texel (8, 4), {want} \
-         (STILL's older color, as if it hid the level: {})",
+    let what = format!(
+        "the average of its newer color and texel (8, 4), {want} (STILL's older color, as if it \
+         hid the level: {})",
         older(7, 4)
     );
+    shows(7, 4, want, what);
     // On the outline: pixel (9, 5) shows background, and its center lies on the older
     // silhouette's right edge; the read (x 9.8) finds the level at texel (9, 5), as last frame
     // had it there. Neither the level drawn now nor, where the rasterizer breaks the tie the
     // other way, the older level covers the pixel: it is not taken as covered, and the estimate
     // leaves a level whose coverage is known to its silhouette. The pixel keeps its newer color.
-    let got = color(pixel(9, 5), 0);
     let want = s.newer.colors[at(9, 5)];
-    assert!(
-        close(got, want, 1e-5),
-        "{who}: pixel (9, 5), on the older silhouette's outline, shows {got}, not its newer color \
-         {want} (the older level's texel there, as last frame's picture has it: {})",
+    let what = format!(
+        "its newer color {want} (on the older silhouette's outline; the older level's texel \
+         there, as last frame's picture has it: {})",
         older(9, 5)
     );
+    shows(9, 5, want, what);
     // On the outline of a level that did not move: pixel (1, 9) shows background, its center
     // lies on TIE's older silhouette's left edge, and it reprojects onto the center of texel
     // (1, 9), which holds TIE: last frame's picture sampled this very point and drew the level
     // there. It shows that level (displayed, pattern 0.1), its texel (1, 9) alone.
-    let got = color(pixel(1, 9), 0);
-    assert!(
-        close(got, older(1, 9), 1e-5),
-        "{who}: pixel (1, 9), on a still level's outline, shows {got}, not the older level's \
-         texel there, {} (its newer color: {})",
+    let what = format!(
+        "the older level's texel there, {} (on a still level's outline; its newer color: {})",
         older(1, 9),
         s.newer.colors[at(1, 9)]
     );
+    shows(1, 9, older(1, 9), what);
     // combine_hider, for the silhouette t-instance at each pixel's read: FRONT at (6, 7) and STILL
     // at (7, 4) (0.05 in front, clearly closer), none at (5, 8) (FRONT within the margin) nor at
     // (3, 5) (the background).

@@ -201,14 +201,7 @@ impl Surface {
                 ((b - a).cross(c - a).dot(eye - a) > 0.0) == front_ccw
             })
             .collect();
-        let half = Vec2::new(size.0 as f32, size.1 as f32) / 2.0;
-        let project = |id: u32| {
-            let clip = clip_from_local * points[id as usize].extend(1.0);
-            (clip.w > 1e-6).then(|| {
-                let ndc = clip.truncate().truncate() / clip.w;
-                Vec2::new((ndc.x + 1.0) * half.x, (1.0 - ndc.y) * half.y)
-            })
-        };
+        let project = |id: u32| to_pixels(clip_from_local, points[id as usize], size);
         let mut segments = Vec::new();
         for (e, &twin) in self.twins.iter().enumerate() {
             if front[e / 3] && !front[twin as usize / 3] {
@@ -221,6 +214,17 @@ impl Surface {
         }
         Ok(segments)
     }
+}
+
+/// Pixel position (x right, y down) of local point `p` under `clip_from_local` on a target of
+/// `size` pixels; `None` at or behind the camera plane (w <= 1e-6), where it has none.
+fn to_pixels(clip_from_local: Mat4, p: Vec3, size: (u32, u32)) -> Option<Vec2> {
+    let clip = clip_from_local * p.extend(1.0);
+    (clip.w > 1e-6).then(|| {
+        let ndc = clip.truncate().truncate() / clip.w;
+        let half = Vec2::new(size.0 as f32, size.1 as f32) / 2.0;
+        Vec2::new((ndc.x + 1.0) * half.x, (1.0 - ndc.y) * half.y)
+    })
 }
 
 /// One id per position (and the positions by id), positions within a millionth of the mesh's

@@ -5,7 +5,7 @@
 use glam::{Mat4, Vec2, Vec4};
 use thiserror::Error;
 
-use super::{Segment, SilhouetteError};
+use super::{Segment, SilhouetteError, to_pixels};
 use crate::alpha_mask::AlphaMask;
 
 /// Why a mask has no outline.
@@ -147,14 +147,7 @@ impl MaskOutline {
         clip_from_local: Mat4,
         size: (u32, u32),
     ) -> Result<Vec<Segment>, SilhouetteError> {
-        let half = Vec2::new(size.0 as f32, size.1 as f32) / 2.0;
-        let project = |p: Vec2| {
-            let clip = clip_from_local * p.extend(0.0).extend(1.0);
-            (clip.w > 1e-6).then(|| {
-                let ndc = clip.truncate().truncate() / clip.w;
-                Vec2::new((ndc.x + 1.0) * half.x, (1.0 - ndc.y) * half.y)
-            })
-        };
+        let project = |p: Vec2| to_pixels(clip_from_local, p.extend(0.0), size);
         self.edges
             .iter()
             .map(|[a, b]| match (project(*a), project(*b)) {
