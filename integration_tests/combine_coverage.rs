@@ -5,6 +5,8 @@
 //! pixel's ray, the older color is the bilinear blend of the same object's texels, and an object
 //! in front of the older level hides it only by more than `COMBINE_HIDDEN_MARGIN`, and only
 //! where it is a t-instance whose older level may still cover the pixel (`combine_may_cover`).
+//! Behind a level drawn now whose older silhouette does not cover a pixel, another t-instance's
+//! older level shows where its silhouette covers the pixel.
 
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 use lodkit::combine::{
@@ -48,7 +50,9 @@ const FRONT: u32 = 7;
 /// on texel (7, 4) of the older frame: drawn this frame too, it is not in front of it now.
 const STILL: u32 = 9;
 /// A t-instance that did not move (its matrix the identity) on older texels 1..=2 x 9..=10,
-/// whose silhouette's left edge passes through the centers of pixel column 1.
+/// whose silhouette's left edge passes through the centers of pixel column 1; its level drawn
+/// now, not shown at this frame, covers pixel (3, 8), inside the silhouette t-instance's older
+/// silhouette and outside its own.
 const TIE: u32 = 11;
 
 /// The scene: older and newer LOD buffers, the newer words, the screen pattern per pixel.
@@ -98,7 +102,9 @@ fn scene() -> Scene {
     // Newer: the silhouette t-instance on 4..=8 x 3..=8 (the level drawn this frame is smaller),
     // the estimated one on 10..=14 x 2..=5 (larger).
     let newer_id = |x: u32, y: u32| {
-        if (4..=8).contains(&x) && SIL_Y.contains(&y) {
+        if (x, y) == (3, 8) {
+            TIE
+        } else if (4..=8).contains(&x) && SIL_Y.contains(&y) {
             SIL
         } else if (10..=14).contains(&x) && (2..=5).contains(&y) {
             EST
@@ -128,7 +134,9 @@ fn scene() -> Scene {
     // FRONT touches the silhouette t-instance's older level at texel (5, 8): 0.0002 in front,
     // within COMBINE_HIDDEN_MARGIN (0.01 of 1 - 0.95: 0.0005).
     older.depths[at(5, 8)] = 0.9498;
-    let newer = image(&newer_id, 3);
+    let mut newer = image(&newer_id, 3);
+    // TIE's level drawn now is not shown at (3, 8) this frame (flag: shown next only).
+    newer.flags[at(3, 8)] = 2;
     let mut pattern: Vec<f32> = noise[6 * n..7 * n].to_vec();
     // Where the silhouette test and the touching texel are checked, the older level is
     // displayed (pattern <= tau 0.5).
@@ -137,6 +145,7 @@ fn scene() -> Scene {
     pattern[at(7, 4)] = 0.1;
     pattern[at(9, 5)] = 0.1;
     pattern[at(1, 9)] = 0.1;
+    pattern[at(3, 8)] = 0.1;
     // The older level's silhouette under this frame's camera: the rectangle from (3, 3) to
     // (9.5, 9) in pixels (its texels 4..=9 moved 0.3 texel left by the camera, widened on the
     // left), which covers pixel column 3 where the older buffer's read finds background, and

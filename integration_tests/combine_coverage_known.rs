@@ -125,6 +125,17 @@ pub(super) fn check_known(out: &[u32], s: &Scene, who: &str) {
         s.newer.colors[at(1, 9)]
     );
     shows(1, 9, older(1, 9), what);
+    // Behind a level: pixel (3, 8) shows TIE's level drawn now, not shown this frame, outside
+    // TIE's older silhouette; the silhouette t-instance's older silhouette covers its center
+    // (3.5, 8.5). Its read (x 3.8) finds background at (3, 8); the level's texel (4, 8) lies 0.7
+    // texel from the ray, and the 2x2 blend around x 3.8 holds it alone (weight 0.3): the pixel
+    // shows that texel, the level behind TIE's, not the background texel (3, 8) TIE's ray lands on.
+    let what = format!(
+        "the older level behind TIE's, its texel (4, 8), {} (the background texel the ray lands on: {})",
+        older(4, 8),
+        older(3, 8)
+    );
+    shows(3, 8, older(4, 8), what);
     // combine_hider, for the silhouette t-instance at each pixel's read: FRONT at (6, 7) and STILL
     // at (7, 4) (0.05 in front, clearly closer), none at (5, 8) (FRONT within the margin) nor at
     // (3, 5) (the background).

@@ -3,7 +3,9 @@
 //! twins, on a hand-made older buffer seen from a camera whose motion moves each depth by another
 //! amount (parallax): the texel a read wants lies several texels along the ray's image from where
 //! the newer depth reprojects, out of reach of the 3x3 block. A pixel that shows no t-instance
-//! reads a level whose silhouette covers it the same way (`combine_read_silhouettes`).
+//! reads a level whose silhouette covers it the same way (`combine_read_silhouettes`). What lies
+//! behind a level is never another t-instance's level known by its silhouette: that one shows at
+//! the pixel only where its silhouette covers it, which `combine_read_silhouettes` reads.
 
 use glam::{Mat4, UVec2, Vec2, Vec4};
 use lodkit::combine::{DepthConvention, LodImage, combine_uv};
@@ -18,9 +20,11 @@ use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words}
 const W: u32 = 16;
 const H: u32 = 4;
 /// Output words per case.
-const OUT: usize = 15;
+const OUT: usize = 17;
 /// The t-instance whose older level the reads look for, on texels 10..=12 of every row, depth 0.5.
 const OWNER: u32 = 3;
+/// A t-instance with no texel in the older buffer: what lies behind its level is looked for too.
+const OTHER: u32 = 7;
 /// The camera's parallax: old NDC x = x + B (z - 0.9), so depth 0.9 stays in place and depth 0.5
 /// moves 6 texels right (8 texels per NDC unit), depth 1 1.5 texels left.
 const B: f32 = -1.875;
@@ -116,13 +120,16 @@ fn twin_words(older: &LodImage, data: &CombineData) -> Vec<u32> {
         .flat_map(|&(x, y, depth)| {
             let uv = combine_uv(UVec2::new(x, y), size);
             let base = reproject_base(uv, &m);
-            let known = combine_read_known(older, OWNER, uv, depth, &m, Vec2::ZERO);
+            let texels = &data.texels;
+            let known = combine_read_known(older, texels, OWNER, uv, depth, &m, Vec2::ZERO);
             let hit = |owned| {
-                combine_ray_texel(older, OWNER, owned, base, depth, &m, Vec2::ZERO)
+                combine_ray_texel(older, texels, OWNER, owned, base, depth, &m, Vec2::ZERO)
                     .map_or([0, 0, 0], |t| [t.x, t.y, 1])
             };
             let at = reproject(uv, depth, &m).truncate();
-            let behind = combine_behind_texel(older, OWNER, at, base, depth, &m, Vec2::ZERO);
+            let behind =
+                |id| combine_behind_texel(older, texels, id, at, base, depth, &m, Vec2::ZERO);
+            let (behind, behind_other) = (behind(OWNER), behind(OTHER));
             let mut w = vec![known.texel.x, known.texel.y, u32::from(known.found)];
             w.extend(words(&known.color.to_array()));
             w.extend(hit(true));
@@ -137,6 +144,7 @@ fn twin_words(older: &LodImage, data: &CombineData) -> Vec<u32> {
                 DepthConvention::Standard,
             );
             w.extend([covered.texel.x, covered.texel.y, u32::from(covered.found)]);
+            w.extend([behind_other.x, behind_other.y]);
             w
         })
         .collect()
@@ -178,6 +186,14 @@ fn check_known(out: &[u32], older: &LodImage, who: &str) {
     assert_eq!(case(3)[10..12], [4, 1], "{who}: behind texel at (4, 1)");
     // (4, 2): out of reach, the 3x3 block's nearest texel not holding OWNER.
     assert_eq!(case(4)[10..12], [9, 2], "{who}: behind texel at (4, 2)");
+    // Behind OTHER's level at (4, 1), depth 0.5: the ray's first texels, 10..=12, hold OWNER,
+    // whose older level is known by its silhouette: skipped. The background texel (4, 1) is what
+    // lies behind, as for OWNER.
+    assert_eq!(
+        case(3)[15..17],
+        [4, 1],
+        "{who}: behind OTHER's level at (4, 1) (not OWNER's texel 10, a level known by its silhouette)"
+    );
     // A pixel showing the background (depth 0.9) inside OWNER's older silhouette reads that
     // level along the ray: at (4, 1) texel 10; at (2, 1) none within reach, so not found
     // (combine_read goes on to the estimate, not to the background texel the read lands on).
@@ -224,13 +240,15 @@ fn ray_read_twins_match() {
         let m = mat4x4<f32>(vec4(1.0, 0.0, 0.0, 0.0), vec4(0.0, 1.0, 0.0, 0.0), {matrix});
         let uv = combine_uv(px, vec2({W}u, {H}u));
         let base = reproject_base(uv, m);
-        let known = combine_read_known(probe_rgba0, probe_urgba0, probe_rgba1, {OWNER}u, uv, depth, m, vec2(0.0));
+        let known = combine_read_known(probe_rgba0, probe_urgba0, probe_rgba1, probe_urgba1, {OWNER}u, uv, depth, m, vec2(0.0));
         out_u(0u, known.texel.x); out_u(1u, known.texel.y); out_u(2u, u32(known.found));
         out_f(3u, known.color.x); out_f(4u, known.color.y); out_f(5u, known.color.z); out_f(6u, known.color.w);
-        let hit = combine_ray_texel(probe_urgba0, probe_rgba1, {OWNER}u, true, base, depth, m, vec2(0.0));
+        let hit = combine_ray_texel(probe_urgba0, probe_rgba1, probe_urgba1, {OWNER}u, true, base, depth, m, vec2(0.0));
         out_u(7u, hit.x); out_u(8u, hit.y); out_u(9u, hit.z);
-        let behind = combine_behind_texel(probe_urgba0, probe_rgba1, {OWNER}u, reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
+        let behind = combine_behind_texel(probe_urgba0, probe_rgba1, probe_urgba1, {OWNER}u, reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
         out_u(10u, behind.x); out_u(11u, behind.y);
+        let other = combine_behind_texel(probe_urgba0, probe_rgba1, probe_urgba1, {OTHER}u, reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
+        out_u(15u, other.x); out_u(16u, other.y);
         let covered = combine_read_silhouettes(probe_rgba0, probe_urgba0, probe_rgba1, probe_urgba1, uv, depth, vec2<f32>(px) + 0.5);
         out_u(12u, covered.texel.x); out_u(13u, covered.texel.y); out_u(14u, u32(covered.found));"
     );
@@ -247,6 +265,8 @@ fn ray_read_twins_match() {
         out_u(7u, hit.x); out_u(8u, hit.y); out_u(9u, hit.z);
         uvec2 behind = lodkit_combine_behind_texel({OWNER}u, lodkit_reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
         out_u(10u, behind.x); out_u(11u, behind.y);
+        uvec2 other = lodkit_combine_behind_texel({OTHER}u, lodkit_reproject(uv, depth, m).xy, base, depth, m, vec2(0.0));
+        out_u(15u, other.x); out_u(16u, other.y);
         lodkit_CombineRead covered = lodkit_combine_read_silhouettes(uv, depth, vec2(px) + 0.5);
         out_u(12u, covered.texel.x); out_u(13u, covered.texel.y); out_u(14u, uint(covered.found));"
     );
@@ -265,7 +285,7 @@ uvec4 lodkit_silhouette_fetch(uint i) {
     // Texels and flags exact; the colors are single texels (a weight of exactly 1): 1e-5.
     let mut kinds = vec![Word::Exact; 3];
     kinds.extend([Word::Float(1e-5); 4]);
-    kinds.extend([Word::Exact; 8]);
+    kinds.extend([Word::Exact; 10]);
     let colors = older.colors.clone();
     for (route, language, header, body) in
         twin_runs(gpu, (wgsl_header, &wgsl), (glsl_header, &glsl))

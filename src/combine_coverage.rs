@@ -303,6 +303,13 @@ pub fn combine_hidden(
     combine_hider(older, owner, at, depth, convention) != 0
 }
 
+/// Whether `id` is a t-instance whose older level's coverage is its silhouette (its record in
+/// `data` is known and routed by the silhouette; Rust twin of `combine_by_silhouette`).
+pub fn combine_by_silhouette(data: &[[u32; 4]], id: u32) -> bool {
+    let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
+    id != 0 && combine_object(data, id).flags & wanted == wanted
+}
+
 /// Whether `id` is a t-instance whose older level's coverage is its silhouette, and that
 /// silhouette covers (or passes through) the pixel center `p` (Rust twin of
 /// `combine_known_covers`).
@@ -369,7 +376,7 @@ pub fn combine_read_silhouettes(
         if front != 0 && combine_known_covers(data, front, p) {
             continue;
         }
-        let read = combine_read_known(older, g, uv, depth, &m, Vec2::ZERO);
+        let read = combine_read_known(older, data, g, uv, depth, &m, Vec2::ZERO);
         if read.found {
             return read;
         }
@@ -381,8 +388,10 @@ pub fn combine_read_silhouettes(
 /// (`m`, `base`, `old`: its reprojection, [`combine_new_to_old`]): a t-instance's own older
 /// level by its record's route (its silhouette, the depth pass, or estimated; estimated for a
 /// t-instance without a record; by its silhouette, the texel in front where [`combine_hider`]
-/// finds another object there that [`combine_may_cover`]); for a pixel showing none, a level the
-/// depth pass drew there, else a level whose silhouette covers it, else the estimate.
+/// finds another object there that [`combine_may_cover`], and where the silhouette does not
+/// cover the pixel, what lies behind the level: another level whose silhouette covers it
+/// ([`combine_read_silhouettes`]), else [`combine_behind_texel`]); for a pixel showing none, a
+/// level the depth pass drew there, else a level whose silhouette covers it, else the estimate.
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
@@ -417,9 +426,15 @@ pub fn combine_read(
                 if front != 0 && combine_may_cover(data, front, p) {
                     return found(older, combine_texel(read_at, size));
                 }
-                return combine_read_known(older, id, uv, depth, m, motion);
+                return combine_read_known(older, data, id, uv, depth, m, motion);
             }
-            let texel = combine_behind_texel(older, id, read_at, base, depth, m, motion);
+            // Behind the level: another t-instance's older level whose silhouette covers the
+            // pixel, else what the ray finds.
+            let behind = combine_read_silhouettes(older, data, uv, depth, p, convention);
+            if behind.found {
+                return behind;
+            }
+            let texel = combine_behind_texel(older, data, id, read_at, base, depth, m, motion);
             return found(older, texel);
         }
         if object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)

@@ -13,6 +13,8 @@ use crate::combine::{
 };
 use crate::reproject::{in_viewport, reproject_base, reproject_from_base, reproject_refine};
 
+use super::combine_by_silhouette;
+
 /// Texels [`combine_ray_texel`] steps along the pixel's ray, each way.
 pub const COMBINE_RAY_STEPS: u32 = 6;
 
@@ -22,7 +24,10 @@ pub const COMBINE_RAY_STEPS: u32 = 6;
 pub const COMBINE_RAY_REACH: f32 = 0.75;
 
 /// The older texel on the pixel's ray (`base` = `reproject_base` under `new_to_old`, moved by
-/// `motion`) that holds `id` (`owned`) or any other id (`!owned`), Rust twin of
+/// `motion`) that holds `id` (`owned`) or any other id (`!owned`) but a t-instance whose record
+/// in `data` gives its silhouette as its coverage ([`combine_by_silhouette`]: such a level shows
+/// at the pixel only where its silhouette covers it, and
+/// [`combine_read_silhouettes`](super::combine_read_silhouettes) reads those), Rust twin of
 /// `combine_ray_texel`: stepping a texel at a time along the ray's image in the older buffer from
 /// the reprojection of `depth`, both ways, nearest first, up to [`COMBINE_RAY_STEPS`]; the first
 /// whose older sample, refined at its own depth, lies within [`COMBINE_RAY_REACH`] of it. None
@@ -32,6 +37,7 @@ pub const COMBINE_RAY_REACH: f32 = 0.75;
 #[allow(clippy::too_many_arguments)]
 pub fn combine_ray_texel(
     older: &LodImage,
+    data: &[[u32; 4]],
     id: u32,
     owned: bool,
     base: Vec4,
@@ -62,7 +68,8 @@ pub fn combine_ray_texel(
             continue;
         }
         let t = combine_texel(at, size);
-        if (id_at(older, t) == id) != owned {
+        let held = id_at(older, t);
+        if (held == id) != owned || (!owned && combine_by_silhouette(data, held)) {
             continue;
         }
         let ray = reproject_refine(base, depth, depth_at(older, t), new_to_old).truncate() + motion;
@@ -80,6 +87,7 @@ pub fn combine_ray_texel(
 /// would show through it).
 pub fn combine_read_known(
     older: &LodImage,
+    data: &[[u32; 4]],
     owner: u32,
     uv: Vec2,
     depth: f32,
@@ -99,7 +107,8 @@ pub fn combine_read_known(
         return read;
     }
     let base = reproject_base(uv, new_to_old);
-    let Some(hit) = combine_ray_texel(older, owner, true, base, depth, new_to_old, motion) else {
+    let Some(hit) = combine_ray_texel(older, data, owner, true, base, depth, new_to_old, motion)
+    else {
         return NOT_FOUND;
     };
     let at = reproject_refine(base, depth, depth_at(older, hit), new_to_old).truncate() + motion;
@@ -110,13 +119,14 @@ pub fn combine_read_known(
 
 /// The older texel showing what lies behind `id`'s older level at the pixel, where that level
 /// is known not to cover it, Rust twin of `combine_behind_texel`: [`combine_ray_texel`]'s texel
-/// of another id on the pixel's ray (`base`, `depth`: the newer level's); where none is,
-/// [`combine_other_texel`] around `at`.
+/// of another id on the pixel's ray (`base`, `depth`: the newer level's; not a t-instance
+/// covering by its silhouette, `data`); where none is, [`combine_other_texel`] around `at`.
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
 pub fn combine_behind_texel(
     older: &LodImage,
+    data: &[[u32; 4]],
     id: u32,
     at: Vec2,
     base: Vec4,
@@ -124,6 +134,6 @@ pub fn combine_behind_texel(
     new_to_old: &Mat4,
     motion: Vec2,
 ) -> UVec2 {
-    combine_ray_texel(older, id, false, base, depth, new_to_old, motion)
+    combine_ray_texel(older, data, id, false, base, depth, new_to_old, motion)
         .unwrap_or_else(|| combine_other_texel(older, id, combine_texel(at, size_of(older)), at))
 }

@@ -21,10 +21,13 @@
 //   lodkit_combine_object(id) -> lodkit_CombineObject   the record of id (unknown past the records)
 //   lodkit_combine_new_to_old(id) -> mat4   the matrix reprojecting a pixel holding id
 //   lodkit_combine_far_depth() -> float   the far clip depth (an older-level depth pass's clear)
+//   lodkit_combine_by_silhouette(id) -> bool   whether id is a t-instance whose older level's
+//       coverage is its silhouette
 //   LODKIT_COMBINE_RAY_STEPS, LODKIT_COMBINE_RAY_REACH   how far and how close to the ray
 //       lodkit_combine_ray_texel looks
 //   lodkit_combine_ray_texel(id, owned, base, depth, new_to_old, motion) -> uvec3   the older
-//       texel on the pixel's ray holding id (owned) or another id; z: found
+//       texel on the pixel's ray holding id (owned) or another id that is no t-instance covering
+//       by its silhouette; z: found
 //   lodkit_combine_read_known(owner, uv, depth, new_to_old, motion) -> lodkit_CombineRead   the
 //       read of owner's older level where its coverage is known; not found where none is held
 //   lodkit_combine_behind_texel(id, at, base, depth, new_to_old, motion) -> uvec2   what lies
@@ -140,6 +143,15 @@ float lodkit_combine_far_depth() {
 #endif
 }
 
+/// Whether `id` is a t-instance whose older level's coverage is its silhouette (its record is
+/// known and routed by the silhouette).
+bool lodkit_combine_by_silhouette(uint id) {
+    // The record's flags alone (lodkit_combine_object's, without its matrix and table).
+    uint wanted = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_SILHOUETTE;
+    bool known = id != 0u && id < lodkit_silhouette_texel(5u).z;
+    return known && (lodkit_silhouette_texel(id * LODKIT_COMBINE_RECORD + 5u).x & wanted) == wanted;
+}
+
 /// Texels lodkit_combine_ray_texel steps along the pixel's ray, each way.
 const uint LODKIT_COMBINE_RAY_STEPS = 6u;
 /// How far (texels, the larger axis) an older sample may lie from the pixel's ray for
@@ -147,10 +159,12 @@ const uint LODKIT_COMBINE_RAY_STEPS = 6u;
 const float LODKIT_COMBINE_RAY_REACH = 0.75;
 
 /// The older texel on the pixel's ray (`base` = lodkit_reproject_base under `new_to_old`, moved
-/// by `motion`) that holds `id` (`owned`) or any other id (`!owned`): stepping a texel at a time
-/// along the ray's image in the older buffer from the reprojection of `depth`, both ways, nearest
-/// first, up to LODKIT_COMBINE_RAY_STEPS; the first whose older sample, refined at its own depth,
-/// lies within LODKIT_COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is.
+/// by `motion`) that holds `id` (`owned`) or any other id (`!owned`) but a t-instance whose
+/// record gives its silhouette as its coverage (such a level shows at the pixel only where its
+/// silhouette covers it, and lodkit_combine_read_silhouettes reads those): stepping a texel at a
+/// time along the ray's image in the older buffer from the reprojection of `depth`, both ways,
+/// nearest first, up to LODKIT_COMBINE_RAY_STEPS; the first whose older sample, refined at its
+/// own depth, lies within LODKIT_COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is.
 uvec3 lodkit_combine_ray_texel(uint id, bool owned, vec4 base, float depth, mat4 new_to_old, vec2 motion) {
     uvec2 size = lodkit_combine_fetch_size();
     vec2 texels = vec2(size);
@@ -167,7 +181,8 @@ uvec3 lodkit_combine_ray_texel(uint id, bool owned, vec4 base, float depth, mat4
             continue;
         }
         uvec2 t = lodkit_combine_texel(at, size);
-        if ((lodkit_lod_buffer_id(lodkit_combine_fetch_word(t)) == id) != owned) {
+        uint held = lodkit_lod_buffer_id(lodkit_combine_fetch_word(t));
+        if ((held == id) != owned || (!owned && lodkit_combine_by_silhouette(held))) {
             continue;
         }
         vec2 ray = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(t), new_to_old).xy + motion;
@@ -199,7 +214,8 @@ lodkit_CombineRead lodkit_combine_read_known(uint owner, vec2 uv, float depth, m
 
 /// The older texel showing what lies behind `id`'s older level at the pixel, where that level is
 /// known not to cover it: lodkit_combine_ray_texel's texel of another id on the pixel's ray
-/// (`base`, `depth`: the newer level's); none: lodkit_combine_other_texel around `at`.
+/// (`base`, `depth`: the newer level's; not a t-instance covering by its silhouette); none:
+/// lodkit_combine_other_texel around `at`.
 uvec2 lodkit_combine_behind_texel(uint id, vec2 at, vec4 base, float depth, mat4 new_to_old, vec2 motion) {
     uvec3 hit = lodkit_combine_ray_texel(id, false, base, depth, new_to_old, motion);
     if (hit.z == 1u) {
@@ -372,8 +388,10 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
 /// (estimated without one; with its silhouette, the texel in front where lodkit_combine_hider
-/// finds another object there that lodkit_combine_may_cover); else the depth pass's level, a
-/// covering silhouette, the estimate.
+/// finds another object there that lodkit_combine_may_cover, and where the silhouette does not
+/// cover the pixel, what lies behind the level: another level whose silhouette covers it, else
+/// lodkit_combine_behind_texel); else the depth pass's level, a covering silhouette, the
+/// estimate.
 lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, vec4 base, vec3 old, mat4 m) {
     uvec2 size = lodkit_combine_fetch_size();
     uint id = lodkit_lod_buffer_id(newer.word);
@@ -382,36 +400,42 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
     lodkit_CombineObject object = lodkit_combine_object(id);
     uint silhouette = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_SILHOUETTE;
     uint depth_pass = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_DEPTH_PASS;
+    vec2 at = old.xy + newer.motion;
     if (id != 0u) {
-        if ((object.flags & silhouette) == silhouette) {
-            int own = lodkit_silhouette_covers(object.silhouette, p);
-            if (own == LODKIT_SILHOUETTE_ON) {
-                own = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(old.xy + newer.motion, size))) == id ? 1 : 0;
+        if ((object.flags & silhouette) != silhouette) {
+            if ((object.flags & depth_pass) == depth_pass) {
+                return lodkit_combine_read_level_depth(newer.level_depth, id, uv, newer.depth, old, newer.motion);
             }
-            vec2 at = old.xy + newer.motion;
-            if (own == 1) {
-                uint front = lodkit_combine_hider(id, at, old.z);
-                if (front != 0u && lodkit_combine_may_cover(front, p)) {
-                    uvec2 held = lodkit_combine_texel(at, size);
-                    return lodkit_CombineRead(held, lodkit_combine_fetch_color(held), true);
-                }
-                return lodkit_combine_read_known(id, uv, newer.depth, m, newer.motion);
+            return lodkit_combine_read_own(id, uv, newer.depth, m, newer.motion, LODKIT_COMBINE_COVER_REACH);
+        }
+        int own = lodkit_silhouette_covers(object.silhouette, p);
+        if (own == LODKIT_SILHOUETTE_ON) {
+            own = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(at, size))) == id ? 1 : 0;
+        }
+        if (own == 1) {
+            uint front = lodkit_combine_hider(id, at, old.z);
+            if (front != 0u && lodkit_combine_may_cover(front, p)) {
+                uvec2 held = lodkit_combine_texel(at, size);
+                return lodkit_CombineRead(held, lodkit_combine_fetch_color(held), true);
             }
-            uvec2 texel = lodkit_combine_behind_texel(id, at, base, newer.depth, m, newer.motion);
-            return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
+            return lodkit_combine_read_known(id, uv, newer.depth, m, newer.motion);
         }
-        if ((object.flags & depth_pass) == depth_pass) {
-            return lodkit_combine_read_level_depth(newer.level_depth, id, uv, newer.depth, old, newer.motion);
+        // Its older level does not cover the pixel: what lies behind it, read below.
+    } else {
+        lodkit_CombineObject frame = lodkit_combine_object(0u);
+        if ((frame.flags & LODKIT_COMBINE_LEVEL_DEPTH) != 0u && lodkit_depth_closer(newer.level_depth, lodkit_combine_far_depth())) {
+            return lodkit_combine_read_level_depth(newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
         }
-        return lodkit_combine_read_own(id, uv, newer.depth, m, newer.motion, LODKIT_COMBINE_COVER_REACH);
     }
-    lodkit_CombineObject frame = lodkit_combine_object(0u);
-    if ((frame.flags & LODKIT_COMBINE_LEVEL_DEPTH) != 0u && lodkit_depth_closer(newer.level_depth, lodkit_combine_far_depth())) {
-        return lodkit_combine_read_level_depth(newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
-    }
+    // Another t-instance's older level whose silhouette covers the pixel; else, behind a level,
+    // what the ray finds, and for a pixel showing no t-instance the estimate.
     lodkit_CombineRead r = lodkit_combine_read_silhouettes(uv, newer.depth, p);
     if (r.found) {
         return r;
+    }
+    if (id != 0u) {
+        uvec2 texel = lodkit_combine_behind_texel(id, at, base, newer.depth, m, newer.motion);
+        return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
     }
     return lodkit_combine_read_estimated(uv, newer.depth, base, old, m, newer.motion);
 }

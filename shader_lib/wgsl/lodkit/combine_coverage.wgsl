@@ -21,15 +21,17 @@
 //   combine_object(data, id) -> CombineObject   the record of id (unknown past the records)
 //   combine_new_to_old(data, id) -> mat4x4<f32>   the matrix reprojecting a pixel holding id
 //   combine_far_depth() -> f32   the far clip depth (an older-level depth pass's clear)
+//   combine_by_silhouette(data, id) -> bool   whether id is a t-instance whose older level's
+//       coverage is its silhouette
 //   COMBINE_RAY_STEPS, COMBINE_RAY_REACH   how far and how close to the ray combine_ray_texel
 //       looks
-//   combine_ray_texel(older_id, older_depth, id, owned, base, depth, new_to_old, motion)
-//       -> vec3<u32>   the older texel on the pixel's ray holding id (owned) or another id; z:
-//       found
-//   combine_read_known(older_color, older_id, older_depth, owner, uv, depth, new_to_old, motion)
-//       -> CombineRead   the read of owner's older level where its coverage is known; not
-//       found where none is held
-//   combine_behind_texel(older_id, older_depth, id, at, base, depth, new_to_old, motion)
+//   combine_ray_texel(older_id, older_depth, data, id, owned, base, depth, new_to_old, motion)
+//       -> vec3<u32>   the older texel on the pixel's ray holding id (owned) or another id that
+//       is no t-instance covering by its silhouette; z: found
+//   combine_read_known(older_color, older_id, older_depth, data, owner, uv, depth, new_to_old,
+//       motion) -> CombineRead   the read of owner's older level where its coverage is known;
+//       not found where none is held
+//   combine_behind_texel(older_id, older_depth, data, id, at, base, depth, new_to_old, motion)
 //       -> vec2<u32>   what lies behind id's older level, on the ray
 //   combine_read_estimated(older_color, older_id, older_depth, data, uv, depth, base, old,
 //       new_to_old, motion) -> CombineRead   a pixel showing no known t-instance, estimated
@@ -142,6 +144,15 @@ fn combine_far_depth() -> f32 {
 #endif
 }
 
+/// Whether `id` is a t-instance whose older level's coverage is its silhouette (its record in
+/// `data` is known and routed by the silhouette).
+fn combine_by_silhouette(data: texture_2d<u32>, id: u32) -> bool {
+    // The record's flags alone (combine_object's, without its matrix and table).
+    let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
+    let known = id != 0u && id < silhouette_texel(data, 5u).z;
+    return known && (silhouette_texel(data, id * COMBINE_RECORD + 5u).x & wanted) == wanted;
+}
+
 /// Texels combine_ray_texel steps along the pixel's ray, each way.
 const COMBINE_RAY_STEPS: u32 = 6u;
 /// How far (texels, the larger axis) an older sample may lie from the pixel's ray for
@@ -149,11 +160,13 @@ const COMBINE_RAY_STEPS: u32 = 6u;
 const COMBINE_RAY_REACH: f32 = 0.75;
 
 /// The older texel on the pixel's ray (`base` = reproject_base under `new_to_old`, moved by
-/// `motion`) that holds `id` (`owned`) or any other id (`!owned`): stepping a texel at a time
+/// `motion`) that holds `id` (`owned`) or any other id (`!owned`) but a t-instance whose record
+/// in `data` gives its silhouette as its coverage (such a level shows at the pixel only where its
+/// silhouette covers it, and combine_read_silhouettes reads those): stepping a texel at a time
 /// along the ray's image in the older buffer from the reprojection of `depth`, both ways, nearest
 /// first, up to COMBINE_RAY_STEPS; the first whose older sample, refined at its own depth, lies
 /// within COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is.
-fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, id: u32, owned: bool, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec3<u32> {
+fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, id: u32, owned: bool, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec3<u32> {
     let size = textureDimensions(older_id, 0);
     let texels = vec2<f32>(size);
     let a = reproject_from_base(base, depth, new_to_old).xy + motion;
@@ -169,7 +182,8 @@ fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, id
             continue;
         }
         let t = combine_texel(at, size);
-        if ((lod_buffer_id(textureLoad(older_id, t, 0).x) == id) != owned) {
+        let held = lod_buffer_id(textureLoad(older_id, t, 0).x);
+        if ((held == id) != owned || (!owned && combine_by_silhouette(data, held))) {
             continue;
         }
         let ray = reproject_refine(base, depth, textureLoad(older_depth, t, 0).x, new_to_old).xy + motion;
@@ -184,13 +198,13 @@ fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, id
 /// combine_read_own within the 3x3 block; where that finds no texel of `owner`, the one
 /// combine_ray_texel finds on the pixel's ray; none: not found (the older buffer does not hold
 /// that part of the level, and another object's texel would show through it).
-fn combine_read_known(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, owner: u32, uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> CombineRead {
+fn combine_read_known(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, owner: u32, uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> CombineRead {
     let read = combine_read_own(older_color, older_id, older_depth, owner, uv, depth, new_to_old, motion, COMBINE_BLOCK_REACH);
     if (lod_buffer_id(textureLoad(older_id, read.texel, 0).x) == owner) {
         return read;
     }
     let base = reproject_base(uv, new_to_old);
-    let hit = combine_ray_texel(older_id, older_depth, owner, true, base, depth, new_to_old, motion);
+    let hit = combine_ray_texel(older_id, older_depth, data, owner, true, base, depth, new_to_old, motion);
     if (hit.z == 0u) {
         return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
     }
@@ -201,9 +215,10 @@ fn combine_read_known(older_color: texture_2d<f32>, older_id: texture_2d<u32>, o
 
 /// The older texel showing what lies behind `id`'s older level at the pixel, where that level is
 /// known not to cover it: combine_ray_texel's texel of another id on the pixel's ray (`base`,
-/// `depth`: the newer level's); none: combine_other_texel around `at`.
-fn combine_behind_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, id: u32, at: vec2<f32>, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec2<u32> {
-    let hit = combine_ray_texel(older_id, older_depth, id, false, base, depth, new_to_old, motion);
+/// `depth`: the newer level's; not a t-instance covering by its silhouette, `data`); none:
+/// combine_other_texel around `at`.
+fn combine_behind_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, id: u32, at: vec2<f32>, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec2<u32> {
+    let hit = combine_ray_texel(older_id, older_depth, data, id, false, base, depth, new_to_old, motion);
     if (hit.z == 1u) {
         return hit.xy;
     }
@@ -360,7 +375,7 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
         if (front != 0u && combine_known_covers(data, front, p)) {
             continue;
         }
-        let read = combine_read_known(older_color, older_id, older_depth, g, uv, depth, m, vec2<f32>(0.0));
+        let read = combine_read_known(older_color, older_id, older_depth, data, g, uv, depth, m, vec2<f32>(0.0));
         if (read.found) {
             return read;
         }
@@ -370,44 +385,51 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
 /// (estimated without one; with its silhouette, the texel in front where combine_hider finds
-/// another object there that combine_may_cover); else the depth pass's level, a covering
-/// silhouette, the estimate.
+/// another object there that combine_may_cover, and where the silhouette does not cover the
+/// pixel, what lies behind the level: another level whose silhouette covers it, else
+/// combine_behind_texel); else the depth pass's level, a covering silhouette, the estimate.
 fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, newer: CombineNewer, pixel: vec2<u32>, base: vec4<f32>, old: vec3<f32>, m: mat4x4<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     let id = lod_buffer_id(newer.word);
     let uv = combine_uv(pixel, size);
     let p = vec2<f32>(pixel) + 0.5;
     let object = combine_object(data, id);
+    let at = old.xy + newer.motion;
     if (id != 0u) {
-        if ((object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)) == (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)) {
-            var own = silhouette_covers(data, object.silhouette, p);
-            if (own == SILHOUETTE_ON) {
-                own = select(0, 1, lod_buffer_id(textureLoad(older_id, combine_texel(old.xy + newer.motion, size), 0).x) == id);
+        if ((object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)) != (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)) {
+            if ((object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) == (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) {
+                return combine_read_level_depth(older_color, older_id, older_depth, data, newer.level_depth, id, uv, newer.depth, old, newer.motion);
             }
-            let at = old.xy + newer.motion;
-            if (own == 1) {
-                let front = combine_hider(older_id, older_depth, id, at, old.z);
-                if (front != 0u && combine_may_cover(data, front, p)) {
-                    let held = combine_texel(at, size);
-                    return CombineRead(held, textureLoad(older_color, held, 0), true);
-                }
-                return combine_read_known(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion);
+            return combine_read_own(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion, COMBINE_COVER_REACH);
+        }
+        var own = silhouette_covers(data, object.silhouette, p);
+        if (own == SILHOUETTE_ON) {
+            own = select(0, 1, lod_buffer_id(textureLoad(older_id, combine_texel(at, size), 0).x) == id);
+        }
+        if (own == 1) {
+            let front = combine_hider(older_id, older_depth, id, at, old.z);
+            if (front != 0u && combine_may_cover(data, front, p)) {
+                let held = combine_texel(at, size);
+                return CombineRead(held, textureLoad(older_color, held, 0), true);
             }
-            let texel = combine_behind_texel(older_id, older_depth, id, at, base, newer.depth, m, newer.motion);
-            return CombineRead(texel, textureLoad(older_color, texel, 0), true);
+            return combine_read_known(older_color, older_id, older_depth, data, id, uv, newer.depth, m, newer.motion);
         }
-        if ((object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) == (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)) {
-            return combine_read_level_depth(older_color, older_id, older_depth, data, newer.level_depth, id, uv, newer.depth, old, newer.motion);
+        // Its older level does not cover the pixel: what lies behind it, read below.
+    } else {
+        let frame = combine_object(data, 0u);
+        if ((frame.flags & COMBINE_LEVEL_DEPTH) != 0u && depth_closer(newer.level_depth, combine_far_depth())) {
+            return combine_read_level_depth(older_color, older_id, older_depth, data, newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
         }
-        return combine_read_own(older_color, older_id, older_depth, id, uv, newer.depth, m, newer.motion, COMBINE_COVER_REACH);
     }
-    let frame = combine_object(data, 0u);
-    if ((frame.flags & COMBINE_LEVEL_DEPTH) != 0u && depth_closer(newer.level_depth, combine_far_depth())) {
-        return combine_read_level_depth(older_color, older_id, older_depth, data, newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
-    }
+    // Another t-instance's older level whose silhouette covers the pixel; else, behind a level,
+    // what the ray finds, and for a pixel showing no t-instance the estimate.
     let r = combine_read_silhouettes(older_color, older_id, older_depth, data, uv, newer.depth, p);
     if (r.found) {
         return r;
+    }
+    if (id != 0u) {
+        let texel = combine_behind_texel(older_id, older_depth, data, id, at, base, newer.depth, m, newer.motion);
+        return CombineRead(texel, textureLoad(older_color, texel, 0), true);
     }
     return combine_read_estimated(older_color, older_id, older_depth, data, uv, newer.depth, base, old, m, newer.motion);
 }
