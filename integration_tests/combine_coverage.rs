@@ -52,7 +52,7 @@ const STILL: u32 = 9;
 /// A t-instance that did not move (its matrix the identity) on older texels 1..=2 x 9..=10,
 /// whose silhouette's left edge passes through the centers of pixel column 1; its level drawn
 /// now, not shown at this frame, covers pixel (3, 8), inside the silhouette t-instance's older
-/// silhouette and outside its own.
+/// silhouette and outside its own, and pixel (12, 9), inside none.
 const TIE: u32 = 11;
 
 /// The scene: older and newer LOD buffers, the newer words, the screen pattern per pixel.
@@ -102,7 +102,7 @@ fn scene() -> Scene {
     // Newer: the silhouette t-instance on 4..=8 x 3..=8 (the level drawn this frame is smaller),
     // the estimated one on 10..=14 x 2..=5 (larger).
     let newer_id = |x: u32, y: u32| {
-        if (x, y) == (3, 8) {
+        if (x, y) == (3, 8) || (x, y) == (12, 9) {
             TIE
         } else if (4..=8).contains(&x) && SIL_Y.contains(&y) {
             SIL
@@ -135,8 +135,9 @@ fn scene() -> Scene {
     // within COMBINE_HIDDEN_MARGIN (0.01 of 1 - 0.95: 0.0005).
     older.depths[at(5, 8)] = 0.9498;
     let mut newer = image(&newer_id, 3);
-    // TIE's level drawn now is not shown at (3, 8) this frame (flag: shown next only).
+    // TIE's level drawn now is not shown at (3, 8) and (12, 9) this frame (flag: shown next only).
     newer.flags[at(3, 8)] = 2;
+    newer.flags[at(12, 9)] = 2;
     let mut pattern: Vec<f32> = noise[6 * n..7 * n].to_vec();
     // Where the silhouette test and the touching texel are checked, the older level is
     // displayed (pattern <= tau 0.5).

@@ -136,6 +136,16 @@ pub(super) fn check_known(out: &[u32], s: &Scene, who: &str) {
         older(3, 8)
     );
     shows(3, 8, older(4, 8), what);
+    // Behind it where no older silhouette covers the pixel: pixel (12, 9), TIE's level drawn now
+    // and not shown, outside every silhouette. What lies behind is read on TIE's ray (its matrix
+    // the identity): the background texel (12, 9), shown as last frame had it, not the level
+    // drawn now.
+    let what = format!(
+        "the background texel behind TIE's level, {} (TIE's newer color: {})",
+        older(12, 9),
+        s.newer.colors[at(12, 9)]
+    );
+    shows(12, 9, older(12, 9), what);
     // combine_hider, for the silhouette t-instance at each pixel's read: FRONT at (6, 7) and STILL
     // at (7, 4) (0.05 in front, clearly closer), none at (5, 8) (FRONT within the margin) nor at
     // (3, 5) (the background).

@@ -3,9 +3,10 @@
 //! twins, on a hand-made older buffer seen from a camera whose motion moves each depth by another
 //! amount (parallax): the texel a read wants lies several texels along the ray's image from where
 //! the newer depth reprojects, out of reach of the 3x3 block. A pixel that shows no t-instance
-//! reads a level whose silhouette covers it the same way (`combine_read_silhouettes`). What lies
-//! behind a level is never another t-instance's level known by its silhouette: that one shows at
-//! the pixel only where its silhouette covers it, which `combine_read_silhouettes` reads.
+//! reads a level whose silhouette covers it the same way (`combine_read_silhouettes`). The ray
+//! search for what lies behind a level passes over levels known by their silhouettes: such a
+//! level shows at the pixel only where its silhouette covers it, which `combine_read_silhouettes`
+//! reads.
 
 use glam::{Mat4, UVec2, Vec2, Vec4};
 use lodkit::combine::{DepthConvention, LodImage, combine_uv};

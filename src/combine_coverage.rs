@@ -332,11 +332,13 @@ pub fn combine_may_cover(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
     o.flags & COMBINE_ROUTE_SILHOUETTE == 0 || silhouette_covers(data, o.silhouette, p) != 0
 }
 
-/// For a pixel that shows no t-instance: the older read ([`combine_read_known`]) of the first
-/// t-instance whose older level's silhouette covers the pixel center `p` (pixels), that no other
-/// t-instance whose silhouette covers it too hides there ([`combine_hider`],
+/// For a pixel that shows no t-instance, or behind a t-instance's level drawn now whose older
+/// silhouette does not cover it (`depth` that level's): the older read ([`combine_read_known`])
+/// of the first t-instance whose older level's silhouette covers the pixel center `p` (pixels),
+/// that no other t-instance whose silhouette covers it too hides there ([`combine_hider`],
 /// [`combine_known_covers`]), and whose older level the read finds, read with that t-instance's
-/// own matrix and no motion (such a pixel has none of its own); not found where none does. A
+/// own matrix and no motion (the pixel's own motion, if any, is that of what it shows, not of
+/// the level behind it); not found where none does. A
 /// center on a silhouette ([`SILHOUETTE_ON`]) is covered only where last frame's picture sampled this very point (its
 /// reprojection within [`COMBINE_SNAP`] of an older texel's center: camera and object still)
 /// and holds the level there; elsewhere the rasterizer may break the tie either way, and the

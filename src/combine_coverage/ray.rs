@@ -31,7 +31,7 @@ pub const COMBINE_RAY_REACH: f32 = 0.75;
 /// `combine_ray_texel`: stepping a texel at a time along the ray's image in the older buffer from
 /// the reprojection of `depth`, both ways, nearest first, up to [`COMBINE_RAY_STEPS`]; the first
 /// whose older sample, refined at its own depth, lies within [`COMBINE_RAY_REACH`] of it. None
-/// where no such texel is.
+/// where no such texel is. (`data` is read only where `!owned`.)
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
@@ -82,8 +82,8 @@ pub fn combine_ray_texel(
 
 /// The read of `owner`'s older level where its coverage is known to include the pixel, Rust
 /// twin of `combine_read_known`: [`combine_read_own`] within the 3x3 block; where that finds no
-/// texel of `owner`, the one [`combine_ray_texel`] finds on the pixel's ray; not found where
-/// none is (the older buffer does not hold that part of the level, and another object's texel
+/// texel of `owner`, the one [`combine_ray_texel`] finds on the pixel's ray (`data` passed on
+/// to it); not found where none is (the older buffer does not hold that part of the level, and another object's texel
 /// would show through it).
 pub fn combine_read_known(
     older: &LodImage,
@@ -120,7 +120,8 @@ pub fn combine_read_known(
 /// The older texel showing what lies behind `id`'s older level at the pixel, where that level
 /// is known not to cover it, Rust twin of `combine_behind_texel`: [`combine_ray_texel`]'s texel
 /// of another id on the pixel's ray (`base`, `depth`: the newer level's; not a t-instance
-/// covering by its silhouette, `data`); where none is, [`combine_other_texel`] around `at`.
+/// covering by its silhouette, `data`); where none is, [`combine_other_texel`] around `at`
+/// (which may be such a level's texel).
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]

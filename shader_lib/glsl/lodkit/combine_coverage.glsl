@@ -46,7 +46,9 @@
 //       covers the pixel center p
 //   lodkit_combine_may_cover(id, p) -> bool   whether id is a t-instance whose older level may
 //       cover the pixel center p (coverage not its silhouette, or its silhouette covers p)
-//   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   the routes' reads
+//   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   a level whose
+//       silhouette covers the pixel (one showing no t-instance, or what lies behind a level that
+//       does not cover it)
 //   lodkit_combine_read(newer, pixel, base, old, m) -> lodkit_CombineRead   by the route of what
 //       the pixel shows
 //   LODKIT_COMBINE_EDGE_REACH   how far outside the older view a reprojection is read at its edge
@@ -215,7 +217,7 @@ lodkit_CombineRead lodkit_combine_read_known(uint owner, vec2 uv, float depth, m
 /// The older texel showing what lies behind `id`'s older level at the pixel, where that level is
 /// known not to cover it: lodkit_combine_ray_texel's texel of another id on the pixel's ray
 /// (`base`, `depth`: the newer level's; not a t-instance covering by its silhouette); none:
-/// lodkit_combine_other_texel around `at`.
+/// lodkit_combine_other_texel around `at` (which may be such a level's texel).
 uvec2 lodkit_combine_behind_texel(uint id, vec2 at, vec4 base, float depth, mat4 new_to_old, vec2 motion) {
     uvec3 hit = lodkit_combine_ray_texel(id, false, base, depth, new_to_old, motion);
     if (hit.z == 1u) {
@@ -344,11 +346,12 @@ bool lodkit_combine_may_cover(uint id, vec2 p) {
     return (o.flags & LODKIT_COMBINE_ROUTE_SILHOUETTE) == 0u || lodkit_silhouette_covers(o.silhouette, p) != 0;
 }
 
-/// For a pixel showing no t-instance: the read (lodkit_combine_read_known) of the first
-/// t-instance whose older silhouette covers the pixel center `p` (on its outline, only where last
-/// frame's picture sampled this very point, within LODKIT_COMBINE_SNAP of an older texel's
-/// center, and holds the level there: elsewhere the rasterizer may break the tie either way, and
-/// a level taken where it would not draw it is a ghost), is not hidden there by another
+/// For a pixel showing no t-instance, or behind a t-instance's level drawn now whose older
+/// silhouette does not cover it (`depth` that level's): the read (lodkit_combine_read_known) of
+/// the first t-instance whose older silhouette covers the pixel center `p` (on its outline, only
+/// where last frame's picture sampled this very point, within LODKIT_COMBINE_SNAP of an older
+/// texel's center, and holds the level there: elsewhere the rasterizer may break the tie either
+/// way, and a level taken where it would not draw it is a ghost), is not hidden there by another
 /// t-instance whose silhouette covers it too (lodkit_combine_hider, lodkit_combine_known_covers),
 /// and whose older level the read finds; none: not found.
 lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p) {

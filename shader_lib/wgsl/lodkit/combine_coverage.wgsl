@@ -51,7 +51,8 @@
 //   combine_may_cover(data, id, p) -> bool   whether id is a t-instance whose older level may
 //       cover the pixel center p (coverage not its silhouette, or its silhouette covers p)
 //   combine_read_silhouettes(older_color, older_id, older_depth, data, uv, depth, p)
-//       -> CombineRead   a pixel showing no t-instance, covered by a level's silhouette
+//       -> CombineRead   a level whose silhouette covers the pixel (one showing no t-instance,
+//       or what lies behind a level that does not cover it)
 //   combine_read(older_color, older_id, older_depth, data, newer, pixel, base, old, m)
 //       -> CombineRead   by the route of what the pixel shows
 //   COMBINE_EDGE_REACH   how far outside the older view a reprojection is read at its edge
@@ -165,7 +166,8 @@ const COMBINE_RAY_REACH: f32 = 0.75;
 /// silhouette covers it, and combine_read_silhouettes reads those): stepping a texel at a time
 /// along the ray's image in the older buffer from the reprojection of `depth`, both ways, nearest
 /// first, up to COMBINE_RAY_STEPS; the first whose older sample, refined at its own depth, lies
-/// within COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is.
+/// within COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is. (`data` is read only
+/// where `!owned`.)
 fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, id: u32, owned: bool, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec3<u32> {
     let size = textureDimensions(older_id, 0);
     let texels = vec2<f32>(size);
@@ -196,8 +198,9 @@ fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, da
 
 /// The read of `owner`'s older level where its coverage is known to include the pixel:
 /// combine_read_own within the 3x3 block; where that finds no texel of `owner`, the one
-/// combine_ray_texel finds on the pixel's ray; none: not found (the older buffer does not hold
-/// that part of the level, and another object's texel would show through it).
+/// combine_ray_texel finds on the pixel's ray (`data` passed on to it); none: not found (the
+/// older buffer does not hold that part of the level, and another object's texel would show
+/// through it).
 fn combine_read_known(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, owner: u32, uv: vec2<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> CombineRead {
     let read = combine_read_own(older_color, older_id, older_depth, owner, uv, depth, new_to_old, motion, COMBINE_BLOCK_REACH);
     if (lod_buffer_id(textureLoad(older_id, read.texel, 0).x) == owner) {
@@ -216,7 +219,7 @@ fn combine_read_known(older_color: texture_2d<f32>, older_id: texture_2d<u32>, o
 /// The older texel showing what lies behind `id`'s older level at the pixel, where that level is
 /// known not to cover it: combine_ray_texel's texel of another id on the pixel's ray (`base`,
 /// `depth`: the newer level's; not a t-instance covering by its silhouette, `data`); none:
-/// combine_other_texel around `at`.
+/// combine_other_texel around `at` (which may be such a level's texel).
 fn combine_behind_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, id: u32, at: vec2<f32>, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec2<u32> {
     let hit = combine_ray_texel(older_id, older_depth, data, id, false, base, depth, new_to_old, motion);
     if (hit.z == 1u) {
@@ -341,13 +344,14 @@ fn combine_may_cover(data: texture_2d<u32>, id: u32, p: vec2<f32>) -> bool {
     return (o.flags & COMBINE_ROUTE_SILHOUETTE) == 0u || silhouette_covers(data, o.silhouette, p) != 0;
 }
 
-/// For a pixel showing no t-instance: the read (combine_read_known) of the first t-instance
-/// whose older silhouette covers the pixel center `p` (on its outline, only where last frame's
-/// picture sampled this very point, within COMBINE_SNAP of an older texel's center, and holds the
-/// level there: elsewhere the rasterizer may break the tie either way, and a level taken where it
-/// would not draw it is a ghost),
-/// is not hidden there by another t-instance whose silhouette covers it too (combine_hider,
-/// combine_known_covers), and whose older level the read finds; none: not found.
+/// For a pixel showing no t-instance, or behind a t-instance's level drawn now whose older
+/// silhouette does not cover it (`depth` that level's): the read (combine_read_known) of the
+/// first t-instance whose older silhouette covers the pixel center `p` (on its outline, only
+/// where last frame's picture sampled this very point, within COMBINE_SNAP of an older texel's
+/// center, and holds the level there: elsewhere the rasterizer may break the tie either way, and
+/// a level taken where it would not draw it is a ghost), is not hidden there by another
+/// t-instance whose silhouette covers it too (combine_hider, combine_known_covers), and whose
+/// older level the read finds; none: not found.
 fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, uv: vec2<f32>, depth: f32, p: vec2<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     let slots = silhouette_texel(data, 5u).z;
