@@ -99,7 +99,7 @@ fn data() -> CombineData {
 }
 
 /// The cases: pixel and newer depth.
-const CASES: [(u32, u32, f32); 5] = [
+const CASES: [(u32, u32, f32); 6] = [
     // Background at depth 0.9 shows; OWNER's older texels lie 6 texels along the ray.
     (4, 1, 0.9),
     // The same 8 texels along: past COMBINE_RAY_STEPS.
@@ -110,6 +110,9 @@ const CASES: [(u32, u32, f32); 5] = [
     (4, 1, 0.5),
     // Behind it the background at depth 1, 7.5 texels back: out of reach.
     (4, 2, 0.5),
+    // Depth 0.9 - 2/15 reprojects 2 texels right, onto texel 5's center; at OWNER's depth the ray
+    // lies on texel 9's center, 1 texel from OWNER's nearest texel (10).
+    (3, 1, 0.9 - 2.0 / 15.0),
 ];
 
 /// The Rust twins' words for each case.
@@ -207,6 +210,21 @@ fn check_known(out: &[u32], older: &LodImage, who: &str) {
         case(1)[14],
         0,
         "{who}: silhouette read at (2, 1) must not be found"
+    );
+    // (3, 1): no texel of OWNER within COMBINE_RAY_REACH (0.75) of the ray; texel 10 lies 1
+    // texel off it, within COMBINE_BLOCK_REACH (1.5), the nearest (texel 11: 2). OWNER covers
+    // the pixel, so its color is read there: texel 10's own, as the bilinear weights at texel
+    // 9's center fall on texel 9 alone, which does not hold OWNER.
+    assert_eq!(case(5)[7..10], [10, 1, 1], "{who}: ray texel at (3, 1)");
+    assert_eq!(case(5)[0..3], [10, 1, 1], "{who}: known read at (3, 1)");
+    assert!(
+        close(color(case(5)), texel(10, 1)),
+        "{who}: color at (3, 1)"
+    );
+    assert_eq!(
+        case(5)[12..15],
+        [10, 1, 1],
+        "{who}: silhouette read at (3, 1)"
     );
 }
 

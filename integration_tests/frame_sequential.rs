@@ -531,18 +531,20 @@ fn no_history_matrix_sends_every_pixel_to_the_newer_buffer() {
 }
 
 proptest! {
-    /// Whatever frame a transition begins on, its first frame draws the outgoing LOD whole and
-    /// the LODs alternate from there.
+    /// Whatever frame a transition begins on, its first frame draws the outgoing LOD whole (tau
+    /// 1 under Fig. 2's schedule, -1, the inverted pattern at threshold 1, under the
+    /// complementary one) and the LODs alternate from there.
     #[test]
-    fn transitions_alternate_with_their_own_phase(start in 0u64..9, frames in 1usize..12) {
-        let mut s = TransitionScheduler::new();
+    fn transitions_alternate_with_their_own_phase(start in 0u64..9, frames in 1usize..12, paper: bool) {
+        let (schedule, whole) = if paper { (Schedule::Paper, 1.0) } else { (Schedule::Complementary, -1.0) };
+        let mut s = TransitionScheduler::with_schedule(schedule);
         let key = s.insert(0);
         for _ in 0..start {
             s.advance(1.0 / 60.0);
         }
         s.begin_transition(key, 1, Drive::Time { seconds: 10.0 }).unwrap();
         let first = s.draw(key).unwrap();
-        prop_assert!(!first.incoming && first.lod == 0 && first.tau == 1.0, "{first:?}");
+        prop_assert!(!first.incoming && first.lod == 0 && first.tau == whole, "{first:?}");
         for k in 1..frames {
             s.advance(1.0 / 60.0);
             let d = s.draw(key).unwrap();

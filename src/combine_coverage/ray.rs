@@ -30,8 +30,11 @@ pub const COMBINE_RAY_REACH: f32 = 0.75;
 /// [`combine_read_silhouettes`](super::combine_read_silhouettes) reads those), Rust twin of
 /// `combine_ray_texel`: stepping a texel at a time along the ray's image in the older buffer from
 /// the reprojection of `depth`, both ways, nearest first, up to [`COMBINE_RAY_STEPS`]; the first
-/// whose older sample, refined at its own depth, lies within [`COMBINE_RAY_REACH`] of it. None
-/// where no such texel is. (`data` is read only where `!owned`.)
+/// whose older sample, refined at its own depth, lies within [`COMBINE_RAY_REACH`] of it;
+/// `owned`, where none does, the nearest of the texels it visited, if within
+/// [`COMBINE_BLOCK_REACH`] (the level covers the pixel, so only its color is looked for: an
+/// object that moves by itself, read without its motion, can put its edge texels a little
+/// farther off). None where no such texel is. (`data` is read only where `!owned`.)
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
@@ -61,6 +64,7 @@ pub fn combine_ray_texel(
     } else {
         Vec2::ZERO
     } / texels;
+    let mut nearest: Option<(UVec2, f32)> = None;
     for k in 0..=2 * COMBINE_RAY_STEPS {
         let j = k.div_ceil(2) as f32 * if k & 1 == 1 { 1.0 } else { -1.0 };
         let at = a + j * stride;
@@ -73,11 +77,15 @@ pub fn combine_ray_texel(
             continue;
         }
         let ray = reproject_refine(base, depth, depth_at(older, t), new_to_old).truncate() + motion;
-        if combine_ray_offset(ray, t, size) < COMBINE_RAY_REACH {
+        let offset = combine_ray_offset(ray, t, size);
+        if offset < COMBINE_RAY_REACH {
             return Some(t);
         }
+        if owned && offset < nearest.map_or(COMBINE_BLOCK_REACH, |(_, o)| o) {
+            nearest = Some((t, offset));
+        }
     }
-    None
+    nearest.map(|(t, _)| t)
 }
 
 /// The read of `owner`'s older level where its coverage is known to include the pixel, Rust

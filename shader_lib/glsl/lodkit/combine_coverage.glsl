@@ -26,8 +26,9 @@
 //   LODKIT_COMBINE_RAY_STEPS, LODKIT_COMBINE_RAY_REACH   how far and how close to the ray
 //       lodkit_combine_ray_texel looks
 //   lodkit_combine_ray_texel(id, owned, base, depth, new_to_old, motion) -> uvec3   the older
-//       texel on the pixel's ray holding id (owned) or another id that is no t-instance covering
-//       by its silhouette; z: found
+//       texel on the pixel's ray holding id (owned; else the nearest within
+//       LODKIT_COMBINE_BLOCK_REACH) or another id that is no t-instance covering by its
+//       silhouette; z: found
 //   lodkit_combine_read_known(owner, uv, depth, new_to_old, motion) -> lodkit_CombineRead   the
 //       read of owner's older level where its coverage is known; not found where none is held
 //   lodkit_combine_behind_texel(id, at, base, depth, new_to_old, motion) -> uvec2   what lies
@@ -166,7 +167,9 @@ const float LODKIT_COMBINE_RAY_REACH = 0.75;
 /// silhouette covers it, and lodkit_combine_read_silhouettes reads those): stepping a texel at a
 /// time along the ray's image in the older buffer from the reprojection of `depth`, both ways,
 /// nearest first, up to LODKIT_COMBINE_RAY_STEPS; the first whose older sample, refined at its
-/// own depth, lies within LODKIT_COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is.
+/// own depth, lies within LODKIT_COMBINE_RAY_REACH of it; `owned`, where none does, the nearest
+/// of the texels it visited, if within LODKIT_COMBINE_BLOCK_REACH (the level covers the pixel,
+/// so only its color is looked for). z: 1 where found, 0 where none is.
 uvec3 lodkit_combine_ray_texel(uint id, bool owned, vec4 base, float depth, mat4 new_to_old, vec2 motion) {
     uvec2 size = lodkit_combine_fetch_size();
     vec2 texels = vec2(size);
@@ -176,6 +179,8 @@ uvec3 lodkit_combine_ray_texel(uint id, bool owned, vec4 base, float depth, mat4
     vec2 along = (lodkit_reproject_from_base(base, other, new_to_old).xy + motion - a) * texels;
     float length_texels = length(along);
     vec2 stride = (length_texels > 1.0e-3 ? along / max(length_texels, 1.0e-3) : vec2(0.0)) / texels;
+    uvec3 nearest = uvec3(0u);
+    float nearest_offset = LODKIT_COMBINE_BLOCK_REACH;
     for (uint k = 0u; k <= 2u * LODKIT_COMBINE_RAY_STEPS; k++) {
         float j = float((k + 1u) / 2u) * ((k & 1u) == 1u ? 1.0 : -1.0);
         vec2 at = a + j * stride;
@@ -188,11 +193,16 @@ uvec3 lodkit_combine_ray_texel(uint id, bool owned, vec4 base, float depth, mat4
             continue;
         }
         vec2 ray = lodkit_reproject_refine(base, depth, lodkit_combine_fetch_depth(t), new_to_old).xy + motion;
-        if (lodkit_combine_ray_offset(ray, t, size) < LODKIT_COMBINE_RAY_REACH) {
+        float offset = lodkit_combine_ray_offset(ray, t, size);
+        if (offset < LODKIT_COMBINE_RAY_REACH) {
             return uvec3(t, 1u);
         }
+        if (owned && offset < nearest_offset) {
+            nearest = uvec3(t, 1u);
+            nearest_offset = offset;
+        }
     }
-    return uvec3(0u);
+    return nearest;
 }
 
 /// The read of `owner`'s older level where its coverage is known to include the pixel:

@@ -26,8 +26,9 @@
 //   COMBINE_RAY_STEPS, COMBINE_RAY_REACH   how far and how close to the ray combine_ray_texel
 //       looks
 //   combine_ray_texel(older_id, older_depth, data, id, owned, base, depth, new_to_old, motion)
-//       -> vec3<u32>   the older texel on the pixel's ray holding id (owned) or another id that
-//       is no t-instance covering by its silhouette; z: found
+//       -> vec3<u32>   the older texel on the pixel's ray holding id (owned; else the nearest
+//       within COMBINE_BLOCK_REACH) or another id that is no t-instance covering by its
+//       silhouette; z: found
 //   combine_read_known(older_color, older_id, older_depth, data, owner, uv, depth, new_to_old,
 //       motion) -> CombineRead   the read of owner's older level where its coverage is known;
 //       not found where none is held
@@ -166,8 +167,11 @@ const COMBINE_RAY_REACH: f32 = 0.75;
 /// silhouette covers it, and combine_read_silhouettes reads those): stepping a texel at a time
 /// along the ray's image in the older buffer from the reprojection of `depth`, both ways, nearest
 /// first, up to COMBINE_RAY_STEPS; the first whose older sample, refined at its own depth, lies
-/// within COMBINE_RAY_REACH of it. z: 1 where found, 0 where none is. (`data` is read only
-/// where `!owned`.)
+/// within COMBINE_RAY_REACH of it. `owned`, where none does, the nearest of the texels it
+/// visited, if within COMBINE_BLOCK_REACH (the level covers the pixel, so only its color is
+/// looked for: an object that moves by itself, read without its motion, can put its edge texels
+/// a little farther off). z: 1 where found, 0 where none is. (`data` is read only where
+/// `!owned`.)
 fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, id: u32, owned: bool, base: vec4<f32>, depth: f32, new_to_old: mat4x4<f32>, motion: vec2<f32>) -> vec3<u32> {
     let size = textureDimensions(older_id, 0);
     let texels = vec2<f32>(size);
@@ -177,6 +181,8 @@ fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, da
     let along = (reproject_from_base(base, other, new_to_old).xy + motion - a) * texels;
     let length_texels = length(along);
     let stride = select(vec2<f32>(0.0), along / max(length_texels, 1.0e-3), length_texels > 1.0e-3) / texels;
+    var nearest = vec3<u32>(0u);
+    var nearest_offset = COMBINE_BLOCK_REACH;
     for (var k = 0u; k <= 2u * COMBINE_RAY_STEPS; k++) {
         let j = f32((k + 1u) / 2u) * select(-1.0, 1.0, (k & 1u) == 1u);
         let at = a + j * stride;
@@ -189,11 +195,16 @@ fn combine_ray_texel(older_id: texture_2d<u32>, older_depth: texture_2d<f32>, da
             continue;
         }
         let ray = reproject_refine(base, depth, textureLoad(older_depth, t, 0).x, new_to_old).xy + motion;
-        if (combine_ray_offset(ray, t, size) < COMBINE_RAY_REACH) {
+        let offset = combine_ray_offset(ray, t, size);
+        if (offset < COMBINE_RAY_REACH) {
             return vec3<u32>(t, 1u);
         }
+        if (owned && offset < nearest_offset) {
+            nearest = vec3<u32>(t, 1u);
+            nearest_offset = offset;
+        }
     }
-    return vec3<u32>(0u);
+    return nearest;
 }
 
 /// The read of `owner`'s older level where its coverage is known to include the pixel:

@@ -361,7 +361,11 @@ See-through is the share of the transitioning objects' interior (pixels both LOD
 the background contributes to the middle frame: the frame is rendered over black and over white \
 scenery and the pixels that differ are counted. Silhouette error is measured at the middle frame \
 of the moving camera: pixels both LODs cover that show the background, plus pixels neither \
-covers that show a transitioning object, as a share of the pixels either covers.\n";
+covers that show a transitioning object, as a share of the pixels either covers. \
+`frame-seq-compl-silhouettes` is frame-sequential LOD as docs/frame-sequential.md recommends it \
+where the levels are closed meshes (the complementary schedule, the pattern on the screen, each \
+level known by its silhouette); `frame-seq-silhouettes` the same with the default schedule, the \
+paper's Fig. 2.\n";
 
 /// Writes `benchmarks.md` and `quality.md` into `docs`.
 pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
