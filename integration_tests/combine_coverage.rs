@@ -23,7 +23,9 @@ use lodkit::lod_buffer::{lod_buffer_id, lod_buffer_word};
 use lodkit::reproject::{reproject, reproject_base};
 use lodkit::silhouette::{SILHOUETTE_ON, silhouette_covers};
 
-use crate::harness::{Probe, Word, assert_twin, floats, run_on, twin_runs, words};
+use crate::harness::{
+    COMBINE_COVERAGE_GLSL, Probe, Word, assert_twin, floats, run_on, twin_runs, words,
+};
 
 #[path = "combine_coverage_known.rs"]
 mod known;
@@ -466,16 +468,9 @@ fn combine_coverage_twins_match() {
         out_u(24u, (lodkit_combine_may_cover({SIL}u, p) ? 1u : 0u) | (lodkit_combine_may_cover({EST}u, p) ? 2u : 0u) | (lodkit_combine_may_cover({FRONT}u, p) ? 4u : 0u) | (lodkit_combine_may_cover({STILL}u, p) ? 8u : 0u) | (lodkit_combine_may_cover(0u, p) ? 16u : 0u));
         out_u(25u, lodkit_combine_hider({SIL}u, a, lodkit_reproject(uv, newer.depth, m).z));"
     );
-    // The GLSL twins read the textures through the hooks the includer defines.
-    let glsl_header = "#include \"lodkit/combine_coverage.glsl\"
-vec4 lodkit_combine_fetch_color(uvec2 t) { return texelFetch(sampler2D(probe_rgba0, probe_sampler), ivec2(t), 0); }
-uint lodkit_combine_fetch_word(uvec2 t) { return texelFetch(usampler2D(probe_urgba0, probe_sampler), ivec2(t), 0).x; }
-float lodkit_combine_fetch_depth(uvec2 t) { return texelFetch(sampler2D(probe_rgba1, probe_sampler), ivec2(t), 0).x; }
-uvec2 lodkit_combine_fetch_size() { return uvec2(textureSize(sampler2D(probe_rgba0, probe_sampler), 0)); }
-uvec4 lodkit_silhouette_fetch(uint i) {
-    uint w = uint(textureSize(usampler2D(probe_urgba1, probe_sampler), 0).x);
-    return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
-}";
+    // The GLSL twins read the textures through the hooks the includer defines
+    // (COMBINE_COVERAGE_GLSL).
+    let glsl_header = COMBINE_COVERAGE_GLSL;
     let wgsl_header = "#import lodkit::combine::{combine_uv, combine_texel, combine_read_own, combine_cover_texel, combine_other_texel, combine_ray_offset, combine_displayed_word, combine_snap, COMBINE_BLOCK_REACH, COMBINE_COVER_REACH}
 #import lodkit::combine_coverage::{CombineNewer, combine_pixel, combine_new_to_old, combine_object, combine_far_depth, combine_known_covers, combine_may_cover, combine_hider, combine_edge_uv}
 #import lodkit::reproject::{reproject, reproject_base}

@@ -107,6 +107,20 @@ pub struct Probe<'a> {
     pub urgba: &'a [(u32, u32, &'a [[u32; 4]])],
 }
 
+/// The GLSL header of a probe of `lodkit/combine_coverage.glsl`: the include and the hooks it
+/// reads its textures through, over the probe's textures (the older color `probe_rgba0`, the
+/// older depth `probe_rgba1`, the older id words `probe_urgba0`, the combine's data texture
+/// `probe_urgba1`).
+pub const COMBINE_COVERAGE_GLSL: &str = "#include \"lodkit/combine_coverage.glsl\"
+vec4 lodkit_combine_fetch_color(uvec2 t) { return texelFetch(sampler2D(probe_rgba0, probe_sampler), ivec2(t), 0); }
+uint lodkit_combine_fetch_word(uvec2 t) { return texelFetch(usampler2D(probe_urgba0, probe_sampler), ivec2(t), 0).x; }
+float lodkit_combine_fetch_depth(uvec2 t) { return texelFetch(sampler2D(probe_rgba1, probe_sampler), ivec2(t), 0).x; }
+uvec2 lodkit_combine_fetch_size() { return uvec2(textureSize(sampler2D(probe_rgba0, probe_sampler), 0)); }
+uvec4 lodkit_silhouette_fetch(uint i) {
+    uint w = uint(textureSize(usampler2D(probe_urgba1, probe_sampler), 0).x);
+    return texelFetch(usampler2D(probe_urgba1, probe_sampler), ivec2(int(i % w), int(i / w)), 0);
+}";
+
 /// The WGSL probe shader (naga_oil: the header `#import`s lodkit).
 pub fn wgsl_probe(p: &Probe) -> String {
     let mut texture = if p.texture.is_some() {

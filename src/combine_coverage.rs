@@ -392,7 +392,9 @@ pub fn combine_read_silhouettes(
 /// t-instance without a record; by its silhouette, the texel in front where [`combine_hider`]
 /// finds another object there that [`combine_may_cover`], and where the silhouette does not
 /// cover the pixel, what lies behind the level: another level whose silhouette covers it
-/// ([`combine_read_silhouettes`]), else [`combine_behind_texel`]); for a pixel showing none, a
+/// ([`combine_read_silhouettes`]), else [`combine_behind_texel`] under the camera's
+/// reprojection alone, the frame's matrix and no motion: what lies behind a level does not move
+/// with it); for a pixel showing none, a
 /// level the depth pass drew there, else a level whose silhouette covers it, else the estimate.
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
@@ -436,7 +438,21 @@ pub fn combine_read(
             if behind.found {
                 return behind;
             }
-            let texel = combine_behind_texel(older, data, id, read_at, base, depth, m, motion);
+            // What lies behind the level moves as the camera alone moves it: the matrix and
+            // motion of the pixel are the level's own.
+            let camera = combine_object(data, 0).new_to_old;
+            let behind = reproject_base(uv, &camera);
+            let behind_at = reproject_from_base(behind, depth, &camera).truncate();
+            let texel = combine_behind_texel(
+                older,
+                data,
+                id,
+                behind_at,
+                behind,
+                depth,
+                &camera,
+                Vec2::ZERO,
+            );
             return found(older, texel);
         }
         if object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS)

@@ -403,8 +403,9 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
 /// (estimated without one; with its silhouette, the texel in front where lodkit_combine_hider
 /// finds another object there that lodkit_combine_may_cover, and where the silhouette does not
 /// cover the pixel, what lies behind the level: another level whose silhouette covers it, else
-/// lodkit_combine_behind_texel); else the depth pass's level, a covering silhouette, the
-/// estimate.
+/// lodkit_combine_behind_texel under the camera's reprojection alone, the frame's matrix and no
+/// motion: what lies behind a level does not move with it); else the depth pass's level, a
+/// covering silhouette, the estimate.
 lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, vec4 base, vec3 old, mat4 m) {
     uvec2 size = lodkit_combine_fetch_size();
     uint id = lodkit_lod_buffer_id(newer.word);
@@ -447,7 +448,12 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
         return r;
     }
     if (id != 0u) {
-        uvec2 texel = lodkit_combine_behind_texel(id, at, base, newer.depth, m, newer.motion);
+        // What lies behind the level moves as the camera alone moves it: the matrix and motion
+        // of the pixel are the level's own.
+        mat4 camera = lodkit_combine_object(0u).new_to_old;
+        vec4 behind = lodkit_reproject_base(uv, camera);
+        vec2 behind_at = lodkit_reproject_from_base(behind, newer.depth, camera).xy;
+        uvec2 texel = lodkit_combine_behind_texel(id, behind_at, behind, newer.depth, camera, vec2(0.0));
         return lodkit_CombineRead(texel, lodkit_combine_fetch_color(texel), true);
     }
     return lodkit_combine_read_estimated(uv, newer.depth, base, old, m, newer.motion);

@@ -402,7 +402,9 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
 /// (estimated without one; with its silhouette, the texel in front where combine_hider finds
 /// another object there that combine_may_cover, and where the silhouette does not cover the
 /// pixel, what lies behind the level: another level whose silhouette covers it, else
-/// combine_behind_texel); else the depth pass's level, a covering silhouette, the estimate.
+/// combine_behind_texel under the camera's reprojection alone, the frame's matrix and no motion:
+/// what lies behind a level does not move with it); else the depth pass's level, a covering
+/// silhouette, the estimate.
 fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, newer: CombineNewer, pixel: vec2<u32>, base: vec4<f32>, old: vec3<f32>, m: mat4x4<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     let id = lod_buffer_id(newer.word);
@@ -443,7 +445,12 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
         return r;
     }
     if (id != 0u) {
-        let texel = combine_behind_texel(older_id, older_depth, data, id, at, base, newer.depth, m, newer.motion);
+        // What lies behind the level moves as the camera alone moves it: the matrix and motion
+        // of the pixel are the level's own.
+        let camera = combine_object(data, 0u).new_to_old;
+        let behind = reproject_base(uv, camera);
+        let behind_at = reproject_from_base(behind, newer.depth, camera).xy;
+        let texel = combine_behind_texel(older_id, older_depth, data, id, behind_at, behind, newer.depth, camera, vec2<f32>(0.0));
         return CombineRead(texel, textureLoad(older_color, texel, 0), true);
     }
     return combine_read_estimated(older_color, older_id, older_depth, data, uv, newer.depth, base, old, m, newer.motion);
