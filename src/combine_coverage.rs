@@ -394,8 +394,8 @@ pub fn combine_read_silhouettes(
 /// cover the pixel, what lies behind the level: another level whose silhouette covers it
 /// ([`combine_read_silhouettes`]), else [`combine_behind_texel`] under the camera's
 /// reprojection alone, the frame's matrix and no motion: what lies behind a level does not move
-/// with it); for a pixel showing none, a
-/// level the depth pass drew there, else a level whose silhouette covers it, else the estimate.
+/// with it); for a pixel showing none, a level the depth pass drew there, else a level whose
+/// silhouette covers it, else the estimate.
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
