@@ -84,10 +84,12 @@ fn scene() -> Scene {
             })
             .collect()
     };
-    // Older: the silhouette t-instance on texels 4..=9 x 3..=8 but for FRONT's and STILL's, the
-    // estimated one on 11..=13 x 2..=5, background elsewhere.
+    // Older: the silhouette t-instance on texels 4..=9 x 3..=8 but for FRONT's, STILL's and the
+    // background at (9, 3), the estimated one on 11..=13 x 2..=5, background elsewhere.
     let older_id = |x: u32, y: u32| {
-        if (5..=7).contains(&x) && (7..=8).contains(&y) {
+        if (x, y) == (9, 3) {
+            0
+        } else if (5..=7).contains(&x) && (7..=8).contains(&y) {
             FRONT
         } else if (x, y) == (7, 4) {
             STILL
@@ -101,12 +103,12 @@ fn scene() -> Scene {
             0
         }
     };
-    // Newer: the silhouette t-instance on 4..=8 x 3..=8 (the level drawn this frame is smaller),
-    // the estimated one on 10..=14 x 2..=5 (larger).
+    // Newer: the silhouette t-instance on 4..=8 x 3..=8 and (9, 3) (the level drawn this frame is
+    // smaller), the estimated one on 10..=14 x 2..=5 (larger).
     let newer_id = |x: u32, y: u32| {
         if (x, y) == (3, 8) || (x, y) == (12, 9) {
             TIE
-        } else if (4..=8).contains(&x) && SIL_Y.contains(&y) {
+        } else if (4..=8).contains(&x) && SIL_Y.contains(&y) || (x, y) == (9, 3) {
             SIL
         } else if (10..=14).contains(&x) && (2..=5).contains(&y) {
             EST
@@ -140,6 +142,8 @@ fn scene() -> Scene {
     // TIE's level drawn now is not shown at (3, 8) and (12, 9) this frame (flag: shown next only).
     newer.flags[at(3, 8)] = 2;
     newer.flags[at(12, 9)] = 2;
+    // The silhouette t-instance's level drawn now is not shown at (9, 3) either.
+    newer.flags[at(9, 3)] = 2;
     let mut pattern: Vec<f32> = noise[6 * n..7 * n].to_vec();
     // Where the silhouette test and the touching texel are checked, the older level is
     // displayed (pattern <= tau 0.5).
@@ -149,6 +153,7 @@ fn scene() -> Scene {
     pattern[at(9, 5)] = 0.1;
     pattern[at(1, 9)] = 0.1;
     pattern[at(3, 8)] = 0.1;
+    pattern[at(9, 3)] = 0.1;
     // The older level's silhouette under this frame's camera: the rectangle from (3, 3) to
     // (9.5, 9) in pixels (its texels 4..=9 moved 0.3 texel left by the camera, widened on the
     // left), which covers pixel column 3 where the older buffer's read finds background, and

@@ -125,6 +125,20 @@ pub(super) fn check_known(out: &[u32], s: &Scene, who: &str) {
         s.newer.colors[at(1, 9)]
     );
     shows(1, 9, older(1, 9), what);
+    // On the outline of a level that moved: pixel (9, 3) shows the silhouette t-instance's level
+    // drawn now, not shown this frame, and its center lies on that t-instance's older
+    // silhouette's right edge. Its read (x 9.8, 0.3 texel off texel (9, 3)'s center: the camera
+    // moved) lands on background: last frame did not sample this point, so the tie is not
+    // decided there, and the level drawn now covers the pixel: the older level is taken as
+    // covering it. Its own texel in the 3x3 block nearest the ray is (9, 4) (1.0 texel off; (8, 3)
+    // and (8, 4) 1.3), whose 2x2 blend around x 9.8 gives it no weight: the pixel shows texel
+    // (9, 4), not the background texel (9, 3) on the ray behind the level.
+    let what = format!(
+        "the older level's texel (9, 4), {} (the background texel behind it: {})",
+        older(9, 4),
+        older(9, 3)
+    );
+    shows(9, 3, older(9, 4), what);
     // Behind a level: pixel (3, 8) shows TIE's level drawn now, not shown this frame, outside
     // TIE's older silhouette; the silhouette t-instance's older silhouette covers its center
     // (3.5, 8.5). Its read (x 3.8) finds background at (3, 8); the level's texel (4, 8) lies 0.7

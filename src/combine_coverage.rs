@@ -332,6 +332,21 @@ pub fn combine_may_cover(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
     o.flags & COMBINE_ROUTE_SILHOUETTE == 0 || silhouette_covers(data, o.silhouette, p) != 0
 }
 
+/// How last frame's picture decides a pixel center that lies on `id`'s older silhouette
+/// ([`SILHOUETTE_ON`]), from the older texel at texture-space `at` (the center's reprojection):
+/// where the picture sampled that very point (`at` in the view, within [`COMBINE_SNAP`] of the
+/// texel's center: camera and level still), 1 if the texel holds `id` and 0 if not; elsewhere
+/// [`SILHOUETTE_ON`] (undecided: the rasterizer may break the tie either way). Rust twin of
+/// `combine_outline`.
+pub fn combine_outline(older: &LodImage, id: u32, at: Vec2) -> i32 {
+    let size = size_of(older);
+    let texel = combine_texel(at, size);
+    if !in_viewport(at) || combine_ray_offset(at, texel, size) >= COMBINE_SNAP {
+        return SILHOUETTE_ON;
+    }
+    i32::from(id_at(older, texel) == id)
+}
+
 /// For a pixel that shows no t-instance, or behind a t-instance's level drawn now whose older
 /// silhouette does not cover it (`depth` that level's): the older read ([`combine_read_known`])
 /// of the first t-instance whose older level's silhouette covers the pixel center `p` (pixels),
@@ -339,10 +354,9 @@ pub fn combine_may_cover(data: &[[u32; 4]], id: u32, p: Vec2) -> bool {
 /// [`combine_known_covers`]), and whose older level the read finds, read with that t-instance's
 /// own matrix and no motion (the pixel's own motion, if any, is that of what it shows, not of
 /// the level behind it); not found where none does. A
-/// center on a silhouette ([`SILHOUETTE_ON`]) is covered only where last frame's picture sampled this very point (its
-/// reprojection within [`COMBINE_SNAP`] of an older texel's center: camera and object still)
-/// and holds the level there; elsewhere the rasterizer may break the tie either way, and the
-/// older level taken where it would not draw it is a ghost.
+/// center on a silhouette ([`SILHOUETTE_ON`]) is covered only where [`combine_outline`] decides
+/// it covered; undecided, the rasterizer may break the tie either way, and the older level
+/// taken where it would not draw it is a ghost.
 pub fn combine_read_silhouettes(
     older: &LodImage,
     data: &[[u32; 4]],
@@ -351,7 +365,6 @@ pub fn combine_read_silhouettes(
     p: Vec2,
     convention: DepthConvention,
 ) -> CombineRead {
-    let size = size_of(older);
     let slots = silhouette_texel(data, 5).z;
     let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
     for g in 1..slots {
@@ -364,11 +377,7 @@ pub fn combine_read_silhouettes(
         }
         let m = combine_object(data, g).new_to_old;
         if covers == SILHOUETTE_ON {
-            let read_at = reproject(uv, depth, &m).truncate();
-            let texel = combine_texel(read_at, size);
-            let sampled =
-                in_viewport(read_at) && combine_ray_offset(read_at, texel, size) < COMBINE_SNAP;
-            covers = i32::from(sampled && id_at(older, texel) == g);
+            covers = combine_outline(older, g, reproject(uv, depth, &m).truncate());
         }
         if covers != 1 {
             continue;
@@ -389,9 +398,10 @@ pub fn combine_read_silhouettes(
 /// The older read of the pixel `pixel` showing `newer`, by the coverage route of what it shows
 /// (`m`, `base`, `old`: its reprojection, [`combine_new_to_old`]): a t-instance's own older
 /// level by its record's route (its silhouette, the depth pass, or estimated; estimated for a
-/// t-instance without a record; by its silhouette, the texel in front where [`combine_hider`]
-/// finds another object there that [`combine_may_cover`], and where the silhouette does not
-/// cover the pixel, what lies behind the level: another level whose silhouette covers it
+/// t-instance without a record; by its silhouette, where it covers the pixel or passes through
+/// its center undecided by [`combine_outline`], the texel in front where [`combine_hider`] finds
+/// another object there that [`combine_may_cover`], else the level's own; where the silhouette
+/// does not cover the pixel, what lies behind the level: another level whose silhouette covers it
 /// ([`combine_read_silhouettes`]), else [`combine_behind_texel`] under the camera's
 /// reprojection alone, the frame's matrix and no motion: what lies behind a level does not move
 /// with it); for a pixel showing none, a level the depth pass drew there, else a level whose
@@ -420,12 +430,14 @@ pub fn combine_read(
         if object.flags & (COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE)
             == COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE
         {
+            let read_at = old.truncate() + motion;
             let mut own = silhouette_covers(data, object.silhouette, p);
             if own == SILHOUETTE_ON {
-                own = i32::from(id_at(older, combine_texel(old.truncate() + motion, size)) == id);
+                own = combine_outline(older, id, read_at);
             }
-            let read_at = old.truncate() + motion;
-            if own == 1 {
+            // Covered, or on the outline where last frame's picture does not decide: the level
+            // drawn now covers the pixel, so the older level taken there is no ghost.
+            if own != 0 {
                 let front = combine_hider(older, id, read_at, old.z, convention);
                 if front != 0 && combine_may_cover(data, front, p) {
                     return found(older, combine_texel(read_at, size));

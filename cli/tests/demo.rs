@@ -7,6 +7,7 @@ use lodkit::gpu::counters::{CounterKind, FragmentCounter};
 use lodkit::metrics::{pop, transition_change};
 use lodkit_cli::demo::fixtures::render::Technique;
 use lodkit_cli::demo::fixtures::scene::{DemoScene, SceneError};
+use lodkit_cli::demo::measures::transitions::TransitionMetrics;
 use lodkit_cli::demo::measures::upsample_quality::METHODS;
 use lodkit_cli::demo::{DemoOptions, run_on, utc_date};
 
@@ -219,8 +220,8 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             t.reversals_moving_coarse,
             t.see_through,
             t.silhouette_error,
-            t.see_through_pixels_moving,
-            t.ghosts_moving,
+            t.see_through_pixel_frames,
+            t.ghost_pixel_frames,
             t.outside_rects
         ));
     }
@@ -313,7 +314,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
         );
         // The silhouette error's parts: the cross-fade's is see-through.
         assert!(
-            fade.see_through_pixels_moving > 0,
+            fade.see_through_pixel_frames > 0,
             "cross-fade: no see-through pixel"
         );
         // Flicker against the coarse level's run is its own figure: a reference that fell back
@@ -444,6 +445,22 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
                     r.pop_static
                 );
             }
+        }
+        // See-through and ghosts, counted on every frame of the transition with both cameras:
+        // the combine that knows the older levels' silhouettes leaves a few pixel-frames (here,
+        // 96x64 and 8 frames, 0-2 per scene and schedule; the estimate 18-85), each fewer than
+        // the estimate with the same schedule. Limit: 3 above the measured.
+        for (estimated, known) in [
+            ("frame-seq-blue-noise", "frame-seq-silhouettes"),
+            ("frame-seq-complementary", "frame-seq-compl-silhouettes"),
+        ] {
+            let wrong = |r: &TransitionMetrics| r.see_through_pixel_frames + r.ghost_pixel_frames;
+            let (estimated, known) = (wrong(row(estimated)), wrong(row(known)));
+            assert!(
+                known <= 5 && known < estimated,
+                "in {}: see-through and ghosts {known} pixel-frames with the silhouettes, {estimated} estimated",
+                scene.name
+            );
         }
     }
     for u in &report.upsampling {

@@ -47,6 +47,8 @@
 //       covers the pixel center p
 //   lodkit_combine_may_cover(id, p) -> bool   whether id is a t-instance whose older level may
 //       cover the pixel center p (coverage not its silhouette, or its silhouette covers p)
+//   lodkit_combine_outline(id, at) -> int   how last frame's picture decides a pixel center on
+//       id's older silhouette: 1 covered, 0 not, LODKIT_SILHOUETTE_ON undecided
 //   lodkit_combine_read_silhouettes(uv, depth, p) -> lodkit_CombineRead   a level whose
 //       silhouette covers the pixel (one showing no t-instance, or what lies behind a level that
 //       does not cover it)
@@ -356,16 +358,29 @@ bool lodkit_combine_may_cover(uint id, vec2 p) {
     return (o.flags & LODKIT_COMBINE_ROUTE_SILHOUETTE) == 0u || lodkit_silhouette_covers(o.silhouette, p) != 0;
 }
 
+/// How last frame's picture decides a pixel center that lies on `id`'s older silhouette
+/// (LODKIT_SILHOUETTE_ON), from the older texel at texture-space `at` (the center's
+/// reprojection): where the picture sampled that very point (`at` in the view, within
+/// LODKIT_COMBINE_SNAP of the texel's center: camera and level still), 1 if the texel holds `id`
+/// and 0 if not; elsewhere LODKIT_SILHOUETTE_ON (undecided: the rasterizer may break the tie
+/// either way).
+int lodkit_combine_outline(uint id, vec2 at) {
+    uvec2 size = lodkit_combine_fetch_size();
+    uvec2 texel = lodkit_combine_texel(at, size);
+    if (!lodkit_in_viewport(at) || lodkit_combine_ray_offset(at, texel, size) >= LODKIT_COMBINE_SNAP) {
+        return LODKIT_SILHOUETTE_ON;
+    }
+    return lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == id ? 1 : 0;
+}
+
 /// For a pixel showing no t-instance, or behind a t-instance's level drawn now whose older
 /// silhouette does not cover it (`depth` that level's): the read (lodkit_combine_read_known) of
 /// the first t-instance whose older silhouette covers the pixel center `p` (on its outline, only
-/// where last frame's picture sampled this very point, within LODKIT_COMBINE_SNAP of an older
-/// texel's center, and holds the level there: elsewhere the rasterizer may break the tie either
-/// way, and a level taken where it would not draw it is a ghost), is not hidden there by another
+/// where lodkit_combine_outline decides it covered: undecided, the rasterizer may break the tie
+/// either way, and a level taken where it would not draw it is a ghost), is not hidden there by another
 /// t-instance whose silhouette covers it too (lodkit_combine_hider, lodkit_combine_known_covers),
 /// and whose older level the read finds; none: not found.
 lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p) {
-    uvec2 size = lodkit_combine_fetch_size();
     uint slots = lodkit_silhouette_texel(5u).z;
     uint wanted = LODKIT_COMBINE_KNOWN | LODKIT_COMBINE_ROUTE_SILHOUETTE;
     for (uint g = 1u; g < slots; g++) {
@@ -378,10 +393,7 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
         }
         mat4 m = lodkit_combine_object(g).new_to_old;
         if (covers == LODKIT_SILHOUETTE_ON) {
-            vec2 at = lodkit_reproject(uv, depth, m).xy;
-            uvec2 texel = lodkit_combine_texel(at, size);
-            bool sampled = lodkit_in_viewport(at) && lodkit_combine_ray_offset(at, texel, size) < LODKIT_COMBINE_SNAP;
-            covers = sampled && lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == g ? 1 : 0;
+            covers = lodkit_combine_outline(g, lodkit_reproject(uv, depth, m).xy);
         }
         if (covers != 1) {
             continue;
@@ -400,9 +412,10 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
 }
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
-/// (estimated without one; with its silhouette, the texel in front where lodkit_combine_hider
-/// finds another object there that lodkit_combine_may_cover, and where the silhouette does not
-/// cover the pixel, what lies behind the level: another level whose silhouette covers it, else
+/// (estimated without one; with its silhouette, where it covers the pixel or passes through its
+/// center undecided by lodkit_combine_outline, the texel in front where lodkit_combine_hider
+/// finds another object there that lodkit_combine_may_cover, else the level's own; where it does
+/// not cover the pixel, what lies behind the level: another level whose silhouette covers it, else
 /// lodkit_combine_behind_texel under the camera's reprojection alone, the frame's matrix and no
 /// motion: what lies behind a level does not move with it); else the depth pass's level, a
 /// covering silhouette, the estimate.
@@ -424,9 +437,11 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
         }
         int own = lodkit_silhouette_covers(object.silhouette, p);
         if (own == LODKIT_SILHOUETTE_ON) {
-            own = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_texel(at, size))) == id ? 1 : 0;
+            own = lodkit_combine_outline(id, at);
         }
-        if (own == 1) {
+        // Covered, or on the outline where last frame's picture does not decide: the level drawn
+        // now covers the pixel, so the older level taken there is no ghost.
+        if (own != 0) {
             uint front = lodkit_combine_hider(id, at, old.z);
             if (front != 0u && lodkit_combine_may_cover(front, p)) {
                 uvec2 held = lodkit_combine_texel(at, size);

@@ -51,6 +51,8 @@
 //       the pixel center p
 //   combine_may_cover(data, id, p) -> bool   whether id is a t-instance whose older level may
 //       cover the pixel center p (coverage not its silhouette, or its silhouette covers p)
+//   combine_outline(older_id, id, at) -> i32   how last frame's picture decides a pixel center on
+//       id's older silhouette: 1 covered, 0 not, SILHOUETTE_ON undecided
 //   combine_read_silhouettes(older_color, older_id, older_depth, data, uv, depth, p)
 //       -> CombineRead   a level whose silhouette covers the pixel (one showing no t-instance,
 //       or what lies behind a level that does not cover it)
@@ -355,16 +357,28 @@ fn combine_may_cover(data: texture_2d<u32>, id: u32, p: vec2<f32>) -> bool {
     return (o.flags & COMBINE_ROUTE_SILHOUETTE) == 0u || silhouette_covers(data, o.silhouette, p) != 0;
 }
 
+/// How last frame's picture decides a pixel center that lies on `id`'s older silhouette
+/// (SILHOUETTE_ON), from the older texel at texture-space `at` (the center's reprojection): where
+/// the picture sampled that very point (`at` in the view, within COMBINE_SNAP of the texel's
+/// center: camera and level still), 1 if the texel holds `id` and 0 if not; elsewhere
+/// SILHOUETTE_ON (undecided: the rasterizer may break the tie either way).
+fn combine_outline(older_id: texture_2d<u32>, id: u32, at: vec2<f32>) -> i32 {
+    let size = textureDimensions(older_id, 0);
+    let texel = combine_texel(at, size);
+    if (!in_viewport(at) || combine_ray_offset(at, texel, size) >= COMBINE_SNAP) {
+        return SILHOUETTE_ON;
+    }
+    return select(0, 1, lod_buffer_id(textureLoad(older_id, texel, 0).x) == id);
+}
+
 /// For a pixel showing no t-instance, or behind a t-instance's level drawn now whose older
 /// silhouette does not cover it (`depth` that level's): the read (combine_read_known) of the
 /// first t-instance whose older silhouette covers the pixel center `p` (on its outline, only
-/// where last frame's picture sampled this very point, within COMBINE_SNAP of an older texel's
-/// center, and holds the level there: elsewhere the rasterizer may break the tie either way, and
-/// a level taken where it would not draw it is a ghost), is not hidden there by another
+/// where combine_outline decides it covered: undecided, the rasterizer may break the tie either
+/// way, and a level taken where it would not draw it is a ghost), is not hidden there by another
 /// t-instance whose silhouette covers it too (combine_hider, combine_known_covers), and whose
 /// older level the read finds; none: not found.
 fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, uv: vec2<f32>, depth: f32, p: vec2<f32>) -> CombineRead {
-    let size = textureDimensions(older_color, 0);
     let slots = silhouette_texel(data, 5u).z;
     let wanted = COMBINE_KNOWN | COMBINE_ROUTE_SILHOUETTE;
     for (var g = 1u; g < slots; g++) {
@@ -377,10 +391,7 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
         }
         let m = combine_object(data, g).new_to_old;
         if (covers == SILHOUETTE_ON) {
-            let at = reproject(uv, depth, m).xy;
-            let texel = combine_texel(at, size);
-            let sampled = in_viewport(at) && combine_ray_offset(at, texel, size) < COMBINE_SNAP;
-            covers = select(0, 1, sampled && lod_buffer_id(textureLoad(older_id, texel, 0).x) == g);
+            covers = combine_outline(older_id, g, reproject(uv, depth, m).xy);
         }
         if (covers != 1) {
             continue;
@@ -399,8 +410,9 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
 }
 
 /// The older read of `pixel` by the route of what it shows: a t-instance's own by its record's
-/// (estimated without one; with its silhouette, the texel in front where combine_hider finds
-/// another object there that combine_may_cover, and where the silhouette does not cover the
+/// (estimated without one; with its silhouette, where it covers the pixel or passes through its
+/// center undecided by combine_outline, the texel in front where combine_hider finds another
+/// object there that combine_may_cover, else the level's own; where it does not cover the
 /// pixel, what lies behind the level: another level whose silhouette covers it, else
 /// combine_behind_texel under the camera's reprojection alone, the frame's matrix and no motion:
 /// what lies behind a level does not move with it); else the depth pass's level, a covering
@@ -421,9 +433,11 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
         }
         var own = silhouette_covers(data, object.silhouette, p);
         if (own == SILHOUETTE_ON) {
-            own = select(0, 1, lod_buffer_id(textureLoad(older_id, combine_texel(at, size), 0).x) == id);
+            own = combine_outline(older_id, id, at);
         }
-        if (own == 1) {
+        // Covered, or on the outline where last frame's picture does not decide: the level drawn
+        // now covers the pixel, so the older level taken there is no ghost.
+        if (own != 0) {
             let front = combine_hider(older_id, older_depth, id, at, old.z);
             if (front != 0u && combine_may_cover(data, front, p)) {
                 let held = combine_texel(at, size);

@@ -1,15 +1,17 @@
 //! The transition metrics: pop, see-through and cost of every technique on one scene, with the
 //! strips and false-color images that show them.
 
+mod coverage;
+
 use std::path::Path;
 
-use glam::Vec4;
 use serde::Serialize;
 
 use crate::demo::error::DemoError;
 use crate::demo::fixtures::render::{
     Background, Frame, LEAD_FRAMES, RunSpec, SceneRenderer, Technique,
 };
+use coverage::LevelMasks;
 use lodkit::combine::PixelSource;
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::metrics::{Flicker, FlickerMeter, pop, transition_change};
@@ -49,18 +51,18 @@ pub struct TransitionMetrics {
     /// The same with the moving camera.
     pub reversals_moving_coarse: u64,
     /// Share of the transitioning objects' interior (pixels both LODs cover) where the
-    /// background contributes to the middle frame.
+    /// background contributes to the static camera's middle frame.
     pub see_through: f32,
     /// Silhouette error with the moving camera at the middle frame: pixels both LODs cover that
     /// show the background, plus pixels neither covers that show a transitioning object, as a
     /// share of the pixels either covers.
     pub silhouette_error: f32,
-    /// Of the silhouette error, the pixels both LODs cover that show the background
-    /// (`lodkit::metrics::see_through`, moving camera, middle frame).
-    pub see_through_pixels_moving: usize,
-    /// Of the silhouette error, the pixels neither LOD covers that show a transitioning object
-    /// (`lodkit::metrics::ghosts`, moving camera, middle frame).
-    pub ghosts_moving: usize,
+    /// Pixels both LODs cover that show the background (`lodkit::metrics::see_through`),
+    /// summed over every frame of the transition, static and moving camera: pixel-frames.
+    pub see_through_pixel_frames: usize,
+    /// Pixels neither LOD covers that show a transitioning object (`lodkit::metrics::ghosts`),
+    /// summed the same way.
+    pub ghost_pixel_frames: usize,
     /// Pixels of objects in transition, in either LOD buffer, outside the combine pass's
     /// rectangles, summed over the frames of both runs (frame-sequential; 0 otherwise). Pixels
     /// there show the newer buffer alone, so the see-through figure holds only when this is 0.
@@ -228,122 +230,6 @@ fn transition_run(
     }
 }
 
-/// The middle frame of `technique` over black and over white scenery (every object but the
-/// transitioning ones in the flat color), with the static or `moving` camera.
-fn over_black_and_white(
-    gpu: &GpuContext,
-    renderer: &SceneRenderer,
-    technique: Technique,
-    moving: bool,
-) -> Result<[Vec<u8>; 2], DemoError> {
-    let middle = LEAD_FRAMES + renderer.transition_frames() / 2;
-    let only_middle = |f: usize| f == middle;
-    let mut over = [Vec::new(), Vec::new()];
-    for (flat, pixels) in [Vec4::new(0.0, 0.0, 0.0, 1.0), Vec4::ONE]
-        .iter()
-        .zip(&mut over)
-    {
-        let spec = RunSpec {
-            technique,
-            moving,
-            transition: true,
-            hold_level: 0,
-            background: Background::Flat(*flat),
-        };
-        renderer.run(
-            gpu,
-            spec,
-            &only_middle,
-            &mut |_, f| *pixels = f.pixels,
-            None,
-        )?;
-    }
-    Ok(over)
-}
-
-/// Whether pixel `i` differs between the two renders `over` (the background shows there).
-fn shows_background(over: &[Vec<u8>; 2], i: usize) -> bool {
-    (0..3).any(|c| over[0][i * 4 + c].abs_diff(over[1][i * 4 + c]) > 2)
-}
-
-/// See-through at the middle frame, static camera: interior pixels (both LODs cover them) where
-/// the renders over black and white scenery differ. Returns the share and a false-color map
-/// (interior gray, see-through red).
-fn see_through(
-    gpu: &GpuContext,
-    renderer: &SceneRenderer,
-    technique: Technique,
-    masks: &[Vec<bool>; 2],
-    size: (u32, u32),
-) -> Result<(f32, image::RgbaImage), DemoError> {
-    let over = over_black_and_white(gpu, renderer, technique, false)?;
-    let (mut interior, mut seen) = (0usize, 0usize);
-    let mut map = image::RgbaImage::new(size.0, size.1);
-    for (i, px) in map.pixels_mut().enumerate() {
-        if !(masks[0][i] && masks[1][i]) {
-            *px = image::Rgba([20, 20, 30, 255]);
-            continue;
-        }
-        interior += 1;
-        if shows_background(&over, i) {
-            seen += 1;
-            *px = image::Rgba([235, 40, 30, 255]);
-        } else {
-            *px = image::Rgba([150, 150, 150, 255]);
-        }
-    }
-    Ok((share(seen, interior), map))
-}
-
-/// Silhouette error at the middle frame, moving camera (`masks` of that frame): holes (pixels
-/// both LODs cover that show the background) plus ghosts (pixels neither covers where the
-/// render over black scenery shows a transitioning object), over the pixels either covers.
-/// Single-frame techniques draw the frame's own geometry; frame-sequential LOD reprojects last
-/// frame's buffer, and this is where that shows.
-fn silhouette_error(
-    gpu: &GpuContext,
-    renderer: &SceneRenderer,
-    technique: Technique,
-    masks: &[Vec<bool>; 2],
-) -> Result<SilhouetteError, DemoError> {
-    let over = over_black_and_white(gpu, renderer, technique, true)?;
-    let n = masks[0].len().min(masks[1].len()).min(over[0].len() / 4);
-    let (fine, coarse) = (&masks[0][..n], &masks[1][..n]);
-    let union = (0..n).filter(|&i| fine[i] || coarse[i]).count();
-    // A hole: the renders over black and white scenery differ. A ghost: the render over black
-    // scenery shows something.
-    let opaque: Vec<bool> = (0..n).map(|i| !shows_background(&over, i)).collect();
-    let lit: Vec<bool> = (0..n)
-        .map(|i| over[0][i * 4..i * 4 + 3].iter().any(|&c| c > 8))
-        .collect();
-    let internal = |e: lodkit::metrics::MetricsError| DemoError::Internal(e.to_string());
-    let holes = lodkit::metrics::see_through(fine, coarse, &opaque).map_err(internal)?;
-    let ghosts = lodkit::metrics::ghosts(fine, coarse, &lit).map_err(internal)?;
-    Ok(SilhouetteError {
-        share: share(holes + ghosts, union),
-        holes,
-        ghosts,
-    })
-}
-
-/// [`silhouette_error`]'s figures.
-struct SilhouetteError {
-    /// Holes and ghosts over the pixels either LOD covers.
-    share: f32,
-    /// Pixels both LODs cover that show the background.
-    holes: usize,
-    /// Pixels neither covers that show a transitioning object.
-    ghosts: usize,
-}
-
-fn share(part: usize, whole: usize) -> f32 {
-    if whole == 0 {
-        0.0
-    } else {
-        part as f32 / whole as f32
-    }
-}
-
 /// False color of the combine rule per pixel: gray newer, orange older, magenta average of the
 /// two LODs, cyan outside the older view.
 pub fn sources_image(size: (u32, u32), sources: &[PixelSource]) -> image::RgbaImage {
@@ -406,8 +292,10 @@ pub fn measure_scene(
     out: &Path,
     tick: &mut dyn FnMut(&str),
 ) -> Result<Vec<TransitionMetrics>, DemoError> {
-    let masks = renderer.lod_masks(gpu, false)?;
-    let moving_masks = renderer.lod_masks(gpu, true)?;
+    let masks = [
+        LevelMasks::render(gpu, renderer, false)?,
+        LevelMasks::render(gpu, renderer, true)?,
+    ];
     let counts = renderer.counter().kind().is_count();
     let mut rows: Vec<TransitionMetrics> = Vec::new();
     // Reference runs of the current technique family (single-frame or frame-sequential),
@@ -453,9 +341,11 @@ pub fn measure_scene(
             flickers.push(run.flicker);
         }
         let outside_rects = renderer.take_outside_rects();
-        let (share, map) = see_through(gpu, renderer, technique, &masks, size)?;
-        let silhouette = silhouette_error(gpu, renderer, technique, &moving_masks)?;
-        crate::demo::error::save(&map, &out.join(format!("see-through/{scene}-{name}.png")))?;
+        let coverage = coverage::measure(gpu, renderer, technique, &masks, size)?;
+        crate::demo::error::save(
+            &coverage.map,
+            &out.join(format!("see-through/{scene}-{name}.png")),
+        )?;
         let moving_change = changes.pop().unwrap_or_default();
         let static_change = changes.pop().unwrap_or_default();
         let [still, moved] = [0, 1].map(|k| flickers.get(k).copied().unwrap_or_default());
@@ -475,11 +365,11 @@ pub fn measure_scene(
             flicker_moving_coarse: moved_coarse.ratio(),
             reversals_static_coarse: still_coarse.reversals,
             reversals_moving_coarse: moved_coarse.reversals,
-            see_through: share,
+            see_through: coverage.see_through_share,
             outside_rects,
-            silhouette_error: silhouette.share,
-            see_through_pixels_moving: silhouette.holes,
-            ghosts_moving: silhouette.ghosts,
+            silhouette_error: coverage.silhouette_error,
+            see_through_pixel_frames: coverage.see_through,
+            ghost_pixel_frames: coverage.ghosts,
             triangles_vs_hard: 0.0,
             fragments_vs_hard: None,
             idle_fragments_vs_hard: None,

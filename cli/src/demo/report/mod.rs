@@ -174,7 +174,7 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                 "flicker (moving)",
                 "flicker vs coarse (static)",
                 "flicker vs coarse (moving)",
-                "see-through / ghosts (moving, px)",
+                "see-through / ghosts (pixel-frames)",
             ],
             rows: rows
                 .map(|t| {
@@ -194,7 +194,7 @@ fn transition_table(report: &DemoReport, scene: &str, cost: bool) -> Table {
                             "{:.2} ({} rev.)",
                             t.flicker_moving_coarse, t.reversals_moving_coarse
                         ),
-                        format!("{} / {}", t.see_through_pixels_moving, t.ghosts_moving),
+                        format!("{} / {}", t.see_through_pixel_frames, t.ghost_pixel_frames),
                     ]
                 })
                 .collect(),
