@@ -358,10 +358,12 @@ const POP_TEXT: &str = "Pop is the largest single-frame share of the image chang
 causes (1.0: all of it in one frame, as a hard switch; 1/N: spread evenly over N frames). With \
 the moving camera, the change of a run without transition is subtracted frame by frame. \
 See-through is the share of the transitioning objects' interior (pixels both LODs cover) where \
-the background contributes to the middle frame: the frame is rendered over black and over white \
-scenery and the pixels that differ are counted. Silhouette error is measured at the middle frame \
-of the moving camera: pixels both LODs cover that show the background, plus pixels neither \
-covers that show a transitioning object, as a share of the pixels either covers. \
+the background contributes to the static camera's middle frame: the frame is rendered over black \
+and over white scenery and the pixels that differ are counted. Silhouette error is measured at \
+the middle frame of the moving camera: pixels both LODs cover that show the background, plus \
+pixels neither covers that show a transitioning object, as a share of the pixels either covers. \
+The last column counts both kinds on every frame of the transition with both cameras, against \
+what each LOD alone covers at that frame: see-through / ghost pixel-frames. \
 `frame-seq-compl-silhouettes` is frame-sequential LOD as docs/frame-sequential.md recommends it \
 where the levels are closed meshes (the complementary schedule, the pattern on the screen, each \
 level known by its silhouette); `frame-seq-silhouettes` the same with the default schedule, the \
