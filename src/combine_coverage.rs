@@ -4,7 +4,7 @@
 //!
 //! Where the level not drawn this frame covers a pixel is known per t-instance, by a
 //! [`CoverageRoute`] given as data: its silhouette's winding number
-//! ([`silhouette_covers`](crate::silhouette::silhouette_covers)), an older-level depth pass the
+//! ([`silhouette_covers`]), an older-level depth pass the
 //! host draws, or the estimate from last frame's picture alone (the paper's). A pass drawn over
 //! the levels' silhouettes ([`silhouette_hull`](crate::silhouette::silhouette_hull)) calls the
 //! shader's `combine_pixel` at each of its pixels.
@@ -538,7 +538,7 @@ pub fn combine_edge_uv(uv: Vec2, size: UVec2) -> Option<Vec2> {
 
 /// The whole per-pixel combine of frame-sequential LOD with the older level's coverage known
 /// (the Rust twin of `combine_pixel`): `newer` as read at `pixel`, the older buffer `older`
-/// (last frame's picture), the frame's data texture `data` ([`CombineData`](super::CombineData):
+/// (last frame's picture), the frame's data texture `data` ([`CombineData`]:
 /// the camera's matrix, per t-instance its matrix, display threshold and coverage route, the
 /// silhouettes). Reprojected farther than [`COMBINE_EDGE_REACH`] texels outside the older view
 /// ([`combine_edge_uv`]), or where no older level is found, the newer color;

@@ -4,8 +4,8 @@
 //! transition between two LODs). A t-instance is drawn with ONE of its two LODs per frame,
 //! alternating with its own phase: the frame its transition begins, and every other frame after,
 //! draw the outgoing LOD, the frames between the incoming. Each draw carries the instance's id,
-//! the LOD's visibility threshold tau under the [`Schedule`] (the paper's Fig. 2 by default, or
-//! complementary) and the threshold the same LOD will have next frame (display-time visibility:
+//! the LOD's visibility threshold tau under the [`Schedule`] (complementary by default, or the
+//! paper's Fig. 2) and the threshold the same LOD will have next frame (display-time visibility:
 //! the combine shows each LOD as it is at the frame displayed). A transition may begin on any
 //! frame: its first frame draws the outgoing LOD whole (both schedules show all of it at
 //! progress 0), so the object never drops out of the newer buffer. Its last frame (progress 1)
@@ -37,21 +37,25 @@ pub struct InstanceKey {
 /// How the two LODs of a t-instance share the visibility texture over a transition.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Schedule {
-    /// The paper's Fig. 2 (the default): the incoming LOD appears over the first half while the
-    /// outgoing stays complete, then the outgoing vanishes over the second half. One LOD is
-    /// always complete, so the object's interior never shows what is behind it, whatever the
-    /// combine knows of the older level's coverage; at silhouettes, where only one LOD covers a
-    /// pixel, the change happens within one half of the transition.
-    #[default]
+    /// The paper's Fig. 2: the incoming LOD appears over the first half while the outgoing
+    /// stays complete, then the outgoing vanishes over the second half. One LOD is always
+    /// complete, so the object's interior never shows what is behind it, whatever the combine
+    /// knows of the older level's coverage; at silhouettes, where only one LOD covers a pixel,
+    /// the change happens within one half of the transition. Take it where the combine estimates
+    /// the older level's coverage from last frame's picture (`CombineCoverage::Estimated`):
+    /// there the complementary schedule shows the background through an object about twice as
+    /// often (docs/frame-sequential.md, "The two schedules").
     Paper,
-    /// Complementary: the incoming LOD shows the texels v <= progress, the outgoing the others
+    /// Complementary (the default): the incoming LOD shows the texels v <= progress, the
+    /// outgoing the others
     /// ([`visibility_threshold_complementary`](crate::visibility::visibility_threshold_complementary)).
     /// The change at silhouettes is spread over the whole transition, like a dither; inside the
     /// object, pixels whose two LOD samples are both shown or both hidden show their average.
-    /// Recommended where the combine knows the older levels' coverage (their silhouettes): there
-    /// its pop stays within 1.1x a blue-noise dither's (Fig. 2's reaches 1.4x) and it reverses
-    /// fewer pixels than [`Paper`](Self::Paper); with the coverage estimated it can show what
-    /// lies behind an object at its outline (docs/frame-sequential.md, "The two schedules").
+    /// Made for a combine that knows the older levels' coverage (their silhouettes, the route
+    /// docs/frame-sequential.md recommends): there its pop stays within 1.1x a blue-noise
+    /// dither's (Fig. 2's reaches 1.4x) and it reverses fewer pixels than
+    /// [`Paper`](Self::Paper).
+    #[default]
     Complementary,
 }
 
@@ -168,7 +172,7 @@ impl Default for TransitionScheduler {
 }
 
 impl TransitionScheduler {
-    /// An empty scheduler at frame 0, with [`Schedule::default`] (the paper's Fig. 2).
+    /// An empty scheduler at frame 0, with [`Schedule::default`] (the complementary schedule).
     pub fn new() -> Self {
         Self {
             frame: 0,
@@ -182,7 +186,7 @@ impl TransitionScheduler {
     }
 
     /// The scheduler with visibility schedule `schedule` ([`new`](Self::new) takes
-    /// [`Schedule::default`], the paper's Fig. 2).
+    /// [`Schedule::default`], the complementary schedule).
     pub fn with_schedule(schedule: Schedule) -> Self {
         Self {
             schedule,

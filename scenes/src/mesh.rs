@@ -191,7 +191,7 @@ impl GpuMesh {
 }
 
 /// Vertex buffer layout and attributes of [`Mesh`] (position at location 0, normal at 1): the
-/// layout [`mesh_pipeline`](lodkit::gpu::resources::mesh_pipeline) builds pipelines with.
+/// layout [`mesh_pipeline`] builds pipelines with.
 pub use lodkit::gpu::resources::{MESH_VERTEX_ATTRIBUTES, MESH_VERTEX_LAYOUT};
 
 /// Rust mirror of `Camera` in `passes/lod_mesh.wgsl`.

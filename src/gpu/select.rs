@@ -165,7 +165,7 @@ fn check_instance(i: usize, inst: &GpuLodInstance) -> Result<(), GpuError> {
 
 impl GpuLodSelector {
     /// Builds the pipeline and the group table. Errors: a group with more than
-    /// [`SELECT_MAX_LEVELS`] levels, invalid settings, more meshes than levels, a device without
+    /// [`SELECT_MAX_LEVELS`](crate::select::SELECT_MAX_LEVELS) levels, invalid settings, more meshes than levels, a device without
     /// compute shaders or indirect execution ([`GpuError::MissingCapability`]).
     pub fn new(gpu: &GpuContext, desc: &GpuLodSelectorDescriptor) -> Result<Self, GpuError> {
         const CALL: &str = "GpuLodSelector::new";

@@ -25,7 +25,7 @@ pub(crate) const GLSL_PARSER_STACK: usize = 256 << 20;
 /// one expression or statement: its brackets, plus the operators chained at each bracket level,
 /// plus the `if`/`else`/loop keywords of statements nested without braces. Parsing and lowering
 /// recurse at most once per counted token; at this depth they stay within the parser thread's
-/// stack ([`GLSL_PARSER_STACK`]) in a debug build.
+/// stack (`GLSL_PARSER_STACK`, 256 MiB) in a debug build.
 pub const MAX_EXPRESSION_DEPTH: usize = 4096;
 
 /// The most tokens GLSL macros may expand a file to (about 40 MB of text): beyond any real

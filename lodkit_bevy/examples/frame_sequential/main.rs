@@ -48,6 +48,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use lodkit::frame_sequential::Schedule;
+use lodkit_bevy::FrameSequentialLod;
 use lodkit_bevy::frame_sequential::{CombineRegion, OlderCoverage, VisibilitySpace};
 
 /// Parsed command line.
@@ -74,7 +75,7 @@ fn parse() -> Result<Option<Args>, String> {
         report: None,
         frames: None,
         with_prepass: true,
-        schedule: Schedule::default(),
+        schedule: FrameSequentialLod::default().schedule,
         anchor: VisibilitySpace::Screen,
         reprojection: true,
         coverage: OlderCoverage::default(),

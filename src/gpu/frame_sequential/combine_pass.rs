@@ -66,7 +66,10 @@ pub enum CombineRegions<'a> {
 pub enum CombineCoverage<'a> {
     /// Nothing: `lodkit::combine::combine_at_moved` (or `combine_at`) estimates it from last
     /// frame's picture. Where a level's edge moved by a fraction of a texel, the pixel shows the
-    /// other level or the background every other frame.
+    /// other level or the background every other frame. Schedule the transitions with
+    /// [`Schedule::Paper`](crate::frame_sequential::Schedule::Paper) then: with the default
+    /// complementary schedule the estimate shows the background through an object about twice
+    /// as often.
     #[default]
     Estimated,
     /// `lodkit::combine_coverage::combine_pixel` with this frame's [`CombineData`]: each

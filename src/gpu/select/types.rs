@@ -123,7 +123,7 @@ pub struct LevelMesh {
     pub base_vertex: i32,
 }
 
-/// How to build a [`GpuLodSelector`].
+/// How to build a [`GpuLodSelector`](super::GpuLodSelector).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct GpuLodSelectorDescriptor<'a> {
     /// The groups, at most [`SELECT_MAX_LEVELS`] levels each.

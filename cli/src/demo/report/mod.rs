@@ -1,5 +1,5 @@
 //! The demo's outputs from a [`DemoReport`]: PNG plots, `report.json`, `index.html` and the two
-//! generated docs pages (the terminal summary is in [`terminal`](crate::demo::report::terminal)).
+//! generated docs pages (the terminal summary is in [`terminal`]).
 
 pub mod closed_loop;
 pub mod doc_pictures;
@@ -364,10 +364,10 @@ the middle frame of the moving camera: pixels both LODs cover that show the back
 pixels neither covers that show a transitioning object, as a share of the pixels either covers. \
 The last column counts both kinds on every frame of the transition with both cameras, against \
 what each LOD alone covers at that frame: see-through / ghost pixel-frames. \
-`frame-seq-compl-silhouettes` is frame-sequential LOD as docs/frame-sequential.md recommends it \
-where the levels are closed meshes (the complementary schedule, the pattern on the screen, each \
-level known by its silhouette); `frame-seq-silhouettes` the same with the default schedule, the \
-paper's Fig. 2.\n";
+`frame-seq-compl-silhouettes` is frame-sequential LOD with the library's defaults on the route \
+docs/frame-sequential.md recommends where the levels are closed meshes (the complementary \
+schedule, the pattern on the screen, each level known by its silhouette); \
+`frame-seq-silhouettes` the same with the paper's Fig. 2 schedule.\n";
 
 /// Writes `benchmarks.md` and `quality.md` into `docs`.
 pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
