@@ -3,11 +3,11 @@
 //! reads ([`CombineData`]).
 //!
 //! Where the level not drawn this frame covers a pixel is known per t-instance, by a
-//! [`CoverageRoute`] given as data: its silhouette's winding number
-//! ([`silhouette_covers`]), an older-level depth pass the
-//! host draws, or the estimate from last frame's picture alone (the paper's). A pass drawn over
-//! the levels' silhouettes ([`silhouette_hull`](crate::silhouette::silhouette_hull)) calls the
-//! shader's `combine_pixel` at each of its pixels.
+//! [`CoverageRoute`] given as data: its silhouette's winding number ([`silhouette_covers`]), an
+//! older-level depth pass the host draws, or the estimate from last frame's picture alone (the
+//! paper's). A pass drawn over the levels' silhouettes
+//! ([`silhouette_hull`](crate::silhouette::silhouette_hull)) calls the shader's `combine_pixel`
+//! at each of its pixels.
 
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 

@@ -173,6 +173,11 @@ impl Default for TransitionScheduler {
 
 impl TransitionScheduler {
     /// An empty scheduler at frame 0, with [`Schedule::default`] (the complementary schedule).
+    ///
+    /// ```
+    /// # use lodkit::frame_sequential::{Schedule, TransitionScheduler};
+    /// assert_eq!(TransitionScheduler::new().schedule(), Schedule::Complementary);
+    /// ```
     pub fn new() -> Self {
         Self {
             frame: 0,

@@ -130,7 +130,8 @@ pub enum GpuError {
         first: String,
     },
     /// The device is lost (driver reset, `Device::destroy`, GPU removed). Every object made
-    /// from the context is dead: recreate the [`GpuContext`](crate::gpu::GpuContext) and the lodkit objects.
+    /// from the context is dead: recreate the [`GpuContext`](crate::gpu::GpuContext) and the
+    /// lodkit objects.
     #[error(
         "{call}: the GPU device was lost ({reason}: {message}); create a new GpuContext and \
          rebuild the lodkit objects made from the old one"
@@ -158,7 +159,8 @@ pub enum GpuError {
     },
     /// wgpu's GL backend gave up waiting for its GL context lock (6 s): another thread held the
     /// context, outside lodkit's calls (they pass one at a time, see
-    /// [`GpuContext::exclusive`](crate::gpu::GpuContext::exclusive)). Nothing is lost: the call did nothing and may be retried.
+    /// [`GpuContext::exclusive`](crate::gpu::GpuContext::exclusive)). Nothing is lost: the call
+    /// did nothing and may be retried.
     #[error(
         "{call}: wgpu's GL backend waited more than 6 s for the GL context, which another \
          thread held; nothing was lost, retry, and run that thread's device work through \

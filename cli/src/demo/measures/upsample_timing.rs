@@ -3,9 +3,9 @@
 //! hardware-filtered bilinear fetch (the combine's timings are in
 //! [`combine_timing`](crate::demo::measures::combine_timing), the packed upsample's in
 //! [`packed_upsample_timing`](crate::demo::measures::packed_upsample_timing)). Each figure is
-//! read from the [`Clock`] it names: GPU timestamps around
-//! a run of recordings where the device has them, so the submission's fixed cost sits on neither side of a ratio; the wall
-//! clock otherwise.
+//! read from the [`Clock`] it names: GPU timestamps around a run of recordings where the device
+//! has them, so the submission's fixed cost sits on neither side of a ratio; the wall clock
+//! otherwise.
 
 use serde::Serialize;
 
