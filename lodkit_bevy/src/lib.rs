@@ -36,6 +36,8 @@
 
 pub mod frame_sequential;
 pub mod framebuffer_lod;
+#[cfg(feature = "gltf")]
+pub mod gltf_lod;
 #[cfg(feature = "lod_chain")]
 pub mod lod_chain;
 mod shaders;

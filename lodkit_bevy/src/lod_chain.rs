@@ -7,10 +7,9 @@
 //!
 //! ```no_run
 //! # use bevy::prelude::*;
-//! # use lodkit_bevy::frame_sequential::FrameSequentialMaterial;
 //! use lodkit_bevy::lod_chain::{LodChainDescriptor, MeshLodChain, PixelErrorCamera};
 //! # fn spawn(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>,
-//! #          material: Handle<FrameSequentialMaterial>, mesh: Mesh) -> Result<(), BevyError> {
+//! #          material: Handle<StandardMaterial>, mesh: Mesh) -> Result<(), BevyError> {
 //! let chain = MeshLodChain::build(&mesh, &LodChainDescriptor::default())?;
 //! let camera = PixelErrorCamera { fov_y: std::f32::consts::FRAC_PI_4, viewport_height: 1080.0, ..default() };
 //! let levels = chain.lod_levels(&mut meshes, |_| material.clone());
@@ -33,7 +32,7 @@ pub use lodkit::lod_chain::{
 };
 use lodkit::select::LodGroup;
 
-use crate::frame_sequential::{FrameSequentialGroup, FrameSequentialMaterial, LodLevel, LodLevels};
+use crate::frame_sequential::{FrameSequentialGroup, LevelMaterial, LodLevel, LodLevels};
 
 /// Why a mesh could not be made into a chain.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -145,11 +144,12 @@ impl MeshLodChain {
         &self.meshes
     }
 
-    /// The levels added to `meshes`, each with the material `material(level)` gives.
-    pub fn lod_levels(
+    /// The levels added to `meshes`, each with the material `material(level)` gives (a
+    /// `Handle<StandardMaterial>` or a `Handle<FrameSequentialMaterial>`).
+    pub fn lod_levels<M: Into<LevelMaterial>>(
         &self,
         meshes: &mut Assets<Mesh>,
-        mut material: impl FnMut(usize) -> Handle<FrameSequentialMaterial>,
+        mut material: impl FnMut(usize) -> M,
     ) -> LodLevels {
         LodLevels(
             self.meshes

@@ -349,6 +349,34 @@ fn a_combine_without_reprojection_fails_the_flicker_limits() {
     }
 }
 
+/// Bevy's default camera has MSAA (`Msaa::Sample4`), where the combine cannot run: the plugin
+/// draws both levels through lodkit's complementary screen-door dither instead, so the change
+/// is spread over the transition (no pop) and no background shows through. Measured (lavapipe,
+/// every camera `Msaa::Sample4`, no prepass): pop 0.0434 / 0.0339 against Bevy's crossfade's
+/// 0.0435 / 0.0348 (still / moving camera), see-through 0, ghosts 0, no combine. Without the
+/// fallback (the switch at once it replaced) the whole change lands in one frame.
+#[test]
+fn msaa_blends_with_the_dither_without_a_pop_or_a_hole() {
+    let Some(r) = report(&["--msaa", "--without-prepass-only"]) else {
+        return;
+    };
+    assert_eq!(r["msaa"], true);
+    for path in ["static", "moving"] {
+        let (ours, theirs) = (
+            num(&r, &format!("pop_frame_sequential_{path}")),
+            num(&r, &format!("pop_bevy_crossfade_{path}")),
+        );
+        assert!(
+            ours > 0.0 && ours <= 1.1 * theirs,
+            "pop {path} with MSAA: {ours} vs Bevy's {theirs}"
+        );
+    }
+    assert_eq!(num(&r, "see_through_frame_sequential"), 0.0, "{r}");
+    assert_eq!(num(&r, "min_coverage_frame_sequential"), 1.0, "{r}");
+    assert_eq!(num(&r, "ghosts_frame_sequential"), 0.0, "{r}");
+    assert_eq!(num(&r, "fragments_frame_sequential_combine"), 0.0, "{r}");
+}
+
 /// The frame-sequential runs' frames in `dir` (`--frames`), per folder: its name and its PNG
 /// files' bytes, in name order.
 fn run_frames(dir: &std::path::Path) -> Vec<(String, Vec<Vec<u8>>)> {

@@ -26,10 +26,23 @@ struct ScreenshotInbox(Option<Image>);
 /// A headless app with `plugins` added: no window, no runner, shaders compiled synchronously so
 /// the first frames draw.
 pub fn build_app(plugins: impl FnOnce(&mut App)) -> App {
+    build_app_with_assets(None, plugins)
+}
+
+/// [`build_app`] whose `AssetServer` reads from `assets` (None: Bevy's default `assets` folder).
+pub fn build_app_with_assets(assets: Option<&Path>, plugins: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
+    let asset_plugin = match assets {
+        Some(dir) => AssetPlugin {
+            file_path: dir.to_string_lossy().into_owned(),
+            ..default()
+        },
+        None => AssetPlugin::default(),
+    };
     app.add_plugins(
         DefaultPlugins
             .build()
+            .set(asset_plugin)
             // The tests' window test enables winit in this crate's dev build; a headless app
             // runs no event loop.
             .disable::<bevy::winit::WinitPlugin>()

@@ -9,7 +9,7 @@
 //! cargo run --example frame_sequential [-- [--out DIR] [--report FILE] [--frames DIR]
 //!     [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection]
 //!     [--coverage estimated|silhouette|depth-pass] [--combine-region hulls|rectangles]
-//!     [--without-prepass-only]]
+//!     [--without-prepass-only] [--chain] [--msaa]]
 //! ```
 //!
 //! Writes into DIR (default `lodkit-bevy-frame-sequential`) `strip_<run>.png` (7 frames over the
@@ -25,6 +25,9 @@
 //! `FrameSequentialLod::combine_region` (default `hulls`; `rectangles`, the groups' screen
 //! rectangles, draws the same picture with more of the combine's fragments:
 //! `fragments_<run>_combine`). `--without-prepass-only` skips the app with a prepass.
+//! `--msaa` gives every camera Bevy's default `Msaa::Sample4`: the frame-sequential runs then take
+//! the plugin's fallback, lodkit's complementary screen-door dither (in the app with a prepass,
+//! a switch at once).
 //! Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
 //!
 //! The scene is `scene.rs` (what a Bevy app writes to use the plugin is there, in
@@ -62,12 +65,13 @@ pub struct Args {
     reprojection: bool,
     coverage: OlderCoverage,
     combine_region: CombineRegion,
+    msaa: bool,
 }
 
 const USAGE: &str = "usage: frame_sequential [--out DIR] [--report FILE] [--frames DIR] \
 [--schedule paper|complementary] [--anchor screen|object] [--no-reprojection] \
 [--coverage estimated|silhouette|depth-pass] [--combine-region hulls|rectangles] \
-[--without-prepass-only] [--chain]";
+[--without-prepass-only] [--chain] [--msaa]";
 
 fn parse() -> Result<Option<Args>, String> {
     let mut args = Args {
@@ -80,6 +84,7 @@ fn parse() -> Result<Option<Args>, String> {
         reprojection: true,
         coverage: OlderCoverage::default(),
         combine_region: CombineRegion::default(),
+        msaa: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -106,6 +111,7 @@ fn parse() -> Result<Option<Args>, String> {
             }
             "--no-reprojection" => args.reprojection = false,
             "--chain" => scene::use_chain(),
+            "--msaa" => args.msaa = true,
             "--coverage" => {
                 args.coverage = match value()?.as_str() {
                     "estimated" => OlderCoverage::Estimated,

@@ -260,6 +260,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         format!("{:?}", args.anchor).to_lowercase().into(),
     );
     report.insert("reprojection".into(), args.reprojection.into());
+    report.insert("msaa".into(), args.msaa.into());
     report.insert(
         "coverage".into(),
         format!("{:?}", args.coverage).to_lowercase().into(),

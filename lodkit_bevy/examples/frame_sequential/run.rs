@@ -203,7 +203,7 @@ impl Harness {
                 ..default()
             },
             RenderTarget::from(self.target.clone()),
-            Msaa::Off,
+            if args.msaa { Msaa::Sample4 } else { Msaa::Off },
             Tonemapping::None,
             DebandDither::Disabled,
             camera_at(false, 0).0,

@@ -13,9 +13,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use bevy::camera::visibility::VisibilityRange;
 use bevy::prelude::*;
 use lodkit::select::LodGroup;
-use lodkit_bevy::frame_sequential::{
-    FrameSequentialExtension, FrameSequentialGroup, FrameSequentialMaterial, LodLevel, LodLevels,
-};
+use lodkit_bevy::frame_sequential::{FrameSequentialGroup, LodLevel, LodLevels};
 use lodkit_bevy::lod_chain::{LodChainDescriptor, MeshLodChain, PixelErrorCamera};
 
 /// Frames of a run.
@@ -212,14 +210,13 @@ pub fn spawn_groups(world: &mut World, technique: Technique) -> Vec<(Entity, Vec
             let transform = Transform::from_translation(spec.position);
             match technique {
                 Technique::FrameSequential => {
+                    // The app's own StandardMaterials, as they are: the plugin derives what
+                    // the combine needs.
                     let levels = (0..2)
                         .map(|i| {
                             let material = world
-                                .resource_mut::<Assets<FrameSequentialMaterial>>()
-                                .add(FrameSequentialMaterial {
-                                    base: standard(spec.colors[i]),
-                                    extension: FrameSequentialExtension::default(),
-                                });
+                                .resource_mut::<Assets<StandardMaterial>>()
+                                .add(standard(spec.colors[i]));
                             LodLevel::new(meshes[i].clone(), material)
                         })
                         .collect();

@@ -6,9 +6,10 @@ use std::time::Duration;
 
 use bevy::camera::CameraUpdateSystems;
 use bevy::camera::visibility::VisibilitySystems;
-use bevy::core_pipeline::prepass::MotionVectorPrepass;
+use bevy::core_pipeline::prepass::{
+    DeferredPrepass, DepthPrepass, MotionVectorPrepass, NormalPrepass,
+};
 use bevy::log::warn_once;
-use bevy::mesh::MeshTag;
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Face, TextureUsages};
@@ -18,6 +19,9 @@ use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection, LodState};
 
+use super::dither::{Fallback, dither_draws};
+use super::drawer::{DrawerQuery, show, spawn_levels};
+use super::level_material::{DerivedMaterials, blends, sync_derived_materials};
 use super::rects::{Bounds, group_hull, group_rect, level_bounds, merge_rows, to_lodkit};
 use super::silhouette::{OutlineView, Surfaces, forget_changed_meshes, outline};
 use super::tag::{decode_tag, encode_tag};
@@ -31,11 +35,13 @@ pub(super) fn build(app: &mut App) {
     app.init_resource::<Scheduler>()
         .init_resource::<FrameSequentialStats>()
         .init_resource::<Surfaces>()
+        .init_resource::<DerivedMaterials>()
         .add_systems(
             PostUpdate,
             (
                 configure_depth_copies,
                 spawn_levels,
+                sync_derived_materials,
                 forget_changed_meshes,
                 update,
             )
@@ -44,12 +50,22 @@ pub(super) fn build(app: &mut App) {
                 .after(CameraUpdateSystems)
                 .before(VisibilitySystems::VisibilityPropagate),
         );
+    #[cfg(feature = "gltf")]
+    app.add_systems(
+        PostUpdate,
+        crate::gltf_lod::spawn_gltf_groups
+            .before(configure_depth_copies)
+            .after(TransformSystems::Propagate),
+    );
 }
 
 /// lodkit's transition scheduler for the app's frame-sequential camera, and the key of each
 /// group in it (released when the group goes away).
 #[derive(Resource, Default)]
-struct Scheduler(TransitionScheduler, Vec<(Entity, InstanceKey)>);
+pub(super) struct Scheduler(
+    pub(super) TransitionScheduler,
+    pub(super) Vec<(Entity, InstanceKey)>,
+);
 
 /// What the plugin keeps of a [`FrameSequentialGroup`] (inserted by the plugin).
 #[derive(Component, Clone, Debug)]
@@ -58,17 +74,20 @@ pub struct FrameSequentialLevels {
     /// level drawn each frame. One entity, not one per level, so Bevy's motion vectors follow
     /// the group from frame to frame (an entity that was hidden last frame gets none).
     pub entity: Entity,
+    /// The second drawing child: the incoming level while the group is drawn through the
+    /// screen-door dither (MSAA, a blending material), else hidden.
+    pub dither_entity: Entity,
     /// The level drawn this frame.
     pub drawn: u8,
     /// lodkit's selection this frame.
     pub selection: Option<LodSelection>,
     /// The transition under way: (from, to).
     pub transition: Option<(u8, u8)>,
-    key: Option<InstanceKey>,
-    state: LodState,
+    pub(super) key: Option<InstanceKey>,
+    pub(super) state: LodState,
     /// The group's model matrix last frame (where the older buffer holds it).
-    previous_model: Option<Mat4>,
-    bounds: Option<Bounds>,
+    pub(super) previous_model: Option<Mat4>,
+    pub(super) bounds: Option<Bounds>,
 }
 
 /// What the last frame's selection did, for reports and tests.
@@ -103,53 +122,6 @@ fn configure_depth_copies(mut cameras: Query<&mut Camera3d, With<FrameSequential
         if !usages.contains(TextureUsages::COPY_SRC) {
             camera.depth_texture_usages = (usages | TextureUsages::COPY_SRC).into();
         }
-    }
-}
-
-/// Spawns the drawing child of every new or changed [`LodLevels`]. A changed group starts over:
-/// its old drawer goes, and so do its transition slot and t-instance id in the scheduler.
-fn spawn_levels(
-    mut commands: Commands,
-    mut scheduler: ResMut<Scheduler>,
-    groups: Query<(Entity, &LodLevels, Option<&FrameSequentialLevels>), Changed<LodLevels>>,
-) {
-    let Scheduler(scheduler, keys) = &mut *scheduler;
-    for (group, levels, old) in &groups {
-        if let Some(old) = old {
-            commands.entity(old.entity).despawn();
-            if let Some(key) = old.key {
-                let _ = scheduler.remove(key);
-            }
-            keys.retain(|&(g, _)| g != group);
-            commands.entity(group).remove::<FrameSequentialLevels>();
-        }
-        if levels.0.len() > 256 {
-            warn_once!("a LOD group has more than 256 levels: the rest are ignored");
-        }
-        let Some(first) = levels.0.first() else {
-            warn_once!("a LOD group has no levels: nothing is drawn");
-            continue;
-        };
-        let entity = commands
-            .spawn((
-                Mesh3d(first.mesh.clone()),
-                MeshMaterial3d(first.material.clone()),
-                MeshTag::new(0),
-                Transform::IDENTITY,
-                Visibility::Hidden,
-                ChildOf(group),
-            ))
-            .id();
-        commands.entity(group).insert(FrameSequentialLevels {
-            entity,
-            drawn: 0,
-            selection: None,
-            transition: None,
-            key: None,
-            state: LodState::NEW,
-            previous_model: None,
-            bounds: None,
-        });
     }
 }
 
@@ -220,6 +192,9 @@ type CameraQuery<'w, 's> = Query<
         Option<&'static FrameSequentialView>,
         Option<&'static Msaa>,
         Has<MotionVectorPrepass>,
+        Has<DepthPrepass>,
+        Has<NormalPrepass>,
+        Has<DeferredPrepass>,
     ),
 >;
 
@@ -243,17 +218,13 @@ fn update(
     time: Res<Time>,
     meshes: Res<Assets<Mesh>>,
     materials: Res<Assets<FrameSequentialMaterial>>,
+    derived: Res<DerivedMaterials>,
     mut scheduler: ResMut<Scheduler>,
     mut stats: ResMut<FrameSequentialStats>,
     mut surfaces: ResMut<Surfaces>,
     cameras: CameraQuery,
     mut groups: GroupQuery,
-    mut drawers: Query<(
-        &mut Visibility,
-        &mut MeshTag,
-        &mut Mesh3d,
-        &mut MeshMaterial3d<FrameSequentialMaterial>,
-    )>,
+    mut drawers: DrawerQuery,
     stale: Query<Entity, (With<FrameSequentialView>, Without<FrameSequentialLod>)>,
 ) {
     for camera in &stale {
@@ -267,20 +238,39 @@ fn update(
         }
         live
     });
-    let Some((camera_entity, camera, camera_transform, settings, last, msaa, has_motion)) =
-        cameras.iter().find(|(_, c, ..)| c.is_active)
+    let Some((
+        camera_entity,
+        camera,
+        camera_transform,
+        settings,
+        last,
+        msaa,
+        has_motion,
+        has_depth,
+        has_normal,
+        has_deferred,
+    )) = cameras.iter().find(|(_, c, ..)| c.is_active)
     else {
         return;
     };
+    let prepass = has_motion || has_depth || has_normal || has_deferred;
     // The combine reads and copies the main pass per pixel: a multisampled camera gets no
-    // combine, and then no transition may begin (a group switches at once, as with
-    // `TransitionMode::Hard`).
+    // combine; its groups are drawn through the screen-door dither, or switch at once where a
+    // prepass rules the dither out (`dither::Fallback`).
     let multisampled = msaa.is_some_and(|m| *m != Msaa::Off);
     if multisampled {
-        warn_once!(
-            "FrameSequentialLod needs Msaa::Off on its camera (the combine reads the main pass \
-             per pixel): its LOD groups switch levels at once"
-        );
+        if prepass {
+            warn_once!(
+                "FrameSequentialLod on a camera with MSAA and a prepass: the combine needs \
+                 Msaa::Off and the screen-door dither no prepass, so its LOD groups switch \
+                 levels at once"
+            );
+        } else {
+            warn_once!(
+                "FrameSequentialLod on a camera with MSAA: its LOD groups blend with lodkit's \
+                 complementary screen-door dither (Msaa::Off for the frame-sequential combine)"
+            );
+        }
         commands
             .entity(camera_entity)
             .remove::<FrameSequentialView>();
@@ -341,7 +331,42 @@ fn update(
             time.delta_secs(),
             &mut state.state,
         );
-        keep_frame |= reconcile(scheduler, state, &selection, older_kept);
+        let blending = levels.0.iter().any(|l| {
+            derived
+                .resolve(&l.material)
+                .and_then(|m| materials.get(&m))
+                .is_some_and(|m| blends(m.base.alpha_mode))
+        });
+        let fallback = Fallback::of(multisampled, blending, prepass);
+        if blending {
+            warn_once!(
+                "a LOD group has a blending material (AlphaMode::Blend, ...), whose alpha cannot \
+                 carry the combine's id word: {}",
+                if fallback == Fallback::Dither {
+                    "it blends with the screen-door dither"
+                } else {
+                    "with a prepass on the camera it switches levels at once"
+                }
+            );
+        }
+        if fallback == Fallback::Dither {
+            if let Some(key) = state.key.take() {
+                let _ = scheduler.remove(key);
+                keys.retain(|&(g, _)| g != entity);
+            }
+            state.transition = None;
+            state.previous_model = Some(model);
+            state.selection = Some(selection);
+            state.drawn = selection.current;
+            for (drawer, draw) in [state.entity, state.dither_entity]
+                .into_iter()
+                .zip(dither_draws(&selection))
+            {
+                show(&mut drawers, drawer, draw, levels, &derived);
+            }
+            continue;
+        }
+        keep_frame |= reconcile(scheduler, state, &selection, older_kept && !blending);
         if state.key != had_key {
             keys.retain(|&(g, _)| g != entity);
             keys.extend(state.key.map(|k| (entity, k)));
@@ -400,8 +425,9 @@ fn update(
             let mut hull = None;
             if let Some(other) = other.filter(|_| selection.visible && settings.coverage.is_exact())
             {
-                let cull_mode = materials
-                    .get(&other.material)
+                let cull_mode = derived
+                    .resolve(&other.material)
+                    .and_then(|m| materials.get(&m))
                     .map_or(Some(Face::Back), |m| m.base.cull_mode);
                 // Where the level's silhouette can be had on the CPU (a closed triangle mesh
                 // with its positions, culled as usual), it tells the coverage; else the
@@ -477,23 +503,9 @@ fn update(
         state.previous_model = Some(model);
         state.selection = Some(selection);
         state.drawn = lod;
-        let level = levels.0.get(usize::from(lod)).or(levels.0.last());
-        if let (Ok((mut visibility, mut mesh_tag, mut mesh, mut material)), Some(level)) =
-            (drawers.get_mut(state.entity), level)
-        {
-            visibility.set_if_neq(if selection.visible {
-                Visibility::Inherited
-            } else {
-                Visibility::Hidden
-            });
-            mesh_tag.set_if_neq(MeshTag::new(tag));
-            if mesh.0 != level.mesh {
-                mesh.0 = level.mesh.clone();
-            }
-            if material.0 != level.material {
-                material.0 = level.material.clone();
-            }
-        }
+        let draw = selection.visible.then_some((lod, tag));
+        show(&mut drawers, state.entity, draw, levels, &derived);
+        show(&mut drawers, state.dither_entity, None, levels, &derived);
     }
     // A rectangle and a row may overlap (groups with and without hulls): that pixel is combined
     // twice, to the same color.

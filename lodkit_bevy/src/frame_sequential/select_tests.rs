@@ -2,8 +2,10 @@
 
 use bevy::ecs::system::RunSystemOnce;
 
+use bevy::mesh::MeshTag;
+
 use super::*;
-use crate::frame_sequential::LodLevel;
+use crate::frame_sequential::{DITHER_TAG_ID, LodLevel};
 use lodkit::select::LodGroup;
 use std::f32::consts::FRAC_PI_2;
 
@@ -17,6 +19,7 @@ fn world_with_group(msaa: Msaa) -> (World, Entity) {
     world.init_resource::<Scheduler>();
     world.init_resource::<FrameSequentialStats>();
     world.init_resource::<Surfaces>();
+    world.init_resource::<DerivedMaterials>();
     let mut camera = Camera::default();
     // P[1][1] = 1: lodkit::select's distance is the distance itself.
     camera.computed.clip_from_view = Mat4::from_cols_array(
@@ -29,7 +32,12 @@ fn world_with_group(msaa: Msaa) -> (World, Entity) {
         FrameSequentialLod::default(),
         msaa,
     ));
-    let level = || LodLevel::new(Handle::default(), Handle::default());
+    let level = || {
+        LodLevel::new(
+            Handle::default(),
+            Handle::<FrameSequentialMaterial>::default(),
+        )
+    };
     let group = world
         .spawn((
             LodLevels(vec![level(), level()]),
@@ -37,7 +45,9 @@ fn world_with_group(msaa: Msaa) -> (World, Entity) {
             GlobalTransform::from_translation(Vec3::new(0.0, 0.0, -1.0)),
         ))
         .id();
-    world.run_system_once(spawn_levels).unwrap();
+    world
+        .run_system_once(super::super::drawer::spawn_levels)
+        .unwrap();
     (world, group)
 }
 
@@ -73,18 +83,37 @@ fn a_transition_begins_after_a_kept_frame() {
     assert_eq!(world.resource::<FrameSequentialStats>().frames_kept, 2);
 }
 
-/// A multisampled camera gets no combine: no frame is kept, no transition begins, the render
-/// world gets no view, and the group switches at once when its selection does.
+/// A multisampled camera gets no combine: no frame is kept, no scheduler transition begins,
+/// the render world gets no view; in the band the group draws both levels through the
+/// complementary screen-door dither, its alphas following the selection, and past the band the
+/// coarse level alone.
 #[test]
-fn a_multisampled_camera_switches_levels_at_once() {
+fn a_multisampled_camera_blends_with_the_dither() {
     let (mut world, group) = world_with_group(Msaa::Sample4);
     assert_eq!(frame(&mut world, group, 1.0), (false, 0, None), "idle");
-    for _ in 0..4 {
-        assert_eq!(
-            frame(&mut world, group, 4.1),
-            (false, 0, None),
-            "in the band"
+    let drawn = |world: &World| {
+        let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+        [levels.entity, levels.dither_entity].map(|e| {
+            let visible = world.get::<Visibility>(e).unwrap() != Visibility::Hidden;
+            let (id, alpha, ..) = decode_tag(world.get::<MeshTag>(e).unwrap().value);
+            visible.then_some((id, alpha))
+        })
+    };
+    let mut last_alpha = -1.0;
+    for z in [3.9, 4.05, 4.2] {
+        assert_eq!(frame(&mut world, group, z), (false, 0, None), "in the band");
+        let [Some(outgoing), Some(incoming)] = drawn(&world) else {
+            panic!("both levels are drawn in the band: {:?}", drawn(&world));
+        };
+        assert_eq!((outgoing.0, incoming.0), (DITHER_TAG_ID, DITHER_TAG_ID));
+        // -(1 - t) and +t: complementary to the tag's steps, t growing with the distance.
+        assert!(
+            outgoing.1 < 0.0 && incoming.1 > 0.0,
+            "{outgoing:?} {incoming:?}"
         );
+        assert!((incoming.1 - outgoing.1 - 1.0).abs() <= 1.0 / 1023.0 + 1e-6);
+        assert!(incoming.1 > last_alpha, "{} after {last_alpha}", incoming.1);
+        last_alpha = incoming.1;
     }
     assert_eq!(
         frame(&mut world, group, 9.0),
@@ -93,8 +122,36 @@ fn a_multisampled_camera_switches_levels_at_once() {
     );
     let levels = world.get::<FrameSequentialLevels>(group).unwrap();
     assert_eq!(levels.drawn, 1, "the coarse level is drawn");
+    // Tag 0 (an n-instance, drawn whole; its tau field decodes to -1).
+    assert_eq!(drawn(&world), [Some((0, -1.0)), None], "one level, whole");
     let mut views = world.query::<&FrameSequentialView>();
     assert_eq!(views.iter(&world).count(), 0, "the render world got a view");
+}
+
+/// With MSAA and a prepass the dither would leave holes (the prepass writes both levels' depth
+/// whole): the group switches at once, one level drawn.
+#[test]
+fn a_multisampled_camera_with_a_prepass_switches_at_once() {
+    let (mut world, group) = world_with_group(Msaa::Sample4);
+    let camera = world
+        .query_filtered::<Entity, With<FrameSequentialLod>>()
+        .single(&world)
+        .unwrap();
+    world
+        .entity_mut(camera)
+        .insert(bevy::core_pipeline::prepass::DepthPrepass);
+    for z in [1.0, 4.1, 4.2] {
+        assert_eq!(frame(&mut world, group, z), (false, 0, None));
+        let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+        assert_eq!(
+            world.get::<Visibility>(levels.dither_entity),
+            Some(&Visibility::Hidden),
+            "one level at {z}"
+        );
+        assert_eq!(levels.drawn, 0);
+    }
+    frame(&mut world, group, 9.0);
+    assert_eq!(world.get::<FrameSequentialLevels>(group).unwrap().drawn, 1);
 }
 
 /// A group whose levels change while it is in transition gives its t-instance id and slot
@@ -108,13 +165,20 @@ fn changed_levels_release_the_groups_transition() {
         .begin_transition(key, 1, Drive::Time { seconds: 1.0 })
         .unwrap();
     assert_eq!(scheduler.live_ids().len(), 1);
-    let level = || LodLevel::new(Handle::default(), Handle::default());
+    let level = || {
+        LodLevel::new(
+            Handle::default(),
+            Handle::<FrameSequentialMaterial>::default(),
+        )
+    };
     let drawer = world.spawn_empty().id();
+    let dither_entity = world.spawn_empty().id();
     let group = world
         .spawn((
             LodLevels(vec![level(), level()]),
             FrameSequentialLevels {
                 entity: drawer,
+                dither_entity,
                 drawn: 0,
                 selection: None,
                 transition: Some((0, 1)),
@@ -126,7 +190,9 @@ fn changed_levels_release_the_groups_transition() {
         ))
         .id();
     world.insert_resource(Scheduler(scheduler, vec![(group, key)]));
-    world.run_system_once(spawn_levels).unwrap();
+    world
+        .run_system_once(super::super::drawer::spawn_levels)
+        .unwrap();
     let Scheduler(scheduler, keys) = world.resource::<Scheduler>();
     assert!(
         scheduler.live_ids().is_empty(),

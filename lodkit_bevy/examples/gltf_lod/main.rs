@@ -1,0 +1,216 @@
+//! A glTF scene with LOD levels (`MSFT_lod`, as `lodkit lod` writes them), loaded with Bevy's own
+//! glTF loader into an app whose only lodkit code is `FrameSequentialLodPlugin`: its own
+//! `StandardMaterial`s, Bevy's default MSAA, and a camera walking away through the scene.
+//!
+//! ```text
+//! cargo run --example gltf_lod [-- [--out DIR] [--report FILE] [--gltf FILE]]
+//! ```
+//!
+//! Without `--gltf` it writes `DIR/assets/scene.gltf` (+ `scene.bin`): two spheres with a coarse
+//! level each (`MSFT_lod`, `MSFT_screencoverage` for switch distance [`SWITCH`], view-normalized),
+//! the second level of the second sphere with a material of its own, and a cube without
+//! `MSFT_lod`; then loads it, walks the camera from near to far and writes `DIR/strip.png` and,
+//! with `--report`, JSON: the groups the loader made (`groups`, each with its level count,
+//! switch distances and the levels it drew), `plain_meshes` (the nodes without LOD, drawn as
+//! before), `intended_switch`, and `min_object_pixels` (the fewest non-background pixels of any
+//! frame). With `--gltf FILE` it loads that file (Scene 0) instead.
+//!
+//! Exit codes: 0 done, 1 the scene did not load or render, 2 usage or I/O error.
+
+#[path = "../common/frames.rs"]
+#[allow(
+    dead_code,
+    reason = "shared by the examples and tests; each uses a part"
+)]
+mod frames;
+#[path = "../common/headless.rs"]
+#[allow(dead_code, reason = "shared by the examples; each uses a part")]
+mod headless;
+mod scene;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
+use bevy::prelude::*;
+use lodkit_bevy::FrameSequentialLodPlugin;
+use lodkit_bevy::frame_sequential::{FrameSequentialGroup, FrameSequentialLevels};
+
+use frames::Frame;
+
+/// The view-normalized distance at which the generated file's spheres switch to their coarse
+/// level (written as `MSFT_screencoverage`).
+const SWITCH: f32 = 3.0;
+const WIDTH: u32 = 256;
+const HEIGHT: u32 = 144;
+const FRAMES: usize = 40;
+const BACKGROUND: Color = Color::srgb_u8(20, 23, 31);
+
+const USAGE: &str = "usage: gltf_lod [--out DIR] [--report FILE] [--gltf FILE]";
+
+fn main() -> ExitCode {
+    let mut out = PathBuf::from("lodkit-bevy-gltf-lod");
+    let mut report = None;
+    let mut gltf = None;
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let mut value = || args.next().ok_or(format!("{arg} needs a value"));
+        let parsed = match arg.as_str() {
+            "--out" => value().map(|v| out = v.into()),
+            "--report" => value().map(|v| report = Some(PathBuf::from(v))),
+            "--gltf" => value().map(|v| gltf = Some(PathBuf::from(v))),
+            "-h" | "--help" => {
+                println!("{USAGE}");
+                return ExitCode::SUCCESS;
+            }
+            _ => Err(format!("unknown argument {arg}")),
+        };
+        if let Err(message) = parsed {
+            eprintln!("error: {message}\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    }
+    match run(&out, report.as_deref(), gltf.as_deref()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err((code, message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8, String)> {
+    let io = |e: std::io::Error| (2, e.to_string());
+    let (assets, file) = match gltf {
+        Some(path) => {
+            let path = std::fs::canonicalize(path).map_err(io)?;
+            let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+            (dir, name.unwrap_or_default())
+        }
+        None => {
+            let dir = std::fs::canonicalize(out).or_else(|_| {
+                std::fs::create_dir_all(out)?;
+                std::fs::canonicalize(out)
+            });
+            let dir = dir.map_err(io)?.join("assets");
+            scene::write(&dir, SWITCH).map_err(io)?;
+            (dir, "scene.gltf".to_owned())
+        }
+    };
+    std::fs::create_dir_all(out).map_err(io)?;
+    let mut app = headless::build_app_with_assets(Some(&assets), |app| {
+        app.add_plugins(FrameSequentialLodPlugin);
+    });
+    let world = app.world_mut();
+    let target = headless::render_target(world, WIDTH, HEIGHT);
+    // An app's camera: Bevy's default MSAA is left as it is.
+    let camera = world
+        .spawn((
+            Camera3d::default(),
+            Camera {
+                clear_color: ClearColorConfig::Custom(BACKGROUND),
+                ..default()
+            },
+            RenderTarget::from(target.clone()),
+            // No tonemapping or deband dither, so the background is the clear color exactly
+            // (the figure counts the other pixels).
+            Tonemapping::None,
+            DebandDither::Disabled,
+            lodkit_bevy::FrameSequentialLod::default(),
+            camera_at(0),
+        ))
+        .id();
+    world.spawn((
+        DirectionalLight::default(),
+        Transform::from_xyz(3.0, 6.0, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    let scene = world
+        .resource::<AssetServer>()
+        .load(GltfAssetLabel::Scene(0).from_asset(file.clone()));
+    world.spawn(WorldAssetRoot(scene));
+    // Until the scene is spawned and its groups made.
+    let mut loaded = false;
+    for _ in 0..600 {
+        headless::step(&mut app);
+        let world = app.world_mut();
+        let spawned = world
+            .query_filtered::<Entity, With<WorldAssetRoot>>()
+            .iter(world)
+            .any(|root| world.get::<Children>(root).is_some_and(|c| !c.is_empty()));
+        if spawned {
+            loaded = true;
+            break;
+        }
+    }
+    if !loaded {
+        return Err((1, format!("{file} did not load")));
+    }
+    headless::step(&mut app);
+    let mut frames = Vec::new();
+    let mut drawn: Vec<Vec<u8>> = Vec::new();
+    for frame in 0..FRAMES {
+        *app.world_mut()
+            .get_mut::<Transform>(camera)
+            .expect("camera") = camera_at(frame);
+        frames.push(headless::capture(&mut app, &target).map_err(|e| (1, e))?);
+        let world = app.world_mut();
+        let levels: Vec<u8> = world
+            .query::<&FrameSequentialLevels>()
+            .iter(world)
+            .map(|l| l.drawn)
+            .collect();
+        drawn.resize(levels.len().max(drawn.len()), Vec::new());
+        for (seen, level) in drawn.iter_mut().zip(levels) {
+            if !seen.contains(&level) {
+                seen.push(level);
+            }
+        }
+    }
+    let strip: Vec<Frame> = frames.iter().step_by(FRAMES / 8).cloned().collect();
+    headless::save_png(&frames::strip(&strip), &out.join("strip.png")).map_err(|e| (2, e))?;
+    let world = app.world_mut();
+    let groups: Vec<serde_json::Value> = world
+        .query::<&FrameSequentialGroup>()
+        .iter(world)
+        .zip(&drawn)
+        .map(|(group, drawn)| {
+            let distances: Vec<f32> = group.group.levels().iter().map(|l| l.distance).collect();
+            serde_json::json!({
+                "levels": distances.len(),
+                "distances": distances,
+                "max_distance": group.group.max_distance(),
+                "drawn": drawn,
+            })
+        })
+        .collect();
+    let plain_meshes = world
+        .query_filtered::<(), With<MeshMaterial3d<StandardMaterial>>>()
+        .iter(world)
+        .count();
+    let background = frames::Frame::filled(1, 1, [20, 23, 31]).rgb(0, 0);
+    let min_object_pixels = frames.iter().map(|f| f.object_pixels(background)).min();
+    println!(
+        "{} groups from {file}; {plain_meshes} meshes without LOD; the fewest object pixels in a frame: {}",
+        groups.len(),
+        min_object_pixels.unwrap_or(0)
+    );
+    if let Some(path) = report {
+        let json = serde_json::json!({
+            "groups": groups,
+            "plain_meshes": plain_meshes,
+            "intended_switch": SWITCH,
+            "min_object_pixels": min_object_pixels,
+            "frames": FRAMES,
+        });
+        std::fs::write(path, serde_json::to_string_pretty(&json).expect("JSON")).map_err(io)?;
+    }
+    Ok(())
+}
+
+/// The camera at `frame`: walking back from 2.5 to 12.5 world units in front of the scene.
+fn camera_at(frame: usize) -> Transform {
+    let z = 2.5 + 10.0 * frame as f32 / (FRAMES - 1) as f32;
+    Transform::from_xyz(0.0, 0.6, z).looking_at(Vec3::new(0.0, 0.0, 0.0), Vec3::Y)
+}

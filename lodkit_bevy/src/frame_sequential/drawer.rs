@@ -1,0 +1,119 @@
+//! The child entities that draw a LOD group: one shows the level drawn this frame, the other
+//! the incoming level while the group is drawn through the screen-door dither.
+
+use bevy::camera::visibility::NoFrustumCulling;
+use bevy::log::warn_once;
+use bevy::mesh::MeshTag;
+use bevy::mesh::skinning::SkinnedMesh;
+use bevy::prelude::*;
+use lodkit::select::LodState;
+
+use super::level_material::DerivedMaterials;
+use super::select::{FrameSequentialLevels, Scheduler};
+use super::{FrameSequentialMaterial, LodLevels};
+
+/// Spawns the drawing child of every new or changed [`LodLevels`]. A changed group starts over:
+/// its old drawer goes, and so do its transition slot and t-instance id in the scheduler.
+pub(super) fn spawn_levels(
+    mut commands: Commands,
+    mut scheduler: ResMut<Scheduler>,
+    groups: Query<
+        (
+            Entity,
+            &LodLevels,
+            Option<&FrameSequentialLevels>,
+            Option<&SkinnedMesh>,
+        ),
+        Changed<LodLevels>,
+    >,
+) {
+    let Scheduler(scheduler, keys) = &mut *scheduler;
+    for (group, levels, old, skin) in &groups {
+        if let Some(old) = old {
+            commands.entity(old.entity).despawn();
+            commands.entity(old.dither_entity).despawn();
+            if let Some(key) = old.key {
+                let _ = scheduler.remove(key);
+            }
+            keys.retain(|&(g, _)| g != group);
+            commands.entity(group).remove::<FrameSequentialLevels>();
+        }
+        if levels.0.len() > 256 {
+            warn_once!("a LOD group has more than 256 levels: the rest are ignored");
+        }
+        let Some(first) = levels.0.first() else {
+            warn_once!("a LOD group has no levels: nothing is drawn");
+            continue;
+        };
+        // The material is set each frame, once a StandardMaterial's derived one is there.
+        let mut drawer = || {
+            let mut drawer = commands.spawn((
+                Mesh3d(first.mesh.clone()),
+                MeshMaterial3d(Handle::<FrameSequentialMaterial>::default()),
+                MeshTag::new(0),
+                Transform::IDENTITY,
+                Visibility::Hidden,
+                ChildOf(group),
+            ));
+            // A skinned group (a glTF primitive with a skin) is drawn with its joints; its box
+            // moves with them, so the drawers are not culled by the rest pose's.
+            if let Some(skin) = skin {
+                drawer.insert((skin.clone(), NoFrustumCulling));
+            }
+            drawer.id()
+        };
+        let (entity, dither_entity) = (drawer(), drawer());
+        commands.entity(group).insert(FrameSequentialLevels {
+            entity,
+            dither_entity,
+            drawn: 0,
+            selection: None,
+            transition: None,
+            key: None,
+            state: LodState::NEW,
+            previous_model: None,
+            bounds: None,
+        });
+    }
+}
+
+pub(super) type DrawerQuery<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static mut Visibility,
+        &'static mut MeshTag,
+        &'static mut Mesh3d,
+        &'static mut MeshMaterial3d<FrameSequentialMaterial>,
+    ),
+>;
+
+/// Shows level `draw.0` of `levels` with tag `draw.1` through `drawer`, or hides it (None, or
+/// a level whose material is not there yet).
+pub(super) fn show(
+    drawers: &mut DrawerQuery,
+    drawer: Entity,
+    draw: Option<(u8, u32)>,
+    levels: &LodLevels,
+    derived: &DerivedMaterials,
+) {
+    let Ok((mut visibility, mut mesh_tag, mut mesh, mut material)) = drawers.get_mut(drawer) else {
+        return;
+    };
+    let shown = draw.and_then(|(lod, tag)| {
+        let level = levels.0.get(usize::from(lod)).or(levels.0.last())?;
+        Some((level, derived.resolve(&level.material)?, tag))
+    });
+    let Some((level, handle, tag)) = shown else {
+        visibility.set_if_neq(Visibility::Hidden);
+        return;
+    };
+    visibility.set_if_neq(Visibility::Inherited);
+    mesh_tag.set_if_neq(MeshTag::new(tag));
+    if mesh.0 != level.mesh {
+        mesh.0 = level.mesh.clone();
+    }
+    if material.0 != handle {
+        material.0 = handle;
+    }
+}

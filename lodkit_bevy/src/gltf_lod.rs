@@ -1,0 +1,381 @@
+//! glTF files with LOD levels (`MSFT_lod`, the files `lodkit lod` writes; Babylon.js's and
+//! others') as frame-sequential LOD groups, loaded by Bevy's own glTF loader: adding
+//! [`FrameSequentialLodPlugin`](crate::FrameSequentialLodPlugin) is all the code an app writes.
+//!
+//! Bevy's loader spawns a node's finest level only (the levels' nodes are named by the
+//! extension alone). The plugin's glTF extension handler sees each node with `MSFT_lod`, and
+//! puts on its entity a [`GltfLod`]: for every primitive of the node's mesh, the same primitive in
+//! each level's mesh (with the level's material where it has another), and the switch
+//! distances. When the scene is spawned, each primitive's entity becomes a
+//! [`FrameSequentialGroup`] with those [`LodLevels`], its `StandardMaterial` used as it is
+//! ([`LevelMaterial`](crate::frame_sequential::LevelMaterial)), its transform, its node's children
+//! and its skin (`SkinnedMesh`, given to the entities that draw it) kept. A file without
+//! `MSFT_lod` loads as before.
+//!
+//! The switch distances come from `MSFT_screencoverage` (the node's extras: one screen share per
+//! level, below which the next level takes over, and below the last the object is hidden) as
+//! `lodkit lod` defines it: the share of the viewport that the sphere of half the node's box
+//! diagonal covers, `π R² / (4 aspect d²)` at view-normalized distance `d`, so
+//! `d = R sqrt(π / (4 aspect c))`, with the aspect [`GLTF_COVERAGE_ASPECT`] (`lodkit lod`'s
+//! default). The primitives of one node share them, so the object switches as a whole. A node
+//! without coverages switches where its sphere's projected radius halves: level `i` from
+//! `d = 2^i R` (a size rule, not a pixel-error bound: give the file coverages, as `lodkit lod`
+//! does, for that).
+
+use bevy::asset::LoadContext;
+use bevy::gltf::extensions::{
+    ErasedGltfExtensionHandler, GltfExtensionHandler, GltfExtensionHandlers,
+};
+use bevy::gltf::gltf;
+use bevy::log::warn;
+use bevy::prelude::*;
+use lodkit::select::LodGroup;
+
+use crate::frame_sequential::{FrameSequentialGroup, LodLevel, LodLevels};
+
+/// The viewport aspect (width / height) a file's `MSFT_screencoverage` is read with: `lodkit
+/// lod`'s default `--aspect`, 16:9.
+pub const GLTF_COVERAGE_ASPECT: f32 = 16.0 / 9.0;
+
+/// A glTF node's LOD levels, put on its entity by the glTF loader (with the plugin) and turned
+/// into [`FrameSequentialGroup`]s, one per primitive, when the scene is spawned.
+#[derive(Component, Reflect, Clone, Debug, Default, PartialEq)]
+#[reflect(Component, Default, Clone)]
+pub struct GltfLod {
+    /// Per primitive of the node's own (finest) mesh: that primitive in every level.
+    pub primitives: Vec<GltfLodPrimitive>,
+    /// The view-normalized distance from which each level is shown, the finest's 0 first.
+    pub distances: Vec<f32>,
+    /// Beyond this view-normalized distance nothing is shown (the last coverage).
+    pub max_distance: Option<f32>,
+}
+
+/// One primitive of a node with LOD levels: [`GltfLod::primitives`].
+#[derive(Reflect, Clone, Debug, Default, PartialEq)]
+#[reflect(Default, Clone)]
+pub struct GltfLodPrimitive {
+    /// The primitive's mesh in the finest level (the one Bevy spawns).
+    pub mesh: Handle<Mesh>,
+    /// The same primitive in each coarser level.
+    pub levels: Vec<GltfLodLevel>,
+}
+
+/// A primitive in one coarser level: [`GltfLodPrimitive::levels`].
+#[derive(Reflect, Clone, Debug, Default, PartialEq)]
+#[reflect(Default, Clone)]
+pub struct GltfLodLevel {
+    /// The level's mesh of the primitive.
+    pub mesh: Handle<Mesh>,
+    /// The level's material where it is not the finest level's (None: the primitive entity's
+    /// own).
+    pub material: Option<Handle<StandardMaterial>>,
+}
+
+/// Registers the glTF extension handler and the system that makes groups of the nodes it marks.
+pub(crate) fn build(app: &mut App) {
+    app.register_type::<GltfLod>()
+        .register_type::<GltfLodPrimitive>()
+        .register_type::<GltfLodLevel>()
+        .register_type::<Vec<GltfLodPrimitive>>()
+        .register_type::<Vec<GltfLodLevel>>()
+        .register_type::<Option<Handle<StandardMaterial>>>()
+        .register_type::<Option<f32>>()
+        .register_type::<Vec<f32>>();
+    app.world_mut()
+        .get_resource_or_init::<GltfExtensionHandlers>()
+        .0
+        .write_blocking()
+        .push(Box::new(MsftLod::default()));
+}
+
+/// What the handler keeps of the document while it loads (one clone per load).
+#[derive(Clone, Default)]
+struct MsftLod {
+    /// Per node: its mesh's index and each primitive's material index.
+    nodes: Vec<Option<(usize, Vec<Option<usize>>)>>,
+}
+
+impl GltfExtensionHandler for MsftLod {
+    fn dyn_clone(&self) -> Box<dyn ErasedGltfExtensionHandler> {
+        Box::new(self.clone())
+    }
+
+    fn on_root(
+        &mut self,
+        _load_context: &mut LoadContext<'_>,
+        gltf: &gltf::Gltf,
+        _settings: &bevy::gltf::GltfLoaderSettings,
+    ) {
+        self.nodes = gltf
+            .nodes()
+            .map(|node| {
+                node.mesh().map(|mesh| {
+                    let materials = mesh.primitives().map(|p| p.material().index()).collect();
+                    (mesh.index(), materials)
+                })
+            })
+            .collect();
+    }
+
+    fn on_gltf_node(
+        &mut self,
+        load_context: &mut LoadContext<'_>,
+        gltf_node: &gltf::Node,
+        entity: &mut EntityWorldMut,
+    ) {
+        let Some(lod) = gltf_node.extension_value("MSFT_lod") else {
+            return;
+        };
+        let path = load_context.path().to_string();
+        let name = gltf_node.name().map_or_else(
+            || format!("node {}", gltf_node.index()),
+            |n| format!("node {n:?}"),
+        );
+        match self.levels(load_context, gltf_node, lod) {
+            Ok(levels) => {
+                entity.insert(levels);
+            }
+            Err(why) => {
+                warn!("{path}: {name}: MSFT_lod ignored (the finest level is shown): {why}")
+            }
+        }
+    }
+}
+
+impl MsftLod {
+    /// The [`GltfLod`] of `node`, whose `MSFT_lod` extension is `lod`.
+    fn levels(
+        &self,
+        load_context: &mut LoadContext<'_>,
+        node: &gltf::Node,
+        lod: &gltf::json::Value,
+    ) -> Result<GltfLod, String> {
+        let mesh = node.mesh().ok_or("the node has no mesh")?;
+        let ids = lod
+            .get("ids")
+            .and_then(|ids| ids.as_array())
+            .ok_or("no \"ids\" array")?;
+        let mut level_nodes = Vec::new();
+        for id in ids {
+            let id = id
+                .as_u64()
+                .and_then(|i| usize::try_from(i).ok())
+                .ok_or_else(|| format!("id {id} is not a node index"))?;
+            match self.nodes.get(id) {
+                Some(Some(info)) => level_nodes.push(info.clone()),
+                Some(None) => return Err(format!("level node {id} has no mesh")),
+                None => return Err(format!("level node {id} does not exist")),
+            }
+        }
+        // The sphere `lodkit lod` measures coverage with: half the diagonal of the box of every
+        // primitive of the finest mesh.
+        // (The accessor's min and max, which glTF requires of positions; read here, not with
+        // the gltf crate's `bounding_box`, which panics where a file lacks them.)
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for p in mesh.primitives() {
+            let positions = p
+                .get(&gltf::Semantic::Positions)
+                .ok_or_else(|| format!("primitive {} has no positions", p.index()))?;
+            let corner = |v: Option<gltf::json::Value>| -> Option<Vec3> {
+                let v: Vec<f32> = gltf::json::deserialize::from_value(v?).ok()?;
+                (v.len() == 3).then(|| Vec3::new(v[0], v[1], v[2]))
+            };
+            let (Some(min), Some(max)) = (corner(positions.min()), corner(positions.max())) else {
+                return Err(format!(
+                    "primitive {}'s positions have no min and max (glTF requires them)",
+                    p.index()
+                ));
+            };
+            lo = lo.min(min);
+            hi = hi.max(max);
+        }
+        let radius = 0.5 * lo.distance(hi);
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(format!("the mesh's box has no size (radius {radius})"));
+        }
+        let coverage = screen_coverage(node)?;
+        let (distances, max_distance) = switch_distances(radius, coverage.as_deref(), ids.len())?;
+        let primitives = mesh
+            .primitives()
+            .map(|p| {
+                let own = p.material().index();
+                GltfLodPrimitive {
+                    mesh: load_context.get_label_handle(format!(
+                        "Mesh{}/Primitive{}",
+                        mesh.index(),
+                        p.index()
+                    )),
+                    levels: level_nodes
+                        .iter()
+                        .map(|(m, materials)| {
+                            // The same primitive, or the level's last where it has fewer.
+                            let k = p.index().min(materials.len().saturating_sub(1));
+                            let material = materials.get(k).copied().flatten();
+                            let level_mesh =
+                                load_context.get_label_handle(format!("Mesh{m}/Primitive{k}"));
+                            let material = (material != own)
+                                .then_some(material)
+                                .flatten()
+                                .map(|i| load_context.get_label_handle(format!("Material{i}/std")));
+                            GltfLodLevel {
+                                mesh: level_mesh,
+                                material,
+                            }
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        Ok(GltfLod {
+            primitives,
+            distances,
+            max_distance,
+        })
+    }
+}
+
+/// The node's `MSFT_screencoverage` (its extras), None where it has none.
+fn screen_coverage(node: &gltf::Node) -> Result<Option<Vec<f32>>, String> {
+    let Some(extras) = node.extras() else {
+        return Ok(None);
+    };
+    let value: gltf::json::Value =
+        gltf::json::deserialize::from_str(extras.get()).map_err(|e| format!("extras: {e}"))?;
+    let Some(list) = value.get("MSFT_screencoverage") else {
+        return Ok(None);
+    };
+    let list = list
+        .as_array()
+        .ok_or("MSFT_screencoverage is not an array")?;
+    list.iter()
+        .map(|c| {
+            c.as_f64()
+                .map(|c| c as f32)
+                .ok_or_else(|| format!("MSFT_screencoverage holds {c}, not a number"))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+}
+
+/// The view-normalized distances from which each of `1 + coarser` levels is shown and the
+/// distance beyond which none is, for a sphere of `radius` with `coverage` (see the module
+/// docs).
+pub fn switch_distances(
+    radius: f32,
+    coverage: Option<&[f32]>,
+    coarser: usize,
+) -> Result<(Vec<f32>, Option<f32>), String> {
+    let Some(coverage) = coverage else {
+        let distances = (0..=coarser)
+            .map(|i| {
+                if i == 0 {
+                    0.0
+                } else {
+                    radius * (1u64 << i.min(60)) as f32
+                }
+            })
+            .collect();
+        return Ok((distances, None));
+    };
+    if coverage.len() < coarser {
+        return Err(format!(
+            "MSFT_screencoverage has {} values for {} levels",
+            coverage.len(),
+            coarser + 1
+        ));
+    }
+    let distance = |c: f32| -> Result<f32, String> {
+        if !(c.is_finite() && c > 0.0) {
+            return Err(format!("screen coverage {c} is not a positive number"));
+        }
+        Ok(radius * (std::f32::consts::PI / (4.0 * GLTF_COVERAGE_ASPECT * c)).sqrt())
+    };
+    let mut distances = vec![0.0];
+    for &c in &coverage[..coarser] {
+        distances.push(distance(c)?);
+    }
+    let max_distance = coverage.get(coarser).map(|&c| distance(c)).transpose()?;
+    Ok((distances, max_distance))
+}
+
+/// Turns the primitive entities of each node the loader marked into LOD groups.
+pub(crate) fn spawn_gltf_groups(
+    mut commands: Commands,
+    nodes: Query<(Entity, &GltfLod, &Children), Added<GltfLod>>,
+    primitives: Query<(&Mesh3d, &MeshMaterial3d<StandardMaterial>)>,
+) {
+    for (node, lod, children) in &nodes {
+        let mut group = LodGroup::from_distances(&lod.distances);
+        if let (Ok(g), Some(max)) = (&group, lod.max_distance) {
+            group = g.clone().with_max_distance(max);
+        }
+        let group = match group {
+            Ok(group) => group,
+            Err(e) => {
+                warn!(
+                    "glTF node {node}: MSFT_lod ignored: the switch distances {:?} and max distance {:?}: {e}",
+                    lod.distances, lod.max_distance
+                );
+                continue;
+            }
+        };
+        for &child in children {
+            let Ok((mesh, material)) = primitives.get(child) else {
+                continue;
+            };
+            let Some(primitive) = lod.primitives.iter().find(|p| p.mesh == mesh.0) else {
+                continue;
+            };
+            let mut levels = vec![LodLevel::new(mesh.0.clone(), material.0.clone())];
+            levels.extend(primitive.levels.iter().map(|level| {
+                let material = level.material.clone().unwrap_or_else(|| material.0.clone());
+                LodLevel::new(level.mesh.clone(), material)
+            }));
+            commands
+                .entity(child)
+                .remove::<(Mesh3d, MeshMaterial3d<StandardMaterial>)>()
+                .insert((LodLevels(levels), FrameSequentialGroup::new(group.clone())));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coverages_give_the_distances_lodkit_lod_wrote_them_from() {
+        // lodkit lod: c = π R² / (4 aspect d²) at the next level's distance.
+        let radius = 1.5;
+        let written = [3.0f32, 7.5, 20.0];
+        let coverage: Vec<f32> = written
+            .iter()
+            .map(|d| std::f32::consts::PI * radius * radius / (4.0 * GLTF_COVERAGE_ASPECT * d * d))
+            .collect();
+        let (distances, max) = switch_distances(radius, Some(&coverage), 2).unwrap();
+        assert_eq!(distances.len(), 3);
+        assert_eq!(distances[0], 0.0);
+        for (d, w) in distances[1..].iter().chain(max.iter()).zip(written) {
+            assert!((d - w).abs() <= 1e-5 * w, "{d} vs {w}");
+        }
+    }
+
+    #[test]
+    fn bad_coverages_are_named_and_missing_ones_fall_back_to_size() {
+        assert!(
+            switch_distances(1.0, Some(&[0.5]), 2)
+                .unwrap_err()
+                .contains("1 values for 3 levels")
+        );
+        assert!(
+            switch_distances(1.0, Some(&[0.5, -1.0]), 2)
+                .unwrap_err()
+                .contains("-1")
+        );
+        assert!(switch_distances(1.0, Some(&[f32::NAN, 0.1]), 2).is_err());
+        assert_eq!(
+            switch_distances(2.0, None, 2).unwrap(),
+            (vec![0.0, 4.0, 8.0], None)
+        );
+    }
+}
