@@ -22,7 +22,7 @@ impl Written {
     fn view(&mut self, bytes: &[u8], target: u32) -> usize {
         let offset = self.bin.len();
         self.bin.extend_from_slice(bytes);
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         self.views.push(json!({

@@ -12,20 +12,25 @@ use super::level_material::DerivedMaterials;
 use super::select::{FrameSequentialLevels, Scheduler};
 use super::{FrameSequentialMaterial, LodLevels};
 
+/// Groups whose levels are new or changed, with their drawers and skin.
+type NewLevels<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static LodLevels,
+        Option<&'static FrameSequentialLevels>,
+        Option<&'static SkinnedMesh>,
+    ),
+    Changed<LodLevels>,
+>;
+
 /// Spawns the drawing child of every new or changed [`LodLevels`]. A changed group starts over:
 /// its old drawer goes, and so do its transition slot and t-instance id in the scheduler.
 pub(super) fn spawn_levels(
     mut commands: Commands,
     mut scheduler: ResMut<Scheduler>,
-    groups: Query<
-        (
-            Entity,
-            &LodLevels,
-            Option<&FrameSequentialLevels>,
-            Option<&SkinnedMesh>,
-        ),
-        Changed<LodLevels>,
-    >,
+    groups: NewLevels,
 ) {
     let Scheduler(scheduler, keys) = &mut *scheduler;
     for (group, levels, old, skin) in &groups {
