@@ -6,11 +6,44 @@ use bevy::log::warn_once;
 use bevy::mesh::MeshTag;
 use bevy::mesh::skinning::SkinnedMesh;
 use bevy::prelude::*;
-use lodkit::select::LodState;
+use lodkit::frame_sequential::{InstanceKey, TransitionScheduler};
+use lodkit::select::{LodSelection, LodState};
 
 use super::level_material::DerivedMaterials;
-use super::select::{FrameSequentialLevels, Scheduler};
-use super::{FrameSequentialMaterial, LodLevels};
+use super::levels::LodLevels;
+use super::material::FrameSequentialMaterial;
+use super::rects::Bounds;
+
+/// lodkit's transition scheduler for the app's frame-sequential camera, and the key of each
+/// group in it (released when the group goes away).
+#[derive(Resource, Default)]
+pub(super) struct Scheduler(
+    pub(super) TransitionScheduler,
+    pub(super) Vec<(Entity, InstanceKey)>,
+);
+
+/// What the plugin keeps of a [`FrameSequentialGroup`](super::FrameSequentialGroup) (inserted by the plugin).
+#[derive(Component, Clone, Debug)]
+pub struct FrameSequentialLevels {
+    /// The child entity that draws the group: the plugin gives it the mesh and material of the
+    /// level drawn each frame. One entity, not one per level, so Bevy's motion vectors follow
+    /// the group from frame to frame (an entity that was hidden last frame gets none).
+    pub entity: Entity,
+    /// The second drawing child: the incoming level while the group is drawn through the
+    /// screen-door dither (MSAA, a blending material), else hidden.
+    pub dither_entity: Entity,
+    /// The level drawn this frame.
+    pub drawn: u8,
+    /// lodkit's selection this frame.
+    pub selection: Option<LodSelection>,
+    /// The transition under way: (from, to).
+    pub transition: Option<(u8, u8)>,
+    pub(super) key: Option<InstanceKey>,
+    pub(super) state: LodState,
+    /// The group's model matrix last frame (where the older buffer holds it).
+    pub(super) previous_model: Option<Mat4>,
+    pub(super) bounds: Option<Bounds>,
+}
 
 /// Groups whose levels are new or changed, with their drawers and skin.
 type NewLevels<'w, 's> = Query<

@@ -1,55 +1,12 @@
-//! A level's material as the app has it: a [`FrameSequentialMaterial`], or a plain
-//! [`StandardMaterial`] handle (what a glTF scene or an app already spawns), from which the plugin
-//! derives the [`FrameSequentialMaterial`] the combine needs and keeps it in step.
+//! The [`FrameSequentialMaterial`] the plugin derives from a level's plain [`StandardMaterial`]
+//! handle (what a glTF scene or an app already spawns; [`LevelMaterial::Standard`]), kept in step
+//! with it.
 
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 
-use super::{FrameSequentialExtension, FrameSequentialMaterial, LodLevels};
-
-/// The material a level is drawn with: [`LodLevel::material`](super::LodLevel::material).
-///
-/// A [`StandardMaterial`] handle is used as it is: the plugin derives one
-/// [`FrameSequentialMaterial`] per `StandardMaterial` (its `base` a clone of it, so every texture
-/// is the same `Handle<Image>`, shared, not copied; the extension's defaults), shared by every
-/// level that names it, and copies the `StandardMaterial` into it again whenever it changes
-/// (`AssetEvent::Modified`), so an app keeps editing its own material. `From` makes either handle
-/// a `LevelMaterial`:
-///
-/// ```
-/// use bevy::prelude::*;
-/// use lodkit_bevy::frame_sequential::LodLevel;
-///
-/// fn level(meshes: &mut Assets<Mesh>, materials: &mut Assets<StandardMaterial>) -> LodLevel {
-///     let mesh = meshes.add(Sphere::new(1.0).mesh().ico(3).unwrap());
-///     LodLevel::new(mesh, materials.add(Color::srgb(0.8, 0.5, 0.2)))
-/// }
-/// # let _ = level;
-/// ```
-///
-/// Opaque and alpha-mask (`AlphaMode::Mask`) materials take part in the combine. A material
-/// that blends (`Blend`, `Premultiplied`, `Add`, `Multiply`, `AlphaToCoverage`) cannot carry the
-/// combine's id word in its alpha: a group with such a level is drawn with the complementary
-/// screen-door dither instead (both levels each frame, disjoint pixels), with one warning.
-#[derive(Clone, Debug, PartialEq)]
-pub enum LevelMaterial {
-    /// A material of the app's, used as it is (see above).
-    Standard(Handle<StandardMaterial>),
-    /// A material made for frame-sequential LOD.
-    FrameSequential(Handle<FrameSequentialMaterial>),
-}
-
-impl From<Handle<StandardMaterial>> for LevelMaterial {
-    fn from(handle: Handle<StandardMaterial>) -> Self {
-        Self::Standard(handle)
-    }
-}
-
-impl From<Handle<FrameSequentialMaterial>> for LevelMaterial {
-    fn from(handle: Handle<FrameSequentialMaterial>) -> Self {
-        Self::FrameSequential(handle)
-    }
-}
+use super::levels::{LevelMaterial, LodLevels};
+use super::material::{FrameSequentialExtension, FrameSequentialMaterial};
 
 /// The [`FrameSequentialMaterial`] derived from each [`StandardMaterial`] a level names.
 #[derive(Resource, Default)]

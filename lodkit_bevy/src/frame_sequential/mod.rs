@@ -27,7 +27,7 @@
 //!
 //! ```no_run
 //! use bevy::prelude::*;
-//! use lodkit::select::{LodGroup, LodSettings};
+//! use lodkit::select::LodSettings;
 //! use lodkit_bevy::frame_sequential::*;
 //!
 //! fn setup(
@@ -98,6 +98,7 @@ mod data;
 mod dither;
 mod drawer;
 mod level_material;
+mod levels;
 mod material;
 mod older_depth;
 mod rects;
@@ -114,9 +115,10 @@ use bevy::prelude::*;
 use bevy::render::RenderApp;
 use bevy::render::extract_component::ExtractComponentPlugin;
 use lodkit::frame_sequential::Schedule;
-use lodkit::select::{LodGroup, LodSettings};
+use lodkit::select::LodSettings;
 
-pub use level_material::LevelMaterial;
+pub use drawer::FrameSequentialLevels;
+pub use levels::{FrameSequentialGroup, LevelMaterial, LodLevel, LodLevels};
 /// Where lodkit's visibility pattern is anchored: [`FrameSequentialLod::anchor`].
 pub use lodkit::visibility::VisibilitySpace;
 pub use material::{
@@ -125,7 +127,7 @@ pub use material::{
 };
 pub use older_depth::OLDER_DEPTH_PASS;
 pub use render::COMBINE_PASS;
-pub use select::{FrameSequentialLevels, FrameSequentialStats};
+pub use select::FrameSequentialStats;
 pub use tag::{DITHER_TAG_ID, MAX_TAG_ID, decode_tag, encode_dither_tag, encode_tag};
 
 use crate::LodkitShadersPlugin;
@@ -309,57 +311,3 @@ impl Default for FrameSequentialLod {
         }
     }
 }
-
-/// A LOD group: its levels ([`LodLevels`]) are selected by distance from the camera with
-/// [`FrameSequentialLod`], and a switch between two levels is a frame-sequential transition.
-///
-/// The plugin spawns one child entity that draws the group (see [`FrameSequentialLevels`]) and
-/// gives it the mesh and material of the level drawn each frame.
-#[derive(Component, Clone, Debug)]
-#[require(Transform, Visibility)]
-pub struct FrameSequentialGroup {
-    /// The level distances (view-normalized, lodkit::select's measure: distance / |P\[1\]\[1\]|).
-    pub group: LodGroup,
-    /// The box that holds every level's vertices (object space; None: the union of the level
-    /// meshes' bounds, computed once they are loaded). Give it for vertex animation that moves
-    /// vertices beyond the meshes' bounds (`lodkit::combine::displaced_bounds`): the combine
-    /// then runs over the box's screen rectangle (not the levels' silhouettes' hull) and only
-    /// works inside it. Read once, when the group's levels are
-    /// first drawn; a change to its [`LodLevels`] reads it again.
-    pub bounds: Option<(Vec3, Vec3)>,
-}
-
-impl FrameSequentialGroup {
-    /// A group selecting with `group`'s distances, bounds from its meshes.
-    pub fn new(group: LodGroup) -> Self {
-        Self {
-            group,
-            bounds: None,
-        }
-    }
-}
-
-/// One level of a LOD group: a mesh and its material.
-#[derive(Clone, Debug)]
-pub struct LodLevel {
-    /// The level's mesh.
-    pub mesh: Handle<Mesh>,
-    /// The level's material: the app's own `StandardMaterial` handle, or a
-    /// [`FrameSequentialMaterial`] ([`LevelMaterial`] says what each does).
-    pub material: LevelMaterial,
-}
-
-impl LodLevel {
-    /// A level of `mesh` drawn with `material`: a `Handle<StandardMaterial>` or a
-    /// `Handle<FrameSequentialMaterial>`.
-    pub fn new(mesh: Handle<Mesh>, material: impl Into<LevelMaterial>) -> Self {
-        Self {
-            mesh,
-            material: material.into(),
-        }
-    }
-}
-
-/// The levels of a [`FrameSequentialGroup`], finest first (at most 256).
-#[derive(Component, Clone, Debug, Default)]
-pub struct LodLevels(pub Vec<LodLevel>);

@@ -15,12 +15,12 @@ use bevy::prelude::*;
 use bevy::render::render_resource::{Face, TextureUsages};
 use bevy::transform::TransformSystems;
 use lodkit::combine::{ScreenRect, merge_rects};
-use lodkit::frame_sequential::{Drive, InstanceKey, TransitionScheduler};
+use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::reproject::new_to_old_matrix;
-use lodkit::select::{LodCamera, LodSelection, LodState};
+use lodkit::select::{LodCamera, LodSelection};
 
 use super::dither::{Fallback, dither_draws};
-use super::drawer::{DrawerQuery, show, spawn_levels};
+use super::drawer::{DrawerQuery, FrameSequentialLevels, Scheduler, show, spawn_levels};
 use super::level_material::{DerivedMaterials, blends, sync_derived_materials};
 use super::rects::{Bounds, group_hull, group_rect, level_bounds, merge_rows, to_lodkit};
 use super::silhouette::{OutlineView, Surfaces, forget_changed_meshes, outline};
@@ -57,37 +57,6 @@ pub(super) fn build(app: &mut App) {
             .before(configure_depth_copies)
             .after(TransformSystems::Propagate),
     );
-}
-
-/// lodkit's transition scheduler for the app's frame-sequential camera, and the key of each
-/// group in it (released when the group goes away).
-#[derive(Resource, Default)]
-pub(super) struct Scheduler(
-    pub(super) TransitionScheduler,
-    pub(super) Vec<(Entity, InstanceKey)>,
-);
-
-/// What the plugin keeps of a [`FrameSequentialGroup`] (inserted by the plugin).
-#[derive(Component, Clone, Debug)]
-pub struct FrameSequentialLevels {
-    /// The child entity that draws the group: the plugin gives it the mesh and material of the
-    /// level drawn each frame. One entity, not one per level, so Bevy's motion vectors follow
-    /// the group from frame to frame (an entity that was hidden last frame gets none).
-    pub entity: Entity,
-    /// The second drawing child: the incoming level while the group is drawn through the
-    /// screen-door dither (MSAA, a blending material), else hidden.
-    pub dither_entity: Entity,
-    /// The level drawn this frame.
-    pub drawn: u8,
-    /// lodkit's selection this frame.
-    pub selection: Option<LodSelection>,
-    /// The transition under way: (from, to).
-    pub transition: Option<(u8, u8)>,
-    pub(super) key: Option<InstanceKey>,
-    pub(super) state: LodState,
-    /// The group's model matrix last frame (where the older buffer holds it).
-    pub(super) previous_model: Option<Mat4>,
-    pub(super) bounds: Option<Bounds>,
 }
 
 /// What the last frame's selection did, for reports and tests.

@@ -6,7 +6,7 @@ use bevy::mesh::MeshTag;
 
 use super::*;
 use crate::frame_sequential::{DITHER_TAG_ID, LodLevel};
-use lodkit::select::LodGroup;
+use lodkit::select::{LodGroup, LodState};
 use std::f32::consts::FRAC_PI_2;
 
 /// A world with a camera (with `msaa`) and one two-level group at distance 1, its levels

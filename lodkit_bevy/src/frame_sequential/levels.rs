@@ -1,0 +1,105 @@
+//! What a LOD group is made of: the [`FrameSequentialGroup`] component, its [`LodLevels`], and
+//! each level's mesh and [`LevelMaterial`].
+
+use bevy::prelude::*;
+use lodkit::select::LodGroup;
+
+use super::material::FrameSequentialMaterial;
+
+/// The material a level is drawn with: [`LodLevel::material`].
+///
+/// A [`StandardMaterial`] handle is used as it is: the plugin derives one
+/// [`FrameSequentialMaterial`] per `StandardMaterial` (its `base` a clone of it, so every texture
+/// is the same `Handle<Image>`, shared, not copied; the extension's defaults), shared by every
+/// level that names it, and copies the `StandardMaterial` into it again whenever it changes
+/// (`AssetEvent::Modified`), so an app keeps editing its own material. `From` makes either handle
+/// a `LevelMaterial`:
+///
+/// ```
+/// use bevy::prelude::*;
+/// use lodkit_bevy::frame_sequential::LodLevel;
+///
+/// fn level(meshes: &mut Assets<Mesh>, materials: &mut Assets<StandardMaterial>) -> LodLevel {
+///     let mesh = meshes.add(Sphere::new(1.0).mesh().ico(3).unwrap());
+///     LodLevel::new(mesh, materials.add(Color::srgb(0.8, 0.5, 0.2)))
+/// }
+/// # let _ = level;
+/// ```
+///
+/// Opaque and alpha-mask (`AlphaMode::Mask`) materials take part in the combine. A material
+/// that blends (`Blend`, `Premultiplied`, `Add`, `Multiply`, `AlphaToCoverage`) cannot carry the
+/// combine's id word in its alpha: a group with such a level is drawn with the complementary
+/// screen-door dither instead (both levels each frame, disjoint pixels), with one warning.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LevelMaterial {
+    /// A material of the app's, used as it is (see above).
+    Standard(Handle<StandardMaterial>),
+    /// A material made for frame-sequential LOD.
+    FrameSequential(Handle<FrameSequentialMaterial>),
+}
+
+impl From<Handle<StandardMaterial>> for LevelMaterial {
+    fn from(handle: Handle<StandardMaterial>) -> Self {
+        Self::Standard(handle)
+    }
+}
+
+impl From<Handle<FrameSequentialMaterial>> for LevelMaterial {
+    fn from(handle: Handle<FrameSequentialMaterial>) -> Self {
+        Self::FrameSequential(handle)
+    }
+}
+
+/// A LOD group: its levels ([`LodLevels`]) are selected by distance from the camera with
+/// [`FrameSequentialLod`](super::FrameSequentialLod), and a switch between two levels is a frame-sequential transition.
+///
+/// The plugin spawns one child entity that draws the group (see [`FrameSequentialLevels`](super::FrameSequentialLevels)) and
+/// gives it the mesh and material of the level drawn each frame.
+#[derive(Component, Clone, Debug)]
+#[require(Transform, Visibility)]
+pub struct FrameSequentialGroup {
+    /// The level distances (view-normalized, lodkit::select's measure: distance / |P\[1\]\[1\]|).
+    pub group: LodGroup,
+    /// The box that holds every level's vertices (object space; None: the union of the level
+    /// meshes' bounds, computed once they are loaded). Give it for vertex animation that moves
+    /// vertices beyond the meshes' bounds (`lodkit::combine::displaced_bounds`): the combine
+    /// then runs over the box's screen rectangle (not the levels' silhouettes' hull) and only
+    /// works inside it. Read once, when the group's levels are
+    /// first drawn; a change to its [`LodLevels`] reads it again.
+    pub bounds: Option<(Vec3, Vec3)>,
+}
+
+impl FrameSequentialGroup {
+    /// A group selecting with `group`'s distances, bounds from its meshes.
+    pub fn new(group: LodGroup) -> Self {
+        Self {
+            group,
+            bounds: None,
+        }
+    }
+}
+
+/// One level of a LOD group: a mesh and its material.
+#[derive(Clone, Debug)]
+pub struct LodLevel {
+    /// The level's mesh.
+    pub mesh: Handle<Mesh>,
+    /// The level's material: the app's own `StandardMaterial` handle, or a
+    /// [`FrameSequentialMaterial`] ([`LevelMaterial`] says what each does).
+    pub material: LevelMaterial,
+}
+
+impl LodLevel {
+    /// A level of `mesh` drawn with `material`: a `Handle<StandardMaterial>` or a
+    /// `Handle<FrameSequentialMaterial>`.
+    pub fn new(mesh: Handle<Mesh>, material: impl Into<LevelMaterial>) -> Self {
+        Self {
+            mesh,
+            material: material.into(),
+        }
+    }
+}
+
+/// The levels of a [`FrameSequentialGroup`], finest first (at most 256).
+#[derive(Component, Clone, Debug, Default)]
+pub struct LodLevels(pub Vec<LodLevel>);
