@@ -31,7 +31,9 @@ use bevy::log::warn;
 use bevy::prelude::*;
 use lodkit::select::LodGroup;
 
-use crate::frame_sequential::{FrameSequentialGroup, LodLevel, LodLevels};
+use crate::frame_sequential::levels::{
+    FrameSequentialGroup, FrameSequentialSystems, LodLevel, LodLevels,
+};
 
 /// The viewport aspect (width / height) a file's `MSFT_screencoverage` is read with: `lodkit
 /// lod`'s default `--aspect`, 16:9.
@@ -86,6 +88,7 @@ pub(crate) fn build(app: &mut App) {
         .0
         .write_blocking()
         .push(Box::new(MsftLod::default()));
+    app.add_systems(PostUpdate, spawn_gltf_groups.before(FrameSequentialSystems));
 }
 
 /// What the handler keeps of the document while it loads (one clone per load).
@@ -299,7 +302,7 @@ pub fn switch_distances(
 }
 
 /// Turns the primitive entities of each node the loader marked into LOD groups.
-pub(crate) fn spawn_gltf_groups(
+fn spawn_gltf_groups(
     mut commands: Commands,
     nodes: Query<(Entity, &GltfLod, &Children), Added<GltfLod>>,
     primitives: Query<(&Mesh3d, &MeshMaterial3d<StandardMaterial>)>,
@@ -341,7 +344,7 @@ pub(crate) fn spawn_gltf_groups(
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::gltf_lod::*;
 
     #[test]
     fn coverages_give_the_distances_lodkit_lod_wrote_them_from() {

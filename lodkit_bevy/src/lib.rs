@@ -18,7 +18,10 @@
 //!   levels per frame and a combine pass merges consecutive frames, reprojected with the main
 //!   pass's depth and the camera's and groups' motion (no prepass needed): less pop than Bevy's
 //!   crossfade, one level drawn per frame. See [`frame_sequential`] for the figures against
-//!   Bevy's crossfade in an app with and without a prepass.
+//!   Bevy's crossfade in an app with and without a prepass. Levels take the app's own
+//!   `StandardMaterial`s; [`gltf_lod`] makes groups of glTF files with `MSFT_lod` levels as
+//!   Bevy's loader spawns them, and [`auto_lod::AutoLod`] of any entity with a mesh, its levels
+//!   built in the background.
 //!
 //! lodkit is used with `default-features = false`: it brings no naga of its own; Bevy links its
 //! WESL modules (wesl-rs), as it links its own.
@@ -34,6 +37,8 @@
 
 #![warn(missing_docs)]
 
+#[cfg(feature = "lod_chain")]
+pub mod auto_lod;
 pub mod frame_sequential;
 pub mod framebuffer_lod;
 #[cfg(feature = "gltf")]
@@ -48,10 +53,12 @@ pub use shaders::{LodkitShaders, LodkitShadersPlugin};
 
 /// The plugins, components and settings an app uses.
 pub mod prelude {
+    #[cfg(feature = "lod_chain")]
+    pub use crate::auto_lod::{AutoLod, AutoLodStatus};
     pub use crate::frame_sequential::{
         FrameSequentialExtension, FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod,
-        FrameSequentialLodPlugin, FrameSequentialMaterial, FrameSequentialStats, LodLevel,
-        LodLevels, OlderCoverage, VisibilitySpace,
+        FrameSequentialLodPlugin, FrameSequentialMaterial, FrameSequentialStats,
+        FrameSequentialSystems, LevelMaterial, LodLevel, LodLevels, OlderCoverage, VisibilitySpace,
     };
     pub use crate::framebuffer_lod::{
         FrameTimeSource, FramebufferLod, FramebufferLodCapabilities, FramebufferLodComposite,

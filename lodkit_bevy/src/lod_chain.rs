@@ -32,7 +32,7 @@ pub use lodkit::lod_chain::{
 };
 use lodkit::select::LodGroup;
 
-use crate::frame_sequential::{FrameSequentialGroup, LevelMaterial, LodLevel, LodLevels};
+use crate::frame_sequential::levels::{FrameSequentialGroup, LevelMaterial, LodLevel, LodLevels};
 
 /// Why a mesh could not be made into a chain.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -288,7 +288,7 @@ fn gather(values: &VertexAttributeValues, picks: &[u32]) -> VertexAttributeValue
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::lod_chain::*;
 
     fn sphere() -> Mesh {
         Sphere::new(1.0).mesh().uv(48, 24)

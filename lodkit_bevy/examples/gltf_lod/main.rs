@@ -32,7 +32,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use bevy::camera::RenderTarget;
+use bevy::camera::primitives::Aabb;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
+use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use lodkit_bevy::FrameSequentialLodPlugin;
 use lodkit_bevy::frame_sequential::{FrameSequentialGroup, FrameSequentialLevels};
@@ -119,7 +121,7 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
             Tonemapping::None,
             DebandDither::Disabled,
             lodkit_bevy::FrameSequentialLod::default(),
-            camera_at(0),
+            Transform::default(),
         ))
         .id();
     world.spawn((
@@ -148,23 +150,26 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
         return Err((1, format!("{file} did not load")));
     }
     headless::step(&mut app);
+    headless::step(&mut app);
+    let Some(sphere) = scene_sphere(app.world_mut()) else {
+        return Err((1, format!("{file} has no mesh")));
+    };
     let mut frames = Vec::new();
-    let mut drawn: Vec<Vec<u8>> = Vec::new();
+    // The levels each group drew, by entity.
+    let mut drawn: HashMap<Entity, Vec<u8>> = HashMap::new();
     for frame in 0..FRAMES {
         *app.world_mut()
             .get_mut::<Transform>(camera)
-            .expect("camera") = camera_at(frame);
+            .expect("camera") = camera_at(sphere, frame);
         frames.push(headless::capture(&mut app, &target).map_err(|e| (1, e))?);
         let world = app.world_mut();
-        let levels: Vec<u8> = world
-            .query::<&FrameSequentialLevels>()
+        for (group, levels) in world
+            .query::<(Entity, &FrameSequentialLevels)>()
             .iter(world)
-            .map(|l| l.drawn)
-            .collect();
-        drawn.resize(levels.len().max(drawn.len()), Vec::new());
-        for (seen, level) in drawn.iter_mut().zip(levels) {
-            if !seen.contains(&level) {
-                seen.push(level);
+        {
+            let seen = drawn.entry(group).or_default();
+            if !seen.contains(&levels.drawn) {
+                seen.push(levels.drawn);
             }
         }
     }
@@ -172,10 +177,10 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
     headless::save_png(&frames::strip(&strip), &out.join("strip.png")).map_err(|e| (2, e))?;
     let world = app.world_mut();
     let groups: Vec<serde_json::Value> = world
-        .query::<&FrameSequentialGroup>()
+        .query::<(Entity, &FrameSequentialGroup)>()
         .iter(world)
-        .zip(&drawn)
-        .map(|(group, drawn)| {
+        .map(|(entity, group)| {
+            let drawn = drawn.get(&entity).cloned().unwrap_or_default();
             let distances: Vec<f32> = group.group.levels().iter().map(|l| l.distance).collect();
             serde_json::json!({
                 "levels": distances.len(),
@@ -209,8 +214,40 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
     Ok(())
 }
 
-/// The camera at `frame`: walking back from 2.5 to 12.5 world units in front of the scene.
-fn camera_at(frame: usize) -> Transform {
-    let z = 2.5 + 10.0 * frame as f32 / (FRAMES - 1) as f32;
-    Transform::from_xyz(0.0, 0.6, z).looking_at(Vec3::new(0.0, 0.0, 0.0), Vec3::Y)
+/// The sphere around every box in the scene (`Aabb`s, kept by the groups): (centre, radius).
+fn scene_sphere(world: &mut World) -> Option<(Vec3, f32)> {
+    let spheres: Vec<(Vec3, f32)> = world
+        .query::<(&Aabb, &GlobalTransform)>()
+        .iter(world)
+        .map(|(aabb, transform)| {
+            let scale = transform
+                .to_scale_rotation_translation()
+                .0
+                .abs()
+                .max_element();
+            let centre = transform.transform_point(Vec3::from(aabb.center));
+            (centre, Vec3::from(aabb.half_extents).length() * scale)
+        })
+        .collect();
+    let (lo, hi) = spheres
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &(c, r)| {
+            (lo.min(c - r), hi.max(c + r))
+        });
+    let centre = 0.5 * (lo + hi);
+    let radius = spheres
+        .iter()
+        .map(|&(c, r)| c.distance(centre) + r)
+        .fold(0.0f32, f32::max);
+    (radius.is_finite() && radius > 0.0).then_some((centre, radius))
+}
+
+/// The camera at `frame`: walking back from 2 to 30 scene radii from the scene's centre, a
+/// little above it, at the same pace in log distance (each level's share of the walk is the
+/// same for a small or a large asset).
+fn camera_at((centre, radius): (Vec3, f32), frame: usize) -> Transform {
+    let t = frame as f32 / (FRAMES - 1) as f32;
+    let distance = radius * 2.0 * 15f32.powf(t);
+    let eye = centre + distance * Vec3::new(0.0, 0.25, 1.0).normalize();
+    Transform::from_translation(eye).looking_at(centre, Vec3::Y)
 }

@@ -62,8 +62,8 @@ pub(super) fn dither_draws(selection: &LodSelection) -> [Option<(u8, u32)>; 2] {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tag::{DITHER_TAG_ID, decode_tag};
     use super::*;
+    use crate::frame_sequential::tag::{DITHER_TAG_ID, decode_tag};
 
     /// The alphas the shader's screen_door_keep takes, decoded from the tags.
     fn alphas(draws: [Option<(u8, u32)>; 2]) -> [Option<(u8, u32, f32)>; 2] {

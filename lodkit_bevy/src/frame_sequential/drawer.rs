@@ -30,8 +30,9 @@ pub struct FrameSequentialLevels {
     /// the group from frame to frame (an entity that was hidden last frame gets none).
     pub entity: Entity,
     /// The second drawing child: the incoming level while the group is drawn through the
-    /// screen-door dither (MSAA, a blending material), else hidden.
-    pub dither_entity: Entity,
+    /// screen-door dither (MSAA, a blending material), else hidden; spawned the first time the
+    /// group is dithered, so groups that never are cost one entity, not two.
+    pub dither_entity: Option<Entity>,
     /// The level drawn this frame.
     pub drawn: u8,
     /// lodkit's selection this frame.
@@ -69,7 +70,9 @@ pub(super) fn spawn_levels(
     for (group, levels, old, skin) in &groups {
         if let Some(old) = old {
             commands.entity(old.entity).despawn();
-            commands.entity(old.dither_entity).despawn();
+            if let Some(dither) = old.dither_entity {
+                commands.entity(dither).despawn();
+            }
             if let Some(key) = old.key {
                 let _ = scheduler.remove(key);
             }
@@ -84,26 +87,10 @@ pub(super) fn spawn_levels(
             continue;
         };
         // The material is set each frame, once a StandardMaterial's derived one is there.
-        let mut drawer = || {
-            let mut drawer = commands.spawn((
-                Mesh3d(first.mesh.clone()),
-                MeshMaterial3d(Handle::<FrameSequentialMaterial>::default()),
-                MeshTag::new(0),
-                Transform::IDENTITY,
-                Visibility::Hidden,
-                ChildOf(group),
-            ));
-            // A skinned group (a glTF primitive with a skin) is drawn with its joints; its box
-            // moves with them, so the drawers are not culled by the rest pose's.
-            if let Some(skin) = skin {
-                drawer.insert((skin.clone(), NoFrustumCulling));
-            }
-            drawer.id()
-        };
-        let (entity, dither_entity) = (drawer(), drawer());
+        let entity = spawn_drawer(&mut commands, group, first.mesh.clone(), skin);
         commands.entity(group).insert(FrameSequentialLevels {
             entity,
-            dither_entity,
+            dither_entity: None,
             drawn: 0,
             selection: None,
             transition: None,
@@ -113,6 +100,41 @@ pub(super) fn spawn_levels(
             bounds: None,
         });
     }
+}
+
+/// A hidden drawing child of `group` (showing `mesh` once made visible), with the group's skin.
+pub(super) fn spawn_drawer(
+    commands: &mut Commands,
+    group: Entity,
+    mesh: Handle<Mesh>,
+    skin: Option<&SkinnedMesh>,
+) -> Entity {
+    let mut drawer = commands.spawn((
+        Mesh3d(mesh),
+        MeshMaterial3d(Handle::<FrameSequentialMaterial>::default()),
+        MeshTag::new(0),
+        Transform::IDENTITY,
+        Visibility::Hidden,
+        ChildOf(group),
+    ));
+    // A skinned group (a glTF primitive with a skin) is drawn with its joints; its box moves
+    // with them, so the drawers are not culled by the rest pose's.
+    if let Some(skin) = skin {
+        drawer.insert((skin.clone(), NoFrustumCulling));
+    }
+    drawer.id()
+}
+
+/// What a drawer shows for `draw` (level, tag) of `levels`: None where nothing, or a level whose
+/// material is not there yet.
+pub(super) fn drawn(
+    draw: Option<(u8, u32)>,
+    levels: &LodLevels,
+    derived: &DerivedMaterials,
+) -> Option<(Handle<Mesh>, Handle<FrameSequentialMaterial>, u32)> {
+    let (lod, tag) = draw?;
+    let level = levels.0.get(usize::from(lod)).or(levels.0.last())?;
+    Some((level.mesh.clone(), derived.resolve(&level.material)?, tag))
 }
 
 pub(super) type DrawerQuery<'w, 's> = Query<
@@ -138,18 +160,14 @@ pub(super) fn show(
     let Ok((mut visibility, mut mesh_tag, mut mesh, mut material)) = drawers.get_mut(drawer) else {
         return;
     };
-    let shown = draw.and_then(|(lod, tag)| {
-        let level = levels.0.get(usize::from(lod)).or(levels.0.last())?;
-        Some((level, derived.resolve(&level.material)?, tag))
-    });
-    let Some((level, handle, tag)) = shown else {
+    let Some((level_mesh, handle, tag)) = drawn(draw, levels, derived) else {
         visibility.set_if_neq(Visibility::Hidden);
         return;
     };
     visibility.set_if_neq(Visibility::Inherited);
     mesh_tag.set_if_neq(MeshTag::new(tag));
-    if mesh.0 != level.mesh {
-        mesh.0 = level.mesh.clone();
+    if mesh.0 != level_mesh {
+        mesh.0 = level_mesh;
     }
     if material.0 != handle {
         material.0 = handle;

@@ -6,6 +6,14 @@ use lodkit::select::LodGroup;
 
 use super::material::FrameSequentialMaterial;
 
+/// The plugin's main-world systems in `PostUpdate` that give each [`FrameSequentialGroup`] its
+/// drawers and select what they draw. A system that makes groups (inserts [`LodLevels`] and a
+/// [`FrameSequentialGroup`], removing the entity's `Mesh3d`) runs `.before(FrameSequentialSystems)`
+/// so the object is drawn in the same frame, as [`AutoLod`](crate::auto_lod::AutoLod) and the
+/// glTF loader's groups do.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FrameSequentialSystems;
+
 /// The material a level is drawn with: [`LodLevel::material`].
 ///
 /// A [`StandardMaterial`] handle is used as it is: the plugin derives one

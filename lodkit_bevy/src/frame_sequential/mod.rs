@@ -98,7 +98,7 @@ mod data;
 mod dither;
 mod drawer;
 mod level_material;
-mod levels;
+pub(crate) mod levels;
 mod material;
 mod older_depth;
 mod rects;
@@ -118,7 +118,9 @@ use lodkit::frame_sequential::Schedule;
 use lodkit::select::LodSettings;
 
 pub use drawer::FrameSequentialLevels;
-pub use levels::{FrameSequentialGroup, LevelMaterial, LodLevel, LodLevels};
+pub use levels::{
+    FrameSequentialGroup, FrameSequentialSystems, LevelMaterial, LodLevel, LodLevels,
+};
 /// Where lodkit's visibility pattern is anchored: [`FrameSequentialLod::anchor`].
 pub use lodkit::visibility::VisibilitySpace;
 pub use material::{
@@ -170,6 +172,8 @@ impl Plugin for FrameSequentialLodPlugin {
         select::build(app);
         #[cfg(feature = "gltf")]
         crate::gltf_lod::build(app);
+        #[cfg(feature = "lod_chain")]
+        crate::auto_lod::build(app);
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {
             render::build(render_app);
         }

@@ -10,6 +10,8 @@ use bevy::core_pipeline::prepass::{
     DeferredPrepass, DepthPrepass, MotionVectorPrepass, NormalPrepass,
 };
 use bevy::log::warn_once;
+use bevy::mesh::MeshTag;
+use bevy::mesh::skinning::SkinnedMesh;
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Face, TextureUsages};
@@ -20,15 +22,17 @@ use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection};
 
 use super::dither::{Fallback, dither_draws};
-use super::drawer::{DrawerQuery, FrameSequentialLevels, Scheduler, show, spawn_levels};
+use super::drawer::{
+    DrawerQuery, FrameSequentialLevels, Scheduler, drawn, show, spawn_drawer, spawn_levels,
+};
 use super::level_material::{DerivedMaterials, blends, sync_derived_materials};
 use super::rects::{Bounds, group_hull, group_rect, level_bounds, merge_rows, to_lodkit};
 use super::silhouette::{OutlineView, Surfaces, forget_changed_meshes, outline};
 use super::tag::{decode_tag, encode_tag};
 use super::view::{FrameSequentialView, OlderLevel};
 use super::{
-    CombineRegion, FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial, LodLevels,
-    OlderCoverage, VisibilitySpace,
+    CombineRegion, FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial,
+    FrameSequentialSystems, LodLevels, OlderCoverage, VisibilitySpace,
 };
 
 pub(super) fn build(app: &mut App) {
@@ -46,17 +50,11 @@ pub(super) fn build(app: &mut App) {
                 update,
             )
                 .chain()
+                .in_set(FrameSequentialSystems)
                 .after(TransformSystems::Propagate)
                 .after(CameraUpdateSystems)
                 .before(VisibilitySystems::VisibilityPropagate),
         );
-    #[cfg(feature = "gltf")]
-    app.add_systems(
-        PostUpdate,
-        crate::gltf_lod::spawn_gltf_groups
-            .before(configure_depth_copies)
-            .after(TransformSystems::Propagate),
-    );
 }
 
 /// What the last frame's selection did, for reports and tests.
@@ -176,6 +174,7 @@ type GroupQuery<'w, 's> = Query<
         &'static LodLevels,
         &'static GlobalTransform,
         &'static mut FrameSequentialLevels,
+        Option<&'static SkinnedMesh>,
     ),
 >;
 
@@ -280,7 +279,7 @@ fn update(
     // render world kept, and frames are kept only while a group is in transition or about to be.
     let older_kept = !multisampled && last.is_some_and(|l| l.keep);
     let mut keep_frame = false;
-    for (entity, group, levels, transform, mut state) in &mut groups {
+    for (entity, group, levels, transform, mut state, skin) in &mut groups {
         let state = &mut *state;
         let had_key = state.key;
         let model = transform.to_matrix();
@@ -300,12 +299,16 @@ fn update(
             time.delta_secs(),
             &mut state.state,
         );
-        let blending = levels.0.iter().any(|l| {
-            derived
-                .resolve(&l.material)
-                .and_then(|m| materials.get(&m))
-                .is_some_and(|m| blends(m.base.alpha_mode))
-        });
+        // Only a group in transition (or starting one) needs to know: a settled group draws its
+        // level whole either way.
+        let transitioning = selection.next.is_some() || state.transition.is_some();
+        let blending = transitioning
+            && levels.0.iter().any(|l| {
+                derived
+                    .resolve(&l.material)
+                    .and_then(|m| materials.get(&m))
+                    .is_some_and(|m| blends(m.base.alpha_mode))
+            });
         let fallback = Fallback::of(multisampled, blending, prepass);
         if blending {
             warn_once!(
@@ -327,11 +330,21 @@ fn update(
             state.previous_model = Some(model);
             state.selection = Some(selection);
             state.drawn = selection.current;
-            for (drawer, draw) in [state.entity, state.dither_entity]
-                .into_iter()
-                .zip(dither_draws(&selection))
-            {
-                show(&mut drawers, drawer, draw, levels, &derived);
+            let [outgoing, incoming] = dither_draws(&selection);
+            show(&mut drawers, state.entity, outgoing, levels, &derived);
+            match (state.dither_entity, drawn(incoming, levels, &derived)) {
+                (Some(drawer), _) => show(&mut drawers, drawer, incoming, levels, &derived),
+                // The group's first dithered transition: its second drawer, shown at once.
+                (None, Some((mesh, material, tag))) => {
+                    let drawer = spawn_drawer(&mut commands, entity, mesh, skin);
+                    commands.entity(drawer).insert((
+                        MeshMaterial3d(material),
+                        MeshTag::new(tag),
+                        Visibility::Inherited,
+                    ));
+                    state.dither_entity = Some(drawer);
+                }
+                (None, None) => {}
             }
             continue;
         }
@@ -474,7 +487,9 @@ fn update(
         state.drawn = lod;
         let draw = selection.visible.then_some((lod, tag));
         show(&mut drawers, state.entity, draw, levels, &derived);
-        show(&mut drawers, state.dither_entity, None, levels, &derived);
+        if let Some(drawer) = state.dither_entity {
+            show(&mut drawers, drawer, None, levels, &derived);
+        }
     }
     // A rectangle and a row may overlap (groups with and without hulls): that pixel is combined
     // twice, to the same color.

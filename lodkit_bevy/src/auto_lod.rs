@@ -1,0 +1,354 @@
+//! LOD levels made on the fly: [`AutoLod`] on an entity that already has `Mesh3d` and
+//! `MeshMaterial3d<StandardMaterial>` builds its mesh's LOD chain ([`MeshLodChain`]: levels from
+//! meshoptimizer, each with a bound of its distance from the mesh, and switch distances that keep
+//! the shown level within a pixel error) in a background task on Bevy's `AsyncComputeTaskPool`,
+//! and turns the entity into a [`FrameSequentialGroup`] when it is ready.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use lodkit_bevy::auto_lod::AutoLod;
+//!
+//! fn give_lod(mut commands: Commands, trees: Query<Entity, With<Mesh3d>>) {
+//!     for tree in &trees {
+//!         commands.entity(tree).insert(AutoLod::default()); // 1 pixel at 1080p, 60°
+//!     }
+//! }
+//! ```
+//!
+//! One chain is built per mesh (and descriptor), shared by every entity that shows that mesh:
+//! the levels are the same `Handle<Mesh>`s. The main thread only clones the mesh for the task and
+//! adds the finished levels to `Assets<Mesh>`; the simplification and its error bound run on the
+//! task pool. Every vertex attribute is carried to the levels, joints and weights included, so a
+//! skinned mesh stays skinned (the group's drawers take its `SkinnedMesh`). A mesh the chain
+//! cannot take (not a triangle list, its data gone to the render world, no positions) is named
+//! in a warning and the entity is left as it is.
+
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use bevy::tasks::futures::check_ready;
+use bevy::tasks::{AsyncComputeTaskPool, Task};
+use lodkit::select::LodGroup;
+
+use crate::frame_sequential::levels::{
+    FrameSequentialGroup, FrameSequentialSystems, LodLevel, LodLevels,
+};
+use crate::lod_chain::{LodChainDescriptor, MeshLodChain, MeshLodChainError, PixelErrorCamera};
+
+/// Gives an entity with `Mesh3d` and `MeshMaterial3d<StandardMaterial>` LOD levels built from its
+/// mesh in the background (see the [module](self) docs).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct AutoLod {
+    /// How the chain is built. Its `camera` sets the pixel error the switch distances keep
+    /// (default 1 pixel on a 1080-pixel-high, 60° viewport) and must name the hysteresis the
+    /// camera selects with (default 0.5, [`FrameSequentialLod`](crate::FrameSequentialLod)'s).
+    pub descriptor: LodChainDescriptor,
+}
+
+impl Default for AutoLod {
+    fn default() -> Self {
+        Self {
+            descriptor: LodChainDescriptor {
+                camera: PixelErrorCamera {
+                    hysteresis: 0.5,
+                    ..default()
+                },
+                ..default()
+            },
+        }
+    }
+}
+
+impl AutoLod {
+    /// The default chain, switching where a level stays within `pixel_error` pixels.
+    pub fn pixel_error(pixel_error: f32) -> Self {
+        let mut lod = Self::default();
+        lod.descriptor.camera.pixel_error = pixel_error;
+        lod
+    }
+}
+
+/// What became of an [`AutoLod`] entity (inserted by the plugin).
+#[derive(Component, Clone, Debug, PartialEq)]
+pub enum AutoLodStatus {
+    /// Its chain is being built.
+    Building,
+    /// It is a LOD group now, with this many levels.
+    Ready(usize),
+    /// The chain could not be built: why (also logged); the entity is drawn as before.
+    Failed(String),
+}
+
+/// A chain shared by the entities showing one mesh with one descriptor.
+enum Chain {
+    /// Being built; the entities waiting for it.
+    Building(Task<Result<MeshLodChain, MeshLodChainError>>, Vec<Entity>),
+    /// Built: the coarser levels (level 0 is each entity's own mesh) and the group.
+    Ready(Vec<Handle<Mesh>>, LodGroup),
+    /// Refused, with the reason.
+    Failed(String),
+}
+
+/// The chains by mesh, one per descriptor; a mesh's chains go when the mesh does.
+#[derive(Resource, Default)]
+struct Chains(HashMap<AssetId<Mesh>, Vec<(LodChainDescriptor, Chain)>>);
+
+pub(crate) fn build(app: &mut App) {
+    app.init_resource::<Chains>().add_systems(
+        PostUpdate,
+        (start_chains, finish_chains)
+            .chain()
+            .before(FrameSequentialSystems),
+    );
+}
+
+/// Starts (or joins) the chain of each new [`AutoLod`] entity whose mesh is loaded.
+fn start_chains(
+    mut commands: Commands,
+    mut chains: ResMut<Chains>,
+    mut events: MessageReader<AssetEvent<Mesh>>,
+    meshes: Res<Assets<Mesh>>,
+    entities: Query<(Entity, &AutoLod, &Mesh3d), Without<AutoLodStatus>>,
+) {
+    for event in events.read() {
+        if let AssetEvent::Removed { id } | AssetEvent::Unused { id } = event {
+            chains.0.remove(id);
+        }
+    }
+    for (entity, lod, mesh) in &entities {
+        let Some(data) = meshes.get(&mesh.0) else {
+            continue; // not loaded yet
+        };
+        let slots = chains.0.entry(mesh.0.id()).or_default();
+        let slot = match slots.iter_mut().position(|(d, _)| *d == lod.descriptor) {
+            Some(i) => &mut slots[i].1,
+            None => {
+                let (mesh, descriptor) = (data.clone(), lod.descriptor);
+                let task = AsyncComputeTaskPool::get()
+                    .spawn(async move { MeshLodChain::build(&mesh, &descriptor) });
+                slots.push((descriptor, Chain::Building(task, Vec::new())));
+                &mut slots.last_mut().expect("pushed").1
+            }
+        };
+        match slot {
+            Chain::Building(_, waiting) => {
+                waiting.push(entity);
+                commands.entity(entity).insert(AutoLodStatus::Building);
+            }
+            Chain::Ready(levels, group) => {
+                convert(&mut commands, entity, levels, group);
+            }
+            Chain::Failed(why) => {
+                commands
+                    .entity(entity)
+                    .insert(AutoLodStatus::Failed(why.clone()));
+            }
+        }
+    }
+}
+
+/// Turns the entities waiting for each finished chain into groups.
+fn finish_chains(
+    mut commands: Commands,
+    mut chains: ResMut<Chains>,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    for slots in chains.0.values_mut() {
+        for (descriptor, slot) in slots.iter_mut() {
+            let Chain::Building(task, waiting) = slot else {
+                continue;
+            };
+            let Some(result) = check_ready(task) else {
+                continue;
+            };
+            let waiting = std::mem::take(waiting);
+            let built = result.and_then(|chain| Ok((chain.lod_group(&descriptor.camera)?, chain)));
+            *slot = match built {
+                Ok((group, chain)) => {
+                    let coarser: Vec<Handle<Mesh>> = chain.meshes()[1..]
+                        .iter()
+                        .map(|m| meshes.add(m.clone()))
+                        .collect();
+                    for &entity in &waiting {
+                        convert(&mut commands, entity, &coarser, &group);
+                    }
+                    Chain::Ready(coarser, group)
+                }
+                Err(e) => {
+                    let why = e.to_string();
+                    for &entity in &waiting {
+                        warn!("AutoLod on {entity}: no LOD levels: {why}");
+                        if let Ok(mut e) = commands.get_entity(entity) {
+                            e.insert(AutoLodStatus::Failed(why.clone()));
+                        }
+                    }
+                    Chain::Failed(why)
+                }
+            };
+        }
+    }
+}
+
+/// Makes `entity` a group of its own mesh and the `coarser` levels, each drawn with its own
+/// material.
+fn convert(commands: &mut Commands, entity: Entity, coarser: &[Handle<Mesh>], group: &LodGroup) {
+    let coarser = coarser.to_vec();
+    let group = group.clone();
+    commands.queue(move |world: &mut World| {
+        let Ok(mut e) = world.get_entity_mut(entity) else {
+            return;
+        };
+        let (Some(mesh), Some(material)) = (
+            e.get::<Mesh3d>().map(|m| m.0.clone()),
+            e.get::<MeshMaterial3d<StandardMaterial>>()
+                .map(|m| m.0.clone()),
+        ) else {
+            let why = "the entity lost its Mesh3d or MeshMaterial3d<StandardMaterial>".to_owned();
+            warn!("AutoLod on {entity}: no LOD levels: {why}");
+            e.insert(AutoLodStatus::Failed(why));
+            return;
+        };
+        let levels: Vec<LodLevel> = std::iter::once(mesh)
+            .chain(coarser)
+            .map(|mesh| LodLevel::new(mesh, material.clone()))
+            .collect();
+        let count = levels.len();
+        e.remove::<(Mesh3d, MeshMaterial3d<StandardMaterial>)>()
+            .insert((
+                LodLevels(levels),
+                FrameSequentialGroup::new(group),
+                AutoLodStatus::Ready(count),
+            ));
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::asset::{AssetPlugin, RenderAssetUsages};
+    use bevy::mesh::PrimitiveTopology;
+
+    use crate::auto_lod::*;
+
+    fn app() -> App {
+        let mut app = App::new();
+        app.add_plugins((MinimalPlugins, AssetPlugin::default()))
+            .init_asset::<Mesh>()
+            .init_asset::<Image>()
+            .init_asset::<StandardMaterial>();
+        build(&mut app);
+        app
+    }
+
+    /// Updates until no entity is building (the chains run on the task pool).
+    fn settle(app: &mut App) {
+        for _ in 0..20_000 {
+            app.update();
+            let world = app.world_mut();
+            let building = world
+                .query::<&AutoLodStatus>()
+                .iter(world)
+                .any(|s| *s == AutoLodStatus::Building);
+            let waiting = world
+                .query_filtered::<(), (With<AutoLod>, Without<AutoLodStatus>)>()
+                .iter(world)
+                .count();
+            if !building && waiting == 0 {
+                return;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        panic!("the chains never finished");
+    }
+
+    #[test]
+    fn entities_with_one_mesh_share_one_chain_and_become_groups() {
+        let mut app = app();
+        let world = app.world_mut();
+        let sphere = Sphere::new(1.0).mesh().uv(48, 24);
+        let expected = MeshLodChain::build(&sphere, &AutoLod::default().descriptor).unwrap();
+        let mesh = world.resource_mut::<Assets<Mesh>>().add(sphere);
+        let materials: Vec<_> = [Color::WHITE, Color::BLACK]
+            .map(|c| world.resource_mut::<Assets<StandardMaterial>>().add(c))
+            .into();
+        let entities: Vec<Entity> = materials
+            .iter()
+            .map(|m| {
+                world
+                    .spawn((
+                        Mesh3d(mesh.clone()),
+                        MeshMaterial3d(m.clone()),
+                        AutoLod::default(),
+                    ))
+                    .id()
+            })
+            .collect();
+        settle(&mut app);
+        let world = app.world();
+        let levels: Vec<&LodLevels> = entities
+            .iter()
+            .map(|&e| world.get::<LodLevels>(e).expect("a group"))
+            .collect();
+        let n = expected.meshes().len();
+        assert!(n >= 3, "{n} levels");
+        for (e, (l, m)) in entities.iter().zip(levels.iter().zip(&materials)) {
+            assert_eq!(
+                world.get::<AutoLodStatus>(*e),
+                Some(&AutoLodStatus::Ready(n))
+            );
+            assert_eq!(l.0.len(), n);
+            assert_eq!(l.0[0].mesh, mesh, "level 0 is the entity's own mesh");
+            assert!(l.0.iter().all(|level| level.material == m.clone().into()));
+            assert!(world.get::<Mesh3d>(*e).is_none(), "the group draws it now");
+        }
+        // One chain: the coarser levels are the same assets for both entities.
+        for k in 1..n {
+            assert_eq!(levels[0].0[k].mesh, levels[1].0[k].mesh);
+            let triangles = world
+                .resource::<Assets<Mesh>>()
+                .get(&levels[0].0[k].mesh)
+                .unwrap()
+                .indices()
+                .unwrap()
+                .len()
+                / 3;
+            assert_eq!(triangles, expected.chain().levels()[k].triangles());
+        }
+        assert_eq!(
+            world.resource::<Assets<Mesh>>().len(),
+            n,
+            "one copy of each level"
+        );
+        let group = world.get::<FrameSequentialGroup>(entities[0]).unwrap();
+        assert_eq!(
+            group.group,
+            expected
+                .lod_group(&AutoLod::default().descriptor.camera)
+                .unwrap()
+        );
+    }
+
+    #[test]
+    fn a_mesh_the_chain_cannot_take_is_named_and_left_as_it_is() {
+        let mut app = app();
+        let world = app.world_mut();
+        let lines = Mesh::new(PrimitiveTopology::LineList, RenderAssetUsages::default())
+            .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; 2]);
+        let mesh = world.resource_mut::<Assets<Mesh>>().add(lines);
+        let material = world
+            .resource_mut::<Assets<StandardMaterial>>()
+            .add(Color::WHITE);
+        let entity = world
+            .spawn((Mesh3d(mesh), MeshMaterial3d(material), AutoLod::default()))
+            .id();
+        settle(&mut app);
+        let status = app.world().get::<AutoLodStatus>(entity).unwrap();
+        assert!(
+            matches!(status, AutoLodStatus::Failed(why) if why.contains("LineList")),
+            "{status:?}"
+        );
+        assert!(
+            app.world().get::<Mesh3d>(entity).is_some(),
+            "drawn as before"
+        );
+        assert!(app.world().get::<LodLevels>(entity).is_none());
+    }
+}
