@@ -154,13 +154,14 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
     let Some(sphere) = scene_sphere(app.world_mut()) else {
         return Err((1, format!("{file} has no mesh")));
     };
+    let far = farthest_switch(app.world_mut(), sphere);
     let mut frames = Vec::new();
     // The levels each group drew, by entity.
     let mut drawn: HashMap<Entity, Vec<u8>> = HashMap::new();
     for frame in 0..FRAMES {
         *app.world_mut()
             .get_mut::<Transform>(camera)
-            .expect("camera") = camera_at(sphere, frame);
+            .expect("camera") = camera_at(sphere, far, frame);
         frames.push(headless::capture(&mut app, &target).map_err(|e| (1, e))?);
         let world = app.world_mut();
         for (group, levels) in world
@@ -242,12 +243,29 @@ fn scene_sphere(world: &mut World) -> Option<(Vec3, f32)> {
     (radius.is_finite() && radius > 0.0).then_some((centre, radius))
 }
 
-/// The camera at `frame`: walking back from 2 to 30 scene radii from the scene's centre, a
-/// little above it, at the same pace in log distance (each level's share of the walk is the
-/// same for a small or a large asset).
-fn camera_at((centre, radius): (Vec3, f32), frame: usize) -> Transform {
+/// The world distance from the scene's centre past which every group shows its last level: the
+/// largest switch distance (view-normalized, so times |P11| of Bevy's default π/4 field of view
+/// and the group's scale) plus the group's distance from the centre; at least 30 scene radii.
+fn farthest_switch(world: &mut World, (centre, radius): (Vec3, f32)) -> f32 {
+    let p11 = 1.0 / std::f32::consts::FRAC_PI_8.tan();
+    world
+        .query::<(&FrameSequentialGroup, &GlobalTransform)>()
+        .iter(world)
+        .filter_map(|(group, transform)| {
+            let last = group.group.levels().last()?.distance;
+            let scale = transform.to_scale_rotation_translation().0.abs().max_element();
+            Some(last * p11 * scale + transform.translation().distance(centre))
+        })
+        .fold(30.0 * radius, f32::max)
+}
+
+/// The camera at `frame`: walking back from 2 scene radii from the scene's centre to 1.25 times
+/// `far`, a little above it, at the same pace in log distance (each level gets its share of the
+/// walk, for a small asset or a large one).
+fn camera_at((centre, radius): (Vec3, f32), far: f32, frame: usize) -> Transform {
     let t = frame as f32 / (FRAMES - 1) as f32;
-    let distance = radius * 2.0 * 15f32.powf(t);
+    let (near, far) = (2.0 * radius, 1.25 * far);
+    let distance = near * (far / near).powf(t);
     let eye = centre + distance * Vec3::new(0.0, 0.25, 1.0).normalize();
     Transform::from_translation(eye).looking_at(centre, Vec3::Y)
 }
