@@ -15,13 +15,22 @@
 //! }
 //! ```
 //!
+//! The task runs on a worker thread where Bevy runs multi-threaded (its `multi_threaded`
+//! feature, on in Bevy's defaults); without it Bevy's task pools run on the main thread, and
+//! the frame that starts a chain takes the whole build (measured: about 0.8 s for a
+//! 65,536-triangle sphere, release build, `cargo run --release --example scale -- --auto-lod 4`
+//! in this crate, whose Bevy has no `multi_threaded`).
+//!
 //! One chain is built per mesh (and descriptor), shared by every entity that shows that mesh:
 //! the levels are the same `Handle<Mesh>`s. The main thread only clones the mesh for the task and
 //! adds the finished levels to `Assets<Mesh>`; the simplification and its error bound run on the
 //! task pool. Every vertex attribute is carried to the levels, joints and weights included, so a
 //! skinned mesh stays skinned (the group's drawers take its `SkinnedMesh`). A mesh the chain
 //! cannot take (not a triangle list, its data gone to the render world, no positions) is named
-//! in a warning and the entity is left as it is.
+//! in a warning and the entity is left as it is. The entity stops drawing its own mesh the frame
+//! its group starts: where Bevy compiles pipelines in the background, the level material's
+//! pipeline for that mesh layout may not be ready yet, and the object is missing for those
+//! frames (a group of the same layout drawn earlier has compiled it).
 
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;

@@ -253,7 +253,11 @@ fn farthest_switch(world: &mut World, (centre, radius): (Vec3, f32)) -> f32 {
         .iter(world)
         .filter_map(|(group, transform)| {
             let last = group.group.levels().last()?.distance;
-            let scale = transform.to_scale_rotation_translation().0.abs().max_element();
+            let scale = transform
+                .to_scale_rotation_translation()
+                .0
+                .abs()
+                .max_element();
             Some(last * p11 * scale + transform.translation().distance(centre))
         })
         .fold(30.0 * radius, f32::max)

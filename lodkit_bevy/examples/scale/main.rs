@@ -16,6 +16,10 @@
 //! warm-up: labelled `wall_ms`), the GPU time of the render passes Bevy's render diagnostics time
 //! with timestamps (`gpu_ms`, median), the groups in transition (median), and lodkit's CPU time
 //! spent on silhouettes.
+//!
+//! `--auto-lod N` instead times N entities given `AutoLod` (one 65,536-triangle sphere mesh, so
+//! one chain built in the background): every frame from the one that adds the component until
+//! all are groups, and the frames around; it prints the slowest frame against the median.
 
 #[path = "../common/frames.rs"]
 #[allow(
@@ -53,7 +57,8 @@ const BAND: f32 = 6.0;
 /// Updates before timing: pipelines compiled, buffers grown.
 const WARMUP: usize = 8;
 
-const USAGE: &str = "usage: scale [--groups N[,N...]] [--frames F] [--size WxH] [--report FILE]";
+const USAGE: &str =
+    "usage: scale [--groups N[,N...]] [--frames F] [--size WxH] [--report FILE] [--auto-lod N]";
 
 #[derive(Clone, Copy, PartialEq)]
 enum Technique {
@@ -75,6 +80,7 @@ struct Args {
     frames: usize,
     size: UVec2,
     report: Option<PathBuf>,
+    auto_lod: Option<usize>,
 }
 
 fn parse() -> Result<Args, String> {
@@ -83,6 +89,7 @@ fn parse() -> Result<Args, String> {
         frames: 48,
         size: UVec2::new(160, 90),
         report: None,
+        auto_lod: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -113,6 +120,10 @@ fn parse() -> Result<Args, String> {
                 };
             }
             "--report" => args.report = Some(value()?.into()),
+            "--auto-lod" => {
+                let n = value()?;
+                args.auto_lod = Some(n.parse().map_err(|e| format!("--auto-lod {n}: {e}"))?);
+            }
             "-h" | "--help" => return Err(String::new()),
             _ => return Err(format!("unknown argument {arg}")),
         }
@@ -132,6 +143,10 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Some(n) = args.auto_lod {
+        auto_lod_frames(n, &args);
+        return ExitCode::SUCCESS;
+    }
     let mut rows = Vec::new();
     println!("groups  technique          median ms  p90 ms  GPU ms  in transition  silhouettes ms");
     for &n in &args.groups {
@@ -154,7 +169,15 @@ fn main() -> ExitCode {
                 "gpu_ms_median": row.gpu,
                 "in_transition_median": row.in_transition,
                 "silhouette_ms_median": row.silhouette_ms,
+                "gpu_ms_median_per_pass": row.passes.iter().map(|(p, ms)| (p.clone(), serde_json::Value::from(*ms))).collect::<serde_json::Map<_, _>>(),
             }));
+            let passes: Vec<String> = row
+                .passes
+                .iter()
+                .filter(|(_, ms)| *ms >= 0.05)
+                .map(|(pass, ms)| format!("{pass} {ms:.2}"))
+                .collect();
+            println!("        GPU ms per pass: {}", passes.join(", "));
         }
     }
     if let Some(path) = &args.report {
@@ -177,6 +200,8 @@ struct Row {
     gpu: f64,
     in_transition: usize,
     silhouette_ms: f64,
+    /// Median GPU milliseconds of each render pass Bevy's diagnostics time.
+    passes: Vec<(String, f64)>,
 }
 
 /// The grid's side for `n` groups, and each group's position (centred on x, in front along -z).
@@ -300,6 +325,7 @@ fn run(technique: Technique, n: usize, args: &Args) -> Row {
     let mut in_transition = Vec::new();
     let mut silhouettes = Vec::new();
     let mut seen = std::collections::HashMap::new();
+    let mut passes: std::collections::BTreeMap<String, Vec<f64>> = Default::default();
     for frame in 0..args.frames {
         *app.world_mut()
             .get_mut::<Transform>(camera)
@@ -311,13 +337,18 @@ fn run(technique: Technique, n: usize, args: &Args) -> Row {
         let store = app.world().resource::<DiagnosticsStore>();
         let mut ms = 0.0;
         for d in store.iter() {
-            if !d.path().as_str().ends_with("/elapsed_gpu") {
+            let path = d.path().as_str();
+            let Some(pass) = path
+                .strip_prefix("render/")
+                .and_then(|p| p.strip_suffix("/elapsed_gpu"))
+            else {
                 continue;
-            }
+            };
             if let Some(m) = d.measurement()
                 && seen.insert(d.path().clone(), m.time) != Some(m.time)
             {
                 ms += m.value;
+                passes.entry(pass.to_owned()).or_default().push(m.value);
             }
         }
         gpu.push(ms);
@@ -345,6 +376,14 @@ fn run(technique: Technique, n: usize, args: &Args) -> Row {
             in_transition[in_transition.len() / 2]
         },
         silhouette_ms: percentile(&mut silhouettes, 0.5),
+        passes: passes
+            .into_iter()
+            .map(|(pass, mut ms)| {
+                // A pass that ran in only some frames counts 0 in the others.
+                ms.resize(args.frames, 0.0);
+                (pass, percentile(&mut ms, 0.5))
+            })
+            .collect(),
     }
 }
 
@@ -353,4 +392,95 @@ fn percentile(values: &mut [f64], q: f64) -> f64 {
     values.sort_by(f64::total_cmp);
     let rank = ((q * values.len() as f64).ceil() as usize).clamp(1, values.len());
     values[rank - 1]
+}
+
+/// Frames while `n` entities sharing one mesh get `AutoLod`: the median frame before and after,
+/// and the slowest frame in between.
+fn auto_lod_frames(n: usize, args: &Args) {
+    use lodkit_bevy::auto_lod::{AutoLod, AutoLodStatus};
+    let mut app = headless::build_app(|app| {
+        app.add_plugins(FrameSequentialLodPlugin);
+    });
+    let world = app.world_mut();
+    let target = headless::render_target(world, args.size.x, args.size.y);
+    world.spawn((
+        Camera3d::default(),
+        RenderTarget::from(target),
+        Msaa::Off,
+        Tonemapping::None,
+        DebandDither::Disabled,
+        FrameSequentialLod::default(),
+        camera_at(0, args.frames),
+    ));
+    world.spawn((
+        DirectionalLight::default(),
+        Transform::from_xyz(-2.0, 4.0, 3.0),
+    ));
+    let mesh = world
+        .resource_mut::<Assets<Mesh>>()
+        .add(Sphere::new(1.0).mesh().uv(256, 129));
+    let material = world
+        .resource_mut::<Assets<StandardMaterial>>()
+        .add(Color::srgb(0.9, 0.55, 0.2));
+    let entities: Vec<Entity> = (0..n)
+        .map(|i| {
+            world
+                .spawn((
+                    Mesh3d(mesh.clone()),
+                    MeshMaterial3d(material.clone()),
+                    Transform::from_translation(position(n, i)),
+                ))
+                .id()
+        })
+        .collect();
+    // One group drawn from the start: the level material's pipelines are compiled before the
+    // timed frames (the headless app compiles them synchronously, a one-off cost that is not
+    // AutoLod's).
+    let level = || LodLevel::new(mesh.clone(), material.clone());
+    world.spawn((
+        LodLevels(vec![level(), level()]),
+        FrameSequentialGroup::new(LodGroup::from_distances(&[0.0, 1e6]).expect("increasing")),
+        Transform::from_xyz(0.0, 0.0, -3.0),
+    ));
+    for _ in 0..WARMUP {
+        headless::step(&mut app);
+    }
+    const AROUND: usize = 10;
+    let mut times = Vec::new();
+    let mut all_ready = None;
+    for frame in 0..2_000 {
+        if frame == AROUND {
+            for &e in &entities {
+                app.world_mut().entity_mut(e).insert(AutoLod::default());
+            }
+        }
+        let start = Instant::now();
+        headless::step(&mut app);
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        let world = app.world_mut();
+        let ready = world
+            .query::<&AutoLodStatus>()
+            .iter(world)
+            .filter(|s| matches!(s, AutoLodStatus::Ready(_)))
+            .count();
+        if ready == n && all_ready.is_none() {
+            all_ready = Some(frame);
+        }
+        if all_ready.is_some_and(|f| frame >= f + AROUND) {
+            break;
+        }
+    }
+    let before = percentile(&mut times[..AROUND].to_vec(), 0.5);
+    let after = percentile(&mut times[times.len() - AROUND..].to_vec(), 0.5);
+    let worst = times[AROUND..times.len() - AROUND + 1]
+        .iter()
+        .copied()
+        .fold(0.0, f64::max);
+    println!(
+        "{n} entities, AutoLod added at frame {AROUND}, all groups at frame {}: median frame \
+         {before:.2} ms before, {after:.2} ms after; slowest frame in between {worst:.2} ms \
+         ({} frames)",
+        all_ready.map_or("never".into(), |f| f.to_string()),
+        times.len() - 2 * AROUND + 1
+    );
 }
