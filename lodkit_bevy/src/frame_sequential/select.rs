@@ -337,10 +337,14 @@ fn update(
                 // The group's first dithered transition: its second drawer, shown at once.
                 (None, Some((mesh, material, tag))) => {
                     let drawer = spawn_drawer(&mut commands, entity, mesh, skin);
+                    // Transforms were propagated before this system: the new child gets its
+                    // group's (its own is the identity), or it would be drawn at the origin
+                    // this frame.
                     commands.entity(drawer).insert((
                         MeshMaterial3d(material),
                         MeshTag::new(tag),
                         Visibility::Inherited,
+                        *transform,
                     ));
                     state.dither_entity = Some(drawer);
                 }
