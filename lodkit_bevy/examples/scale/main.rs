@@ -42,6 +42,7 @@ use bevy::diagnostic::DiagnosticsStore;
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
+use lodkit::metrics::median;
 use lodkit::select::{LodGroup, LodSettings, TransitionMode};
 use lodkit_bevy::frame_sequential::{
     FrameSequentialGroup, FrameSequentialLod, FrameSequentialLodPlugin, FrameSequentialStats,
@@ -368,26 +369,26 @@ fn run(technique: Technique, n: usize, args: &Args) -> Row {
         );
     }
     Row {
-        median: percentile(&mut wall, 0.5),
+        median: median(&wall),
         p90: percentile(&mut wall, 0.9),
-        gpu: percentile(&mut gpu, 0.5),
+        gpu: median(&gpu),
         in_transition: {
             in_transition.sort_unstable();
             in_transition[in_transition.len() / 2]
         },
-        silhouette_ms: percentile(&mut silhouettes, 0.5),
+        silhouette_ms: median(&silhouettes),
         passes: passes
             .into_iter()
             .map(|(pass, mut ms)| {
                 // A pass that ran in only some frames counts 0 in the others.
                 ms.resize(args.frames, 0.0);
-                (pass, percentile(&mut ms, 0.5))
+                (pass, median(&ms))
             })
             .collect(),
     }
 }
 
-/// The `q` quantile of `values` (nearest rank).
+/// The `q` quantile of `values` (nearest rank; the medians are `lodkit::metrics::median`'s).
 fn percentile(values: &mut [f64], q: f64) -> f64 {
     values.sort_by(f64::total_cmp);
     let rank = ((q * values.len() as f64).ceil() as usize).clamp(1, values.len());
@@ -470,8 +471,8 @@ fn auto_lod_frames(n: usize, args: &Args) {
             break;
         }
     }
-    let before = percentile(&mut times[..AROUND].to_vec(), 0.5);
-    let after = percentile(&mut times[times.len() - AROUND..].to_vec(), 0.5);
+    let before = median(&times[..AROUND]);
+    let after = median(&times[times.len() - AROUND..]);
     let worst = times[AROUND..times.len() - AROUND + 1]
         .iter()
         .copied()

@@ -27,7 +27,7 @@
 //!
 //! ```no_run
 //! use bevy::prelude::*;
-//! use lodkit::select::LodSettings;
+//! use lodkit::select::{LodGroup, LodSettings};
 //! use lodkit_bevy::frame_sequential::*;
 //!
 //! fn setup(
