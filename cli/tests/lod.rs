@@ -357,3 +357,67 @@ fn babylon_loads_the_msft_lod_levels_in_order() {
     ours.reverse();
     assert_eq!(loads, ours, "Babylon.js {}", got["babylon"]);
 }
+
+/// lodkit_bevy's `gltf_scene` example loads a committed file that `lodkit lod` made of the
+/// repository's scene: it is exactly what the scene's writer and `lodkit lod` write now (a
+/// change to either, or a hand edit, fails here), and it holds what the example is about.
+#[test]
+fn committed_gltf_scene_is_what_lodkit_lod_writes() {
+    use lodkit_cli::demo::fixtures::gltf_scene::{ASSET, lod_args, write};
+    let dir = Scratch::folder();
+    write(&dir).unwrap();
+    let out = dir.join("lod_scene.glb");
+    let mut args = vec!["lod".to_owned(), "scene.gltf".to_owned()];
+    args.extend(lod_args(&out));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, stderr) = run(&dir, &args);
+    assert_eq!(code, 0, "{stderr}");
+    let committed = crate::support::workspace_root().join(ASSET);
+    let fix = "regenerate it with `bash scripts/gltf-scene.sh`";
+    let on_disk =
+        std::fs::read(&committed).unwrap_or_else(|e| panic!("{}: {e}; {fix}", committed.display()));
+    assert!(
+        same_glb(&on_disk, &std::fs::read(&out).unwrap()),
+        "{} is stale or was edited by hand; {fix}",
+        committed.display()
+    );
+    // Three objects with levels (the ball, the two-material tree, the ring), in order, and the
+    // crate as it was: one level, no MSFT_lod.
+    let (doc, _, _) = gltf::import(&committed).unwrap();
+    let levels = |name: &str| {
+        let node = doc.nodes().find(|n| n.name() == Some(name)).unwrap();
+        node.extension_value("MSFT_lod")
+            .map_or(0, |lod| lod["ids"].as_array().unwrap().len())
+            + 1
+    };
+    assert_eq!(["ball", "tree", "ring", "crate"].map(levels), [4, 4, 4, 1]);
+    let tree = doc.meshes().find(|m| m.name() == Some("tree")).unwrap();
+    assert_eq!(tree.primitives().count(), 2);
+    assert_eq!(doc.materials().count(), 5);
+}
+
+/// The JSON chunk's value (numbers as the f32 they stand for: how a float is printed differs
+/// with serde_json's features, which differ between a test build and `cargo run`) and the
+/// binary chunk's bytes of a GLB file.
+fn glb_parts(glb: &[u8]) -> Option<(serde_json::Value, &[u8])> {
+    fn to_f32(v: serde_json::Value) -> serde_json::Value {
+        use serde_json::Value;
+        match v {
+            Value::Number(n) if !n.is_u64() && !n.is_i64() => {
+                serde_json::json!(n.as_f64().map(|x| x as f32))
+            }
+            Value::Array(a) => Value::Array(a.into_iter().map(to_f32).collect()),
+            Value::Object(o) => Value::Object(o.into_iter().map(|(k, v)| (k, to_f32(v))).collect()),
+            other => other,
+        }
+    }
+    let word = |at: usize| Some(u32::from_le_bytes(glb.get(at..at + 4)?.try_into().ok()?) as usize);
+    let json_len = word(12)?;
+    let json = glb.get(20..20 + json_len)?;
+    let bin = glb.get(20 + json_len + 8..)?;
+    Some((to_f32(serde_json::from_slice(json).ok()?), bin))
+}
+
+fn same_glb(a: &[u8], b: &[u8]) -> bool {
+    matches!((glb_parts(a), glb_parts(b)), (Some(x), Some(y)) if x == y)
+}

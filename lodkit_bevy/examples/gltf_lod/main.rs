@@ -17,6 +17,8 @@
 //!
 //! Exit codes: 0 done, 1 the scene did not load or render, 2 usage or I/O error.
 
+#[path = "../common/bounds.rs"]
+mod bounds;
 #[path = "../common/frames.rs"]
 #[allow(
     dead_code,
@@ -32,7 +34,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use bevy::camera::RenderTarget;
-use bevy::camera::primitives::Aabb;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
@@ -151,7 +152,7 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
     }
     headless::step(&mut app);
     headless::step(&mut app);
-    let Some(sphere) = scene_sphere(app.world_mut()) else {
+    let Some(sphere) = bounds::scene_sphere(app.world_mut()) else {
         return Err((1, format!("{file} has no mesh")));
     };
     let far = farthest_switch(app.world_mut(), sphere);
@@ -213,34 +214,6 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
         std::fs::write(path, serde_json::to_string_pretty(&json).expect("JSON")).map_err(io)?;
     }
     Ok(())
-}
-
-/// The sphere around every box in the scene (`Aabb`s, kept by the groups): (centre, radius).
-fn scene_sphere(world: &mut World) -> Option<(Vec3, f32)> {
-    let spheres: Vec<(Vec3, f32)> = world
-        .query::<(&Aabb, &GlobalTransform)>()
-        .iter(world)
-        .map(|(aabb, transform)| {
-            let scale = transform
-                .to_scale_rotation_translation()
-                .0
-                .abs()
-                .max_element();
-            let centre = transform.transform_point(Vec3::from(aabb.center));
-            (centre, Vec3::from(aabb.half_extents).length() * scale)
-        })
-        .collect();
-    let (lo, hi) = spheres
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &(c, r)| {
-            (lo.min(c - r), hi.max(c + r))
-        });
-    let centre = 0.5 * (lo + hi);
-    let radius = spheres
-        .iter()
-        .map(|&(c, r)| c.distance(centre) + r)
-        .fold(0.0f32, f32::max);
-    (radius.is_finite() && radius > 0.0).then_some((centre, radius))
 }
 
 /// The world distance from the scene's centre past which every group shows its last level: the

@@ -330,12 +330,15 @@ fn update(
             state.previous_model = Some(model);
             state.selection = Some(selection);
             state.drawn = selection.current;
-            let [outgoing, incoming] = dither_draws(&selection);
-            show(&mut drawers, state.entity, outgoing, levels, &derived);
+            let [mut outgoing, incoming] = dither_draws(&selection);
             match (state.dither_entity, drawn(incoming, levels, &derived)) {
                 (Some(drawer), _) => show(&mut drawers, drawer, incoming, levels, &derived),
-                // The group's first dithered transition: its second drawer, shown at once.
+                // The group's first dithered transition: its second drawer is spawned now, and
+                // Bevy draws an entity from the frame after the one it was spawned in. This
+                // frame the outgoing level is drawn whole (the transition starts a frame
+                // late), or the pixels left to the incoming one would show what is behind.
                 (None, Some((mesh, material, tag))) => {
+                    outgoing = outgoing.map(|(level, _)| (level, 0));
                     let drawer = spawn_drawer(&mut commands, entity, mesh, skin);
                     // Transforms were propagated before this system: the new child gets its
                     // group's (its own is the identity), or it would be drawn at the origin
@@ -350,6 +353,7 @@ fn update(
                 }
                 (None, None) => {}
             }
+            show(&mut drawers, state.entity, outgoing, levels, &derived);
             continue;
         }
         keep_frame |= reconcile(scheduler, state, &selection, older_kept && !blending);

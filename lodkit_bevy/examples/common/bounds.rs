@@ -1,0 +1,33 @@
+//! The sphere around what a loaded scene shows, for the examples' camera walks.
+
+use bevy::camera::primitives::Aabb;
+use bevy::prelude::*;
+
+/// The sphere around every box in the scene (`Aabb`s, kept by LOD groups too): (centre,
+/// radius); None for an empty scene.
+pub fn scene_sphere(world: &mut World) -> Option<(Vec3, f32)> {
+    let spheres: Vec<(Vec3, f32)> = world
+        .query::<(&Aabb, &GlobalTransform)>()
+        .iter(world)
+        .map(|(aabb, transform)| {
+            let scale = transform
+                .to_scale_rotation_translation()
+                .0
+                .abs()
+                .max_element();
+            let centre = transform.transform_point(Vec3::from(aabb.center));
+            (centre, Vec3::from(aabb.half_extents).length() * scale)
+        })
+        .collect();
+    let (lo, hi) = spheres
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &(c, r)| {
+            (lo.min(c - r), hi.max(c + r))
+        });
+    let centre = 0.5 * (lo + hi);
+    let radius = spheres
+        .iter()
+        .map(|&(c, r)| c.distance(centre) + r)
+        .fold(0.0f32, f32::max);
+    (radius.is_finite() && radius > 0.0).then_some((centre, radius))
+}

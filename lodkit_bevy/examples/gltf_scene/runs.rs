@@ -1,0 +1,317 @@
+//! The loaded scene and one run over it: a camera of its own (Bevy's default MSAA, nothing
+//! else changed), the scene's LOD groups drawn by lodkit, by Bevy's `VisibilityRange` crossfade
+//! from the same levels, or as one level alone (the references), every frame read back.
+
+use std::path::Path;
+
+use bevy::camera::RenderTarget;
+use bevy::camera::visibility::VisibilityRange;
+use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
+use bevy::prelude::*;
+use bevy::render::gpu_readback::{Readback, ReadbackComplete};
+use lodkit_bevy::frame_sequential::{
+    FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod, FrameSequentialLodPlugin,
+    LevelMaterial, LodLevels,
+};
+
+use crate::frames::Frame;
+use crate::headless::{build_app_with_assets, render_target, step};
+
+pub const WIDTH: u32 = 320;
+/// The height `lodkit lod` made the committed file's switch distances for.
+pub const HEIGHT: u32 = 180;
+pub const BACKGROUND: Color = Color::srgb_u8(20, 23, 31);
+/// Updates at the first pose before a run is recorded (materials and view resources ready).
+const WARMUP_UPDATES: usize = 3;
+/// Updates to wait for the last readbacks of a run.
+const DRAIN_UPDATES: usize = 12;
+
+/// A failure with its exit code.
+pub struct Failure(pub u8, pub String);
+
+/// How a run draws the scene's LOD groups (nodes without levels are drawn as loaded in every
+/// run).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Technique {
+    /// Each group's level k alone (its last where it has fewer), as a plain Bevy mesh: the
+    /// references.
+    Level(usize),
+    /// Bevy's own `VisibilityRange` crossfade over the group's levels, at its distances and
+    /// with the same band.
+    BevyCrossfade,
+    /// lodkit's frame-sequential LOD: the groups the plugin made of the file, as they are.
+    FrameSequential,
+}
+
+/// A LOD group the plugin made of the file.
+pub struct Group {
+    pub entity: Entity,
+    pub name: String,
+    /// Mesh and StandardMaterial of each level.
+    pub levels: Vec<(Handle<Mesh>, Handle<StandardMaterial>)>,
+    /// View-normalized switch distances (the first is 0).
+    pub distances: Vec<f32>,
+    pub max_distance: Option<f32>,
+    pub transform: Transform,
+    /// Largest axis scale (lodkit divides world distances by it).
+    pub scale: f32,
+}
+
+impl Group {
+    /// Bevy's visibility range of level `k`: the band of lodkit's hysteresis `h` around each
+    /// switch, in world units (view-normalized distance times |P11| and the scale).
+    fn range(&self, k: usize, h: f32) -> VisibilityRange {
+        let world = |d: f32| (d - h / 2.0) * p11() * self.scale..(d + h / 2.0) * p11() * self.scale;
+        let next = self.distances.get(k + 1).copied().or(self.max_distance);
+        VisibilityRange {
+            start_margin: if k == 0 {
+                0.0..0.0
+            } else {
+                world(self.distances[k])
+            },
+            end_margin: next.map_or(f32::MAX..f32::MAX, world),
+            use_aabb: false,
+        }
+    }
+}
+
+/// |P[1][1]| of Bevy's default perspective (vertical field of view π/4).
+pub fn p11() -> f32 {
+    1.0 / std::f32::consts::FRAC_PI_8.tan()
+}
+
+/// Frames read back, in order.
+#[derive(Resource, Default)]
+struct Inbox(Vec<Vec<u8>>);
+
+/// What one run recorded.
+pub struct Run {
+    pub frames: Vec<Frame>,
+    /// Per group (in [`Scene::groups`] order): the levels lodkit drew, in the order first drawn.
+    pub drawn: Vec<Vec<u8>>,
+}
+
+pub struct Scene {
+    app: App,
+    target: Handle<Image>,
+    pub groups: Vec<Group>,
+    /// Meshes the file gave no levels (drawn as loaded).
+    pub plain_meshes: usize,
+    /// The sphere around the scene: (centre, radius).
+    pub sphere: (Vec3, f32),
+}
+
+impl Scene {
+    /// Loads scene 0 of `file` (in folder `assets`) with Bevy's glTF loader, in an app whose
+    /// only lodkit code is the plugin.
+    pub fn load(assets: &Path, file: &str) -> Result<Self, Failure> {
+        let mut app = build_app_with_assets(Some(assets), |app| {
+            app.add_plugins(FrameSequentialLodPlugin)
+                .init_resource::<Inbox>();
+        });
+        let world = app.world_mut();
+        let target = render_target(world, WIDTH, HEIGHT);
+        world.spawn((
+            DirectionalLight {
+                illuminance: 6000.0,
+                ..default()
+            },
+            Transform::from_xyz(3.0, 6.0, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+        let scene = world
+            .resource::<AssetServer>()
+            .load(GltfAssetLabel::Scene(0).from_asset(file.to_owned()));
+        world.spawn(WorldAssetRoot(scene));
+        let mut loaded = false;
+        for _ in 0..600 {
+            step(&mut app);
+            let world = app.world_mut();
+            loaded = world
+                .query_filtered::<Entity, With<WorldAssetRoot>>()
+                .iter(world)
+                .any(|root| world.get::<Children>(root).is_some_and(|c| !c.is_empty()));
+            if loaded {
+                break;
+            }
+        }
+        if !loaded {
+            return Err(Failure(1, format!("{file} did not load")));
+        }
+        // The groups are made, their transforms propagated.
+        step(&mut app);
+        step(&mut app);
+        let world = app.world_mut();
+        let mut groups = Vec::new();
+        let mut query = world.query::<(
+            Entity,
+            &FrameSequentialGroup,
+            &LodLevels,
+            &GlobalTransform,
+            Option<&Name>,
+            Option<&ChildOf>,
+        )>();
+        for (entity, group, levels, transform, name, parent) in query.iter(world) {
+            let name = name
+                .or_else(|| parent.and_then(|p| world.get::<Name>(p.parent())))
+                .map_or_else(|| format!("{entity}"), |n| n.as_str().to_owned());
+            let levels = levels
+                .0
+                .iter()
+                .map(|level| match &level.material {
+                    LevelMaterial::Standard(material) => Ok((level.mesh.clone(), material.clone())),
+                    LevelMaterial::FrameSequential(_) => Err(Failure(
+                        1,
+                        format!("{name}: a level without a StandardMaterial"),
+                    )),
+                })
+                .collect::<Result<_, _>>()?;
+            let transform = transform.compute_transform();
+            groups.push(Group {
+                entity,
+                name,
+                levels,
+                distances: group.group.levels().iter().map(|l| l.distance).collect(),
+                max_distance: group.group.max_distance(),
+                scale: transform.scale.abs().max_element(),
+                transform,
+            });
+        }
+        groups.sort_by(|a, b| a.name.cmp(&b.name));
+        let plain_meshes = world
+            .query_filtered::<(), With<MeshMaterial3d<StandardMaterial>>>()
+            .iter(world)
+            .count();
+        let Some(sphere) = crate::bounds::scene_sphere(world) else {
+            return Err(Failure(1, format!("{file} has no mesh")));
+        };
+        Ok(Self {
+            app,
+            target,
+            groups,
+            plain_meshes,
+            sphere,
+        })
+    }
+
+    /// The world distance from the scene's centre past which every group shows its last level:
+    /// each group's last switch (the far edge of its band) plus its distance from the centre.
+    pub fn farthest_switch(&self) -> f32 {
+        let h = FrameSequentialLod::default().settings.hysteresis;
+        self.groups
+            .iter()
+            .filter_map(|g| {
+                let last = g.distances.iter().skip(1).last()?;
+                let off = g.transform.translation.distance(self.sphere.0);
+                Some((last + h / 2.0) * p11() * g.scale + off)
+            })
+            .fold(2.0 * self.sphere.1, f32::max)
+    }
+
+    /// Runs `technique` with the camera at `poses`, one per frame.
+    pub fn run(&mut self, technique: Technique, poses: &[Transform]) -> Result<Run, Failure> {
+        let world = self.app.world_mut();
+        // An app's camera: Bevy's default MSAA (Sample4) is left as it is; no tonemapping or
+        // deband dither, so the background is the clear colour exactly.
+        let mut camera = world.spawn((
+            Camera3d::default(),
+            Camera {
+                clear_color: ClearColorConfig::Custom(BACKGROUND),
+                ..default()
+            },
+            RenderTarget::from(self.target.clone()),
+            Tonemapping::None,
+            DebandDither::Disabled,
+            poses[0],
+        ));
+        if technique == Technique::FrameSequential {
+            camera.insert(FrameSequentialLod::default());
+        }
+        let camera = camera.id();
+        let h = FrameSequentialLod::default().settings.hysteresis;
+        let mut copies = Vec::new();
+        for group in &self.groups {
+            let shown = technique == Technique::FrameSequential;
+            *world.get_mut::<Visibility>(group.entity).expect("a group") = if shown {
+                Visibility::Inherited
+            } else {
+                Visibility::Hidden
+            };
+            let last = group.levels.len() - 1;
+            let levels: Vec<usize> = match technique {
+                Technique::Level(k) => vec![k.min(last)],
+                Technique::BevyCrossfade => (0..=last).collect(),
+                Technique::FrameSequential => Vec::new(),
+            };
+            for k in levels {
+                let (mesh, material) = group.levels[k].clone();
+                let mut copy =
+                    world.spawn((Mesh3d(mesh), MeshMaterial3d(material), group.transform));
+                if technique == Technique::BevyCrossfade {
+                    copy.insert(group.range(k, h));
+                }
+                copies.push(copy.id());
+            }
+        }
+        for _ in 0..WARMUP_UPDATES {
+            step(&mut self.app);
+        }
+        let world = self.app.world_mut();
+        world.resource_mut::<Inbox>().0.clear();
+        let readback = world
+            .spawn(Readback::texture(self.target.clone()))
+            .observe(|done: On<ReadbackComplete>, mut inbox: ResMut<Inbox>| {
+                inbox.0.push(done.data.clone());
+            })
+            .id();
+        let mut drawn = vec![Vec::new(); self.groups.len()];
+        for pose in poses {
+            *self
+                .app
+                .world_mut()
+                .get_mut::<Transform>(camera)
+                .expect("camera") = *pose;
+            step(&mut self.app);
+            let world = self.app.world();
+            for (group, seen) in self.groups.iter().zip(&mut drawn) {
+                if let Some(levels) = world.get::<FrameSequentialLevels>(group.entity)
+                    && technique == Technique::FrameSequential
+                    && !seen.contains(&levels.drawn)
+                {
+                    seen.push(levels.drawn);
+                }
+            }
+        }
+        for _ in 0..DRAIN_UPDATES {
+            if self.app.world().resource::<Inbox>().0.len() >= poses.len() {
+                break;
+            }
+            step(&mut self.app);
+        }
+        let world = self.app.world_mut();
+        world.despawn(readback);
+        world.despawn(camera);
+        for copy in copies {
+            world.despawn(copy);
+        }
+        let data = std::mem::take(&mut world.resource_mut::<Inbox>().0);
+        if data.len() < poses.len() {
+            return Err(Failure(
+                1,
+                format!("{} of {} frames came back", data.len(), poses.len()),
+            ));
+        }
+        // Let the last frames' readbacks come in before the next run.
+        for _ in 0..4 {
+            step(&mut self.app);
+        }
+        self.app.world_mut().resource_mut::<Inbox>().0.clear();
+        Ok(Run {
+            frames: data
+                .into_iter()
+                .take(poses.len())
+                .map(|rgba| Frame::new(WIDTH, HEIGHT, rgba))
+                .collect(),
+            drawn,
+        })
+    }
+}
