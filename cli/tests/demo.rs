@@ -128,6 +128,60 @@ fn demo_command_rejects_bad_options_with_usage_errors() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/scene.ron"));
 }
 
+/// A run whose stderr is not a terminal (a CI log, a pipe) prints a line per scene and part,
+/// with the seconds since the start, where a terminal gets the progress bar.
+#[test]
+fn demo_prints_a_line_per_part_when_its_output_is_not_a_terminal() {
+    let _gpu = lodkit_test_gpu!();
+    let out = scratch("demo-lines");
+    std::fs::create_dir_all(&*out).unwrap();
+    let scene = out.join("simple.ron");
+    let text = ron::ser::to_string_pretty(&DemoScene::simple(), Default::default()).unwrap();
+    std::fs::write(&scene, text).unwrap();
+    let run = lodkit()
+        .arg("demo")
+        .arg("--out")
+        .arg(&*out)
+        .arg("--scene")
+        .arg(&scene)
+        .args([
+            "--size",
+            "64x64",
+            "--frames",
+            "4",
+            "--pairs",
+            "1",
+            "--fb-size",
+            "64x64",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.starts_with('[')).collect();
+    for technique in Technique::ALL {
+        let part = format!("scene simple: {}: done", technique.name());
+        assert!(
+            lines.iter().any(|l| l.ends_with(&part)),
+            "no line `{part}` in\n{stderr}"
+        );
+    }
+    for part in [
+        "framebuffer LOD: timing: done",
+        "pass time ratios",
+        "plots and report",
+    ] {
+        assert!(
+            lines.iter().any(|l| l.contains(part)),
+            "no `{part}` in\n{stderr}"
+        );
+    }
+    assert!(
+        lines.last().is_some_and(|l| l.ends_with("] done")),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn demo_without_an_adapter_says_what_to_install() {
     // This build has no Metal backend on Linux, so asking for it finds no adapter at all.

@@ -60,7 +60,8 @@ pub struct DemoOptions {
     /// controller runs (64..=4096 each way; default 1280x720, where a pass is not dominated by
     /// submission overhead).
     pub fb_size: (u32, u32),
-    /// Show a progress bar on the terminal.
+    /// Show progress on stderr: a bar on a terminal, one line per scene and part elsewhere (a
+    /// CI log, a pipe).
     pub progress: bool,
 }
 
@@ -98,6 +99,69 @@ impl Default for DemoOptions {
             fb_size: (1280, 720),
             progress: true,
         }
+    }
+}
+
+/// Progress of a run on stderr: a bar on a terminal; elsewhere (a CI log, a pipe, where a bar
+/// is not drawn) a line per part with the seconds since the start, so a log shows where the
+/// time goes.
+struct Progress {
+    bar: indicatif::ProgressBar,
+    lines: bool,
+    start: std::time::Instant,
+}
+
+impl Progress {
+    fn new(enabled: bool, steps: usize) -> Self {
+        use std::io::IsTerminal;
+        let terminal = std::io::stderr().is_terminal();
+        let bar = if enabled && terminal {
+            indicatif::ProgressBar::new(steps as u64)
+        } else {
+            indicatif::ProgressBar::hidden()
+        };
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:32} {pos}/{len} {msg}",
+        ) {
+            bar.set_style(style);
+        }
+        Self {
+            bar,
+            lines: enabled && !terminal,
+            start: std::time::Instant::now(),
+        }
+    }
+
+    /// The part that starts now.
+    fn set_message(&self, message: impl Into<String>) {
+        let message = message.into();
+        if self.lines {
+            let seconds = self.start.elapsed().as_secs_f64();
+            eprintln!("[{seconds:7.1} s] {message}");
+        }
+        self.bar.set_message(message);
+    }
+
+    fn inc(&self, n: u64) {
+        self.bar.inc(n);
+    }
+
+    /// A step that has just ended.
+    fn done(&self, message: String) {
+        if self.lines {
+            let seconds = self.start.elapsed().as_secs_f64();
+            eprintln!("[{seconds:7.1} s] {message}: done");
+        }
+        self.bar.set_message(message);
+        self.bar.inc(1);
+    }
+
+    fn finish(&self) {
+        if self.lines {
+            let seconds = self.start.elapsed().as_secs_f64();
+            eprintln!("[{seconds:7.1} s] done");
+        }
+        self.bar.finish_and_clear();
     }
 }
 
@@ -188,16 +252,7 @@ pub fn run_on(
     std::fs::create_dir_all(out).map_err(|e| DemoError::io(out, e))?;
     let steps =
         scenes.len() * render::Technique::ALL.len() + upsample_quality::RESIZE_FACTORS.len() + 7;
-    let bar = if options.progress {
-        indicatif::ProgressBar::new(steps as u64)
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "{spinner} [{elapsed_precise}] {bar:32} {pos}/{len} {msg}",
-    ) {
-        bar.set_style(style);
-    }
+    let bar = Progress::new(options.progress, steps);
     let mut transitions = Vec::new();
     let mut counter = String::new();
     for scene in scenes {
@@ -208,10 +263,7 @@ pub fn run_on(
         bar.set_message(format!("scene {}", scene.name));
         let renderer = render::SceneRenderer::new(gpu, scene, options.size, options.frames)?;
         counter = renderer.counter().kind().describe().to_owned();
-        let mut tick = |name: &str| {
-            bar.set_message(format!("scene {}: {name}", scene.name));
-            bar.inc(1);
-        };
+        let mut tick = |name: &str| bar.done(format!("scene {}: {name}", scene.name));
         transitions.extend(transitions::measure_scene(
             gpu,
             &renderer,
@@ -222,10 +274,7 @@ pub fn run_on(
         )?);
     }
     bar.set_message("framebuffer LOD");
-    let mut tick = |name: &str| {
-        bar.set_message(format!("framebuffer LOD: {name}"));
-        bar.inc(1);
-    };
+    let mut tick = |name: &str| bar.done(format!("framebuffer LOD: {name}"));
     let rounds = (options.timing_pairs / 4).max(3);
     let timer = clock::Timer::new(gpu, RECORDINGS)?;
     let upsampling =
@@ -301,6 +350,6 @@ pub fn run_on(
         doc_pictures::write_doc_pictures(&report, out, docs)?;
     }
     bar.inc(1);
-    bar.finish_and_clear();
+    bar.finish();
     Ok(report)
 }

@@ -121,7 +121,6 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
             // (the figure counts the other pixels).
             Tonemapping::None,
             DebandDither::Disabled,
-            lodkit_bevy::FrameSequentialLod::default(),
             Transform::default(),
         ))
         .id();

@@ -1,8 +1,9 @@
 //! The example a Bevy app copies: a glTF scene whose levels `lodkit lod` made (several objects
 //! and materials; `examples/assets/lod_scene.glb`, written by `scripts/gltf-scene.sh` from the
 //! repository's scene), loaded with Bevy's own glTF loader into an app whose only lodkit code is
-//! `FrameSequentialLodPlugin` and `FrameSequentialLod::default()` on its camera; the camera keeps
-//! Bevy's default MSAA and walks back through the scene until every object shows its last level.
+//! `FrameSequentialLodPlugin` (the plugin gives the camera `FrameSequentialLod::default()`); the
+//! camera keeps Bevy's default MSAA and walks back through the scene until every object shows
+//! its last level.
 //!
 //! ```text
 //! cargo run --example gltf_scene [-- [--out DIR] [--report FILE] [--gltf FILE] [--frames N]

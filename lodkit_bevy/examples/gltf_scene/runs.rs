@@ -10,8 +10,8 @@ use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use lodkit_bevy::frame_sequential::{
-    FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod, FrameSequentialLodPlugin,
-    LevelMaterial, LodLevels,
+    FrameSequentialDefaultCamera, FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod,
+    FrameSequentialLodPlugin, LevelMaterial, LodLevels,
 };
 
 use crate::frames::Frame;
@@ -212,7 +212,7 @@ impl Scene {
         let world = self.app.world_mut();
         // An app's camera: Bevy's default MSAA (Sample4) is left as it is; no tonemapping or
         // deband dither, so the background is the clear colour exactly.
-        let mut camera = world.spawn((
+        let camera = world.spawn((
             Camera3d::default(),
             Camera {
                 clear_color: ClearColorConfig::Custom(BACKGROUND),
@@ -223,10 +223,13 @@ impl Scene {
             DebandDither::Disabled,
             poses[0],
         ));
-        if technique == Technique::FrameSequential {
-            camera.insert(FrameSequentialLod::default());
-        }
         let camera = camera.id();
+        // The app's camera has no lodkit component: with groups about and no camera selecting,
+        // the plugin gives it `FrameSequentialLod::default()`. The other runs' cameras are the
+        // harness's and must stay as they are (no Hdr).
+        world.insert_resource(FrameSequentialDefaultCamera(
+            technique == Technique::FrameSequential,
+        ));
         let h = FrameSequentialLod::default().settings.hysteresis;
         let mut copies = Vec::new();
         for group in &self.groups {
@@ -263,6 +266,13 @@ impl Scene {
                 inbox.0.push(done.data.clone());
             })
             .id();
+        let selecting = self.app.world().get::<FrameSequentialLod>(camera).is_some();
+        if selecting != (technique == Technique::FrameSequential) {
+            return Err(Failure(
+                1,
+                format!("{technique:?}: the camera selects: {selecting}"),
+            ));
+        }
         let mut drawn = vec![Vec::new(); self.groups.len()];
         for pose in poses {
             *self

@@ -83,6 +83,11 @@
 //!   combine over the convex hulls of the silhouettes of the groups in transition (both
 //!   levels'; [`CombineRegion`]), or their screen rectangles where a level has none.
 //!
+//! Adding the plugin is enough: while LOD groups exist and no camera has
+//! [`FrameSequentialLod`], the plugin gives the app's first active 3D camera
+//! `FrameSequentialLod::default()` ([`FrameSequentialDefaultCamera`] says which, and turns it
+//! off).
+//!
 //! Limits: one camera per app drives the selection (the first active one with
 //! [`FrameSequentialLod`]); the combine needs `Msaa::Off`: on a camera with MSAA (Bevy's
 //! default) the plugin logs one warning and its groups blend with lodkit's complementary
@@ -94,6 +99,7 @@
 //! at most [`MAX_TAG_ID`] groups in transition at once (more switch at once, with a warning);
 //! the combine reads no storage buffer, but the plugin has not been run on WebGL2.
 
+mod camera;
 mod data;
 mod dither;
 mod drawer;
@@ -117,6 +123,7 @@ use bevy::render::extract_component::ExtractComponentPlugin;
 use lodkit::frame_sequential::Schedule;
 use lodkit::select::LodSettings;
 
+pub use camera::FrameSequentialDefaultCamera;
 pub use drawer::FrameSequentialLevels;
 pub use levels::{
     FrameSequentialGroup, FrameSequentialSystems, LevelMaterial, LodLevel, LodLevels,

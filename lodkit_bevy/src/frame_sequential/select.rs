@@ -21,6 +21,7 @@ use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::reproject::new_to_old_matrix;
 use lodkit::select::{LodCamera, LodSelection};
 
+use super::camera::{FrameSequentialDefaultCamera, default_camera};
 use super::dither::{Fallback, dither_draws};
 use super::drawer::{
     DrawerQuery, FrameSequentialLevels, Scheduler, drawn, show, spawn_drawer, spawn_levels,
@@ -37,12 +38,14 @@ use super::{
 
 pub(super) fn build(app: &mut App) {
     app.init_resource::<Scheduler>()
+        .init_resource::<FrameSequentialDefaultCamera>()
         .init_resource::<FrameSequentialStats>()
         .init_resource::<Surfaces>()
         .init_resource::<DerivedMaterials>()
         .add_systems(
             PostUpdate,
             (
+                default_camera,
                 configure_depth_copies,
                 spawn_levels,
                 sync_derived_materials,
