@@ -273,6 +273,13 @@ fn lod_bad_inputs_name_the_file_and_mesh() {
             },
             "past the end of buffer",
         ),
+        (
+            // The gltf crate's own validation indexed the empty list with it and panicked.
+            "no_accessors",
+            sphere(6, 12),
+            |doc| doc["accessors"] = json!([]),
+            "POSITION is accessor 0, but the file has 0 accessors",
+        ),
     ];
     for (name, fixture, edit, want) in cases {
         let dir = Scratch::folder();

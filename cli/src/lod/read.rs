@@ -35,11 +35,54 @@ pub struct MeshInput {
 /// Loads the document and its buffers.
 pub fn open(path: &Path) -> Result<(gltf::Document, Vec<gltf::buffer::Data>), String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))?;
+    check_positions(&bytes)?;
     let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| format!("not a valid glTF/GLB: {e}"))?;
     let base = path.parent().unwrap_or(Path::new("."));
     let buffers = gltf::import_buffers(&gltf.document, Some(base), gltf.blob)
         .map_err(|e| format!("cannot load its buffers: {e}"))?;
     Ok((gltf.document, buffers))
+}
+
+/// That every primitive's POSITION names an accessor the file has. The gltf crate's validation
+/// indexes the accessor list with it unchecked (gltf-json 1.4.1, `primitive_validate_hook`) and
+/// panics on one past the end, so this is looked at first, in the JSON as it is. A file that is
+/// not JSON (or not a GLB) is left to the gltf crate to refuse.
+fn check_positions(bytes: &[u8]) -> Result<(), String> {
+    let json = if bytes.starts_with(b"glTF") {
+        match gltf::Glb::from_slice(bytes) {
+            Ok(glb) => glb.json.into_owned(),
+            Err(_) => return Ok(()),
+        }
+    } else {
+        bytes.to_vec()
+    };
+    let Ok(root) = serde_json::from_slice::<serde_json::Value>(&json) else {
+        return Ok(());
+    };
+    let accessors = root["accessors"].as_array().map_or(0, Vec::len);
+    let meshes = root["meshes"]
+        .as_array()
+        .map(Vec::as_slice)
+        .unwrap_or_default();
+    for (m, mesh) in meshes.iter().enumerate() {
+        let name = mesh["name"].as_str().unwrap_or("");
+        let primitives = mesh["primitives"]
+            .as_array()
+            .map(Vec::as_slice)
+            .unwrap_or_default();
+        for (p, primitive) in primitives.iter().enumerate() {
+            let position = &primitive["attributes"]["POSITION"];
+            if let Some(index) = position.as_u64()
+                && index >= accessors as u64
+            {
+                return Err(format!(
+                    "mesh {m} '{name}' primitive {p}: POSITION is accessor {index}, but the \
+                     file has {accessors} accessors"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The bytes of element `k` of `accessor` (checked by [`check_accessor`] first).

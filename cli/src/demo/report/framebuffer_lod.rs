@@ -11,7 +11,7 @@ use crate::demo::report::table::img as figure;
 
 const BREAKDOWN_TEXT: &str = "Each pass of a frame timed on its own (per recording, on the clock below, median of the rounds): the full-resolution geometry prepass the upsampling needs (depth and normal, with the cheap albedo term), the low-resolution shading pass, and the upsample pass. The fine-grained route shades only the lighting at low resolution; its full-resolution albedo pass writes the geometry, so it is the prepass. Speed-up: the full-resolution frame's time over the sum of the passes.";
 
-const SWEEP_TEXT: &str = "Whole frames (the three passes recorded one after the other, per recording, on the same clock) against the synthetic shading work per fragment: the full-resolution frame shades every pixel, the framebuffer-LOD frame runs the prepass, the low-resolution shading and the upsample.";
+const SWEEP_TEXT: &str = "Whole frames (the three passes recorded one after the other, per recording, on the same clock; on GPU timestamps each frame is timed alone, as an engine times its frames) against the synthetic shading work per fragment: the full-resolution frame shades every pixel, the framebuffer-LOD frame runs the prepass, the low-resolution shading and the upsample.";
 
 /// The plots of these sections.
 pub fn write_plots(report: &DemoReport, out: &Path) -> Result<(), DemoError> {

@@ -337,10 +337,11 @@ fn header(report: &DemoReport, what: &str) -> String {
          {clock}. Images {width}x{height}, transitions of {frames} frames; fragment counts are \
          {counter}. The demo's own report (`index.html` in its output folder) shows the images \
          behind these figures. Timings are per recording of a pass, read from the clock named: \
-         GPU timestamps around a run of {recordings} recordings in one encoder (the GPU's own \
-         time, no submission or wait), or, where the device has none, the wall clock around the \
-         run's submission and wait; on a software rasterizer (device type Cpu) read the ratios, \
-         not the milliseconds.\n",
+         GPU timestamps around a run of {recordings} recordings in one encoder (fewer where \
+         one recording lasts {min_run} ms or more: as many as make the run last that long; the \
+         GPU's own time, no submission or wait), or, where the device has none, the wall clock \
+         around the run's submission and wait; on a software rasterizer (device type Cpu) read \
+         the ratios, not the milliseconds.\n",
         command = report.command,
         date = report.date,
         adapter = report.adapter,
@@ -351,6 +352,7 @@ fn header(report: &DemoReport, what: &str) -> String {
         frames = report.frames,
         counter = report.counter,
         recordings = crate::demo::fixtures::clock::RECORDINGS,
+        min_run = crate::demo::fixtures::clock::MIN_RUN_MS,
     )
 }
 
