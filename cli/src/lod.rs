@@ -114,11 +114,16 @@ pub fn run(args: &LodArgs) -> ExitCode {
         },
         ..Default::default()
     };
-    let (document, buffers) = match read::open(&args.input) {
+    let read::Opened {
+        document,
+        buffers,
+        required_here,
+    } = match read::open(&args.input) {
         Ok(x) => x,
         Err(e) => return fail(if e.starts_with("cannot read") { 2 } else { 1 }, e),
     };
     let mut out = write::Output::new(document.clone(), &buffers);
+    out.require(&required_here);
     let mut reports = Vec::new();
     for mesh in document.meshes() {
         let name = mesh.name().unwrap_or("").to_owned();

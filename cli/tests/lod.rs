@@ -428,3 +428,104 @@ fn glb_parts(glb: &[u8]) -> Option<(serde_json::Value, &[u8])> {
 fn same_glb(a: &[u8], b: &[u8]) -> bool {
     matches!((glb_parts(a), glb_parts(b)), (Some(x), Some(y)) if x == y)
 }
+
+/// A file as gltfpack writes it by default: `KHR_mesh_quantization` required (positions as
+/// 16-bit integers, the node's scale and translation turning them back into metres; normals as
+/// normalized bytes), with a light (`KHR_lights_punctual`, required as well). The gltf crate
+/// refuses both required extensions on its own; `lodkit lod` reads the integers, makes the
+/// chain in the integers' units and writes a file that requires both again and keeps the light.
+#[test]
+fn lod_reads_a_quantized_file_and_keeps_what_it_requires() {
+    let (positions, indices) = lodkit::lod_chain::uv_sphere(12, 24);
+    let quantize = |x: f32| ((x + 1.0) * 1000.0).round() as u16;
+    let mut bin: Vec<u8> = Vec::new();
+    for p in &positions {
+        for &x in p {
+            bin.extend(quantize(x).to_le_bytes());
+        }
+        bin.extend([0, 0]); // each element is 4-byte aligned
+    }
+    let normals_at = bin.len();
+    for p in &positions {
+        let n = glam::Vec3::from(*p).normalize();
+        bin.extend([
+            (n.x * 127.0) as i8 as u8,
+            (n.y * 127.0) as i8 as u8,
+            (n.z * 127.0) as i8 as u8,
+            0,
+        ]);
+    }
+    let indices_at = bin.len();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    let count = positions.len();
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_mesh_quantization", "KHR_lights_punctual"],
+        "extensionsRequired": ["KHR_mesh_quantization", "KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 5.0}]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1]}],
+        "nodes": [
+            {"mesh": 0, "name": "ball", "scale": [0.001, 0.001, 0.001],
+             "translation": [-1.0, -1.0, -1.0]},
+            {"name": "lamp", "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        ],
+        "meshes": [{"name": "ball", "primitives": [
+            {"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
+        "buffers": [{"uri": "q.bin", "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": normals_at, "byteStride": 8},
+            {"buffer": 0, "byteOffset": normals_at, "byteLength": indices_at - normals_at,
+             "byteStride": 4},
+            {"buffer": 0, "byteOffset": indices_at, "byteLength": bin.len() - indices_at},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5123, "count": count, "type": "VEC3",
+             "min": [0, 0, 0], "max": [2000, 2000, 2000]},
+            {"bufferView": 1, "componentType": 5120, "normalized": true, "count": count,
+             "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5125, "count": indices.len(), "type": "SCALAR"},
+        ],
+    });
+    let dir = Scratch::folder();
+    std::fs::write(dir.join("q.bin"), &bin).unwrap();
+    std::fs::write(dir.join("q.gltf"), serde_json::to_vec(&doc).unwrap()).unwrap();
+    let (code, stdout, stderr) = run(
+        &dir,
+        &[
+            "lod", "q.gltf", "-o", "out.glb", "--levels", "3", "--report", "r.json",
+        ],
+    );
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("r.json")).unwrap()).unwrap();
+    let mesh = &report["meshes"][0];
+    // The integers are read as their value (a radius of about 1000 units), not as normalized.
+    let radius = mesh["radius"].as_f64().unwrap();
+    assert!((900.0..2000.0).contains(&radius), "radius {radius}");
+    let triangles: Vec<u64> = mesh["levels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["triangles"].as_u64().unwrap())
+        .collect();
+    assert_eq!(triangles.len(), 3, "{report}");
+    assert!(triangles.windows(2).all(|w| w[0] > w[1]), "{triangles:?}");
+    let out =
+        gltf::Gltf::from_slice_without_validation(&std::fs::read(dir.join("out.glb")).unwrap())
+            .unwrap();
+    let root = out.document.into_json();
+    for e in ["KHR_mesh_quantization", "KHR_lights_punctual"] {
+        assert!(
+            root.extensions_required.iter().any(|r| r == e),
+            "{e} required"
+        );
+    }
+    assert!(root.extensions_used.iter().any(|r| r == "MSFT_lod"));
+    let lights = root
+        .extensions
+        .as_ref()
+        .and_then(|x| x.khr_lights_punctual.as_ref())
+        .map_or(0, |l| l.lights.len());
+    assert_eq!(lights, 1, "the light is kept");
+}

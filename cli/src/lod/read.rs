@@ -32,15 +32,42 @@ pub struct MeshInput {
     pub warnings: Vec<String>,
 }
 
+/// Extensions a file may require that `lodkit lod` reads itself, which the gltf crate refuses
+/// when they are required: `KHR_mesh_quantization` (attributes as integers, normalized or not,
+/// which [`floats`] reads; what gltfpack writes by default).
+const READ_HERE: [&str; 1] = ["KHR_mesh_quantization"];
+
+/// A file as `lodkit lod` reads it.
+pub struct Opened {
+    pub document: gltf::Document,
+    pub buffers: Vec<gltf::buffer::Data>,
+    /// Extensions the file requires that were taken out of `extensionsRequired` for the gltf
+    /// crate ([`READ_HERE`]): the output requires them again.
+    pub required_here: Vec<String>,
+}
+
 /// Loads the document and its buffers.
-pub fn open(path: &Path) -> Result<(gltf::Document, Vec<gltf::buffer::Data>), String> {
+pub fn open(path: &Path) -> Result<Opened, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read it: {e}"))?;
     check_positions(&bytes)?;
-    let gltf = gltf::Gltf::from_slice(&bytes).map_err(|e| format!("not a valid glTF/GLB: {e}"))?;
+    let invalid = |e: gltf::Error| format!("not a valid glTF/GLB: {e}");
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(invalid)?;
+    let mut root = gltf.document.into_json();
+    let (required_here, other): (Vec<String>, Vec<String>) = root
+        .extensions_required
+        .drain(..)
+        .partition(|e| READ_HERE.contains(&e.as_str()));
+    root.extensions_required = other;
+    // Validated here as `Gltf::from_slice` would have, without the extensions read above.
+    let document = gltf::Document::from_json(root).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&gltf.document, Some(base), gltf.blob)
+    let buffers = gltf::import_buffers(&document, Some(base), gltf.blob)
         .map_err(|e| format!("cannot load its buffers: {e}"))?;
-    Ok((gltf.document, buffers))
+    Ok(Opened {
+        document,
+        buffers,
+        required_here,
+    })
 }
 
 /// That every primitive's POSITION names an accessor the file has. The gltf crate's validation
@@ -154,28 +181,32 @@ fn floats(
         ));
     }
     let n = dims.multiplicity();
+    let normalized = accessor.normalized();
+    // glTF's decoding of normalized integers (signed: max(c / (2^(b-1) - 1), -1)); integers
+    // that are not normalized (KHR_mesh_quantization's positions and texture coordinates) are
+    // their value.
     let read = |b: &[u8], k: usize| -> f32 {
-        match accessor.data_type() {
-            DataType::F32 => f32::from_le_bytes(b[k * 4..k * 4 + 4].try_into().expect("4 bytes")),
-            DataType::U8 if accessor.normalized() => f32::from(b[k]) / 255.0,
-            DataType::U16 if accessor.normalized() => {
-                f32::from(u16::from_le_bytes([b[k * 2], b[k * 2 + 1]])) / 65535.0
+        let i16_at = |k: usize| i16::from_le_bytes([b[k * 2], b[k * 2 + 1]]);
+        let u16_at = |k: usize| u16::from_le_bytes([b[k * 2], b[k * 2 + 1]]);
+        match (accessor.data_type(), normalized) {
+            (DataType::F32, _) => {
+                f32::from_le_bytes(b[k * 4..k * 4 + 4].try_into().expect("4 bytes"))
             }
-            _ => f32::NAN,
+            (DataType::U8, true) => f32::from(b[k]) / 255.0,
+            (DataType::U16, true) => f32::from(u16_at(k)) / 65535.0,
+            (DataType::I8, true) => (f32::from(b[k] as i8) / 127.0).max(-1.0),
+            (DataType::I16, true) => (f32::from(i16_at(k)) / 32767.0).max(-1.0),
+            (DataType::U8, false) => f32::from(b[k]),
+            (DataType::U16, false) => f32::from(u16_at(k)),
+            (DataType::I8, false) => f32::from(b[k] as i8),
+            (DataType::I16, false) => f32::from(i16_at(k)),
+            (DataType::U32, _) => f32::NAN,
         }
     };
-    let ok = matches!(accessor.data_type(), DataType::F32)
-        || (accessor.normalized() && matches!(accessor.data_type(), DataType::U8 | DataType::U16));
-    if !ok {
+    if accessor.data_type() == DataType::U32 {
         return Err(format!(
-            "{what} (accessor {}) holds {:?}{}, not floats",
-            accessor.index(),
-            accessor.data_type(),
-            if accessor.normalized() {
-                " (normalized)"
-            } else {
-                ""
-            }
+            "{what} (accessor {}) holds U32, which no glTF vertex attribute may",
+            accessor.index()
         ));
     }
     Ok((0..accessor.count())

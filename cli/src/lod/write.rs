@@ -52,6 +52,16 @@ impl Output {
         Output { root, bin }
     }
 
+    /// Requires `extensions` again (those the reader took out of `extensionsRequired` because
+    /// it reads them itself: the input's own accessors still use them).
+    pub fn require(&mut self, extensions: &[String]) {
+        for e in extensions {
+            if !self.root.extensions_required.contains(e) {
+                self.root.extensions_required.push(e.clone());
+            }
+        }
+    }
+
     fn view(&mut self, bytes: &[u8], target: json::buffer::Target) -> Index<json::buffer::View> {
         self.strided_view(bytes, target, None)
     }
