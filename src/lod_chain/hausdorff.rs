@@ -136,6 +136,11 @@ impl Surface {
         }
     }
 
+    /// Its number of triangles.
+    fn triangles(&self) -> usize {
+        self.tree.size()
+    }
+
     /// Whether a triangle of the surface has vertex `v` of the shared positions.
     fn has_vertex(&self, v: u32) -> bool {
         self.vertices.get(v as usize).copied().unwrap_or(false)
@@ -144,7 +149,7 @@ impl Surface {
     /// The triangles whose bounding boxes meet the box of the triangle `s` moved by up to
     /// `margin` along its normal either way (the target triangles within `margin` of `s`'s
     /// plane that are over or under it), in no order.
-    fn candidates(&self, s: &[DVec3; 3], margin: f64) -> Vec<&Tri> {
+    fn candidates(&self, s: &[DVec3; 3], margin: f64) -> impl Iterator<Item = &Tri> {
         let n = (s[1] - s[0]).cross(s[2] - s[0]).normalize_or_zero();
         let grow = if n == DVec3::ZERO {
             DVec3::splat(margin)
@@ -155,7 +160,6 @@ impl Surface {
         let hi = s[0].max(s[1]).max(s[2]) + grow;
         self.tree
             .locate_in_envelope_intersecting(&AABB::from_corners(lo.to_array(), hi.to_array()))
-            .collect()
     }
 
     /// Distance from `p` to the surface and the nearest triangle (+inf and `None` for an empty
@@ -203,6 +207,63 @@ impl Tolerance {
 /// target triangles are candidates for its partition.
 const MARGIN: f64 = 0.05;
 
+/// Candidate triangles a bound may weigh in partitions, per triangle of the source and the
+/// target together. The meshes `lodkit lod` was run on here weigh 1 to 20 per triangle (the
+/// sample scene's ball, tree and ring, every level, both directions); long slivers spanning the
+/// mesh (a triangle list read as a fan) weigh much of the target in every partition and every
+/// cut of a refinement (1,500 per triangle, 31 s for a level of a 57,598-triangle fan). Past
+/// the budget a triangle keeps the Lipschitz and convexity bounds it has (upper bounds still,
+/// looser) and nothing is refined further (that fan's level: 6 s).
+const BUDGET_PER_TRIANGLE: u64 = 256;
+
+/// What is left of a bound's budget of candidate triangles ([`BUDGET_PER_TRIANGLE`]).
+struct Budget(std::sync::atomic::AtomicU64);
+
+impl Budget {
+    fn new(per_triangle: u64, triangles: usize) -> Self {
+        Self(std::sync::atomic::AtomicU64::new(
+            per_triangle.saturating_mul(triangles as u64),
+        ))
+    }
+
+    /// The candidates of `target` for `s` ([`Surface::candidates`]), taken from the budget;
+    /// None when the budget has fewer left (the query stops there, so an exhausted budget costs
+    /// no more than it has left).
+    fn candidates<'a>(
+        &self,
+        target: &'a Surface,
+        s: &[DVec3; 3],
+        margin: f64,
+    ) -> Option<Vec<&'a Tri>> {
+        use std::sync::atomic::Ordering::Relaxed;
+        let left = self.0.load(Relaxed);
+        let limit = usize::try_from(left).unwrap_or(usize::MAX);
+        let found: Vec<&Tri> = target
+            .candidates(s, margin)
+            .take(limit.saturating_add(1))
+            .collect();
+        let n = found.len() as u64;
+        match self
+            .0
+            .fetch_update(Relaxed, Relaxed, |left| left.checked_sub(n))
+        {
+            Ok(_) => Some(found),
+            Err(_) => {
+                self.0.store(0, Relaxed);
+                None
+            }
+        }
+    }
+
+    fn left(&self) -> u64 {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    fn exhausted(&self) -> bool {
+        self.left() == 0
+    }
+}
+
 /// Upper bound of `sup_{x in source} d(x, target)` over the triangles `indices` of `positions`
 /// (which the target indexes too).
 pub(crate) fn directed_bound(
@@ -211,7 +272,19 @@ pub(crate) fn directed_bound(
     target: &Surface,
     tolerance: Tolerance,
 ) -> f64 {
+    directed_bound_within(positions, indices, target, tolerance, BUDGET_PER_TRIANGLE)
+}
+
+/// [`directed_bound`] with `per_triangle` candidates of budget per triangle.
+pub(crate) fn directed_bound_within(
+    positions: &[[f32; 3]],
+    indices: &[u32],
+    target: &Surface,
+    tolerance: Tolerance,
+    per_triangle: u64,
+) -> f64 {
     let p = |i: u32| DVec3::from(positions[i as usize].map(f64::from));
+    let budget = Budget::new(per_triangle, indices.len() / 3 + target.triangles());
     // f at every vertex the source uses (with the nearest triangle): zero at the target's own
     // vertices.
     let mut used: Vec<u32> = indices.to_vec();
@@ -287,7 +360,10 @@ pub(crate) fn directed_bound(
             .max(f[1])
             .max(f[2])
             .max(centre.map_or(0.0, |c| c.distance));
-        let candidates = target.candidates(&corners, 2.0 * local + MARGIN * longest);
+        let Some(candidates) = budget.candidates(target, &corners, 2.0 * local + MARGIN * longest)
+        else {
+            return best;
+        };
         match partition::partition_bound(corners, &candidates) {
             Some(b) if b.bound < best.0 => (b.bound, Some(b.at)),
             _ => best,
@@ -307,6 +383,11 @@ pub(crate) fn directed_bound(
     open.sort_unstable_by(|&a, &b| first[b].0.total_cmp(&first[a].0));
     for k in open {
         let (bound, at) = first[k];
+        if budget.exhausted() {
+            // No refinement left to pay for: the first bound (an upper bound) stands.
+            reported = reported.max(bound);
+            continue;
+        }
         if bound <= lb + tolerance.slack(lb) {
             // Every triangle after this one is bounded lower still.
             reported = reported.max(bound);
@@ -321,7 +402,7 @@ pub(crate) fn directed_bound(
             }
         }
         let corners = triangles[k].map(|v| target.nearest(p(v)));
-        let refined = refine::refine(target, corners, 0, &mut lb, tolerance);
+        let refined = refine::refine(target, corners, 0, &mut lb, tolerance, &budget);
         reported = reported.max(refined.min(bound));
     }
     reported.max(lb)

@@ -310,7 +310,7 @@ mod tests {
             DVec3::new(0.71, 0.23, 0.1),
             DVec3::new(0.33, 0.87, 0.1),
         ];
-        let c = s.candidates(&tri, 0.2);
+        let c: Vec<_> = s.candidates(&tri, 0.2).collect();
         assert!(c.len() > 100, "{} candidates", c.len());
         let b = partition_bound(tri, &c).expect("a bound");
         // The corners are 0.1 above the grid (in f64).

@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use super::partition::partition_bound;
-use super::{MARGIN, Sample, Surface, Tolerance, longest_side};
+use super::{Budget, MARGIN, Sample, Surface, Tolerance, longest_side};
 
 /// Deepest cut of one source triangle.
 const MAX_DEPTH: u32 = 12;
@@ -24,6 +24,7 @@ pub(super) fn refine<'a>(
     depth: u32,
     lb: &mut f64,
     tolerance: Tolerance,
+    budget: &Budget,
 ) -> f64 {
     let p = c.map(|s| s.at);
     let longest = longest_side(&p);
@@ -38,14 +39,21 @@ pub(super) fn refine<'a>(
         .map(|t| p.iter().map(|&x| t.distance(x)).fold(0.0, f64::max))
         .fold(f64::INFINITY, f64::min);
     let mut bound = lipschitz.min(convex);
+    let mut spent = false;
     if bound > *lb + tolerance.slack(*lb) {
         let margin = 2.0 * near.max(centre.distance) + MARGIN * longest;
-        if let Some(b) = partition_bound(p, &target.candidates(&p, margin)) {
-            bound = bound.min(b.bound);
-            *lb = lb.max(target.nearest(b.at).distance);
+        match budget.candidates(target, &p, margin) {
+            Some(candidates) => {
+                if let Some(b) = partition_bound(p, &candidates) {
+                    bound = bound.min(b.bound);
+                    *lb = lb.max(target.nearest(b.at).distance);
+                }
+            }
+            None => spent = true,
         }
     }
-    if bound <= *lb + tolerance.slack(*lb) || depth >= MAX_DEPTH {
+    // Past the budget the piece keeps the bound it has: cutting it would weigh more.
+    if bound <= *lb + tolerance.slack(*lb) || depth >= MAX_DEPTH || spent {
         return bound;
     }
     let m = [
@@ -65,6 +73,6 @@ pub(super) fn refine<'a>(
         [m[0], m[1], m[2]],
     ]
     .into_iter()
-    .map(|piece| refine(target, piece, depth + 1, lb, tolerance))
+    .map(|piece| refine(target, piece, depth + 1, lb, tolerance, budget))
     .fold(0.0, f64::max)
 }
