@@ -84,7 +84,8 @@
 //!   levels'; [`CombineRegion`]), or their screen rectangles where a level has none.
 //!
 //! Adding the plugin is enough: while LOD groups exist and no camera has
-//! [`FrameSequentialLod`], the plugin gives the app's first active 3D camera
+//! [`FrameSequentialLod`], the plugin gives the app's main camera (an active 3D camera drawing
+//! to a window, the lowest `Camera::order` first)
 //! `FrameSequentialLod::default()` ([`FrameSequentialDefaultCamera`] says which, and turns it
 //! off).
 //!
