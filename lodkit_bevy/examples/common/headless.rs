@@ -7,6 +7,7 @@ use std::path::Path;
 use bevy::asset::RenderAssetUsages;
 use bevy::prelude::*;
 use bevy::render::RenderPlugin;
+use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use bevy::render::render_resource::{
     Extent3d, PollType, TextureDimension, TextureFormat, TextureUsages,
 };
@@ -18,6 +19,24 @@ use crate::frames::Frame;
 
 /// Updates to wait for one screenshot to come back from the GPU.
 const READBACK_UPDATES: usize = 8;
+
+/// Every frame read back since [`start_readback`], in order.
+#[derive(Resource, Default)]
+pub struct FrameInbox(pub Vec<Vec<u8>>);
+
+/// Reads `target` back every frame into [`FrameInbox`] (emptied first) until the returned
+/// entity is despawned.
+pub fn start_readback(world: &mut World, target: &Handle<Image>) -> Entity {
+    world.resource_mut::<FrameInbox>().0.clear();
+    world
+        .spawn(Readback::texture(target.clone()))
+        .observe(
+            |done: On<ReadbackComplete>, mut inbox: ResMut<FrameInbox>| {
+                inbox.0.push(done.data.clone());
+            },
+        )
+        .id()
+}
 
 /// Where the last screenshot's image lands (filled by the screenshot observer).
 #[derive(Resource, Default)]
@@ -56,7 +75,8 @@ pub fn build_app_with_assets(assets: Option<&Path>, plugins: impl FnOnce(&mut Ap
                 ..default()
             }),
     )
-    .init_resource::<ScreenshotInbox>();
+    .init_resource::<ScreenshotInbox>()
+    .init_resource::<FrameInbox>();
     plugins(&mut app);
     // What `App::run` would do before its first update; we never call it.
     app.finish();

@@ -26,6 +26,7 @@
 )]
 mod frames;
 #[path = "../common/headless.rs"]
+#[allow(dead_code, reason = "shared by the examples; each uses a part")]
 mod headless;
 mod lod_material;
 mod transition;

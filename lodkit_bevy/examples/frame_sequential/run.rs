@@ -10,7 +10,6 @@ use bevy::diagnostic::{DiagnosticPath, DiagnosticsStore};
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::render::diagnostic::RenderDiagnosticsPlugin;
-use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use lodkit::select::{LodSettings, TransitionMode};
 use lodkit_bevy::frame_sequential::{
     COMBINE_PASS, FrameSequentialLod, FrameSequentialLodPlugin, FrameSequentialStats,
@@ -19,7 +18,7 @@ use lodkit_bevy::frame_sequential::{
 
 use crate::Args;
 use crate::frames::Frame;
-use crate::headless::{build_app, render_target, step};
+use crate::headless::{FrameInbox, build_app, render_target, start_readback, step};
 use crate::scene::{
     FRAMES, Technique, bevy_ranges, camera_at, group_position, groups, in_band, p11, spawn_groups,
 };
@@ -76,10 +75,6 @@ impl Pass {
 /// A failure with its exit code.
 pub struct Failure(pub u8, pub String);
 
-/// Frames read back, in order.
-#[derive(Resource, Default)]
-struct Inbox(Vec<Vec<u8>>);
-
 /// What one run recorded.
 pub struct Run {
     pub frames: Vec<Frame>,
@@ -134,8 +129,7 @@ pub struct Harness {
 impl Harness {
     pub fn new() -> Self {
         let mut app = build_app(|app| {
-            app.add_plugins((FrameSequentialLodPlugin, RenderDiagnosticsPlugin))
-                .init_resource::<Inbox>();
+            app.add_plugins((FrameSequentialLodPlugin, RenderDiagnosticsPlugin));
         });
         let world = app.world_mut();
         let target = render_target(world, WIDTH, HEIGHT);
@@ -252,14 +246,7 @@ impl Harness {
         for _ in 0..WARMUP_UPDATES {
             self.step();
         }
-        let world = self.app.world_mut();
-        world.resource_mut::<Inbox>().0.clear();
-        let readback = world
-            .spawn(Readback::texture(self.target.clone()))
-            .observe(|done: On<ReadbackComplete>, mut inbox: ResMut<Inbox>| {
-                inbox.0.push(done.data.clone());
-            })
-            .id();
+        let readback = start_readback(self.app.world_mut(), &self.target);
         let specs = groups();
         let mut run = Run {
             frames: Vec::new(),
@@ -294,7 +281,7 @@ impl Harness {
             ));
         }
         for _ in 0..DRAIN_UPDATES {
-            if self.app.world().resource::<Inbox>().0.len() >= FRAMES {
+            if self.app.world().resource::<FrameInbox>().0.len() >= FRAMES {
                 break;
             }
             let [fragments, gpu_ms] = self.step_timed();
@@ -307,7 +294,7 @@ impl Harness {
         for (root, _) in roots {
             world.despawn(root);
         }
-        let data = std::mem::take(&mut world.resource_mut::<Inbox>().0);
+        let data = std::mem::take(&mut world.resource_mut::<FrameInbox>().0);
         if data.len() < FRAMES {
             return Err(Failure(
                 1,

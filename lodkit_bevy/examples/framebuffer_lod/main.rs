@@ -22,6 +22,7 @@
 )]
 mod frames;
 #[path = "../common/headless.rs"]
+#[allow(dead_code, reason = "shared by the examples; each uses a part")]
 mod headless;
 mod measure;
 mod run;

@@ -17,14 +17,14 @@
 //!
 //! Exit codes: 0 done, 1 the scene did not load or render, 2 usage or I/O error.
 
-#[path = "../common/bounds.rs"]
-mod bounds;
 #[path = "../common/frames.rs"]
 #[allow(
     dead_code,
     reason = "shared by the examples and tests; each uses a part"
 )]
 mod frames;
+#[path = "../common/gltf_scene.rs"]
+mod gltf_scene;
 #[path = "../common/headless.rs"]
 #[allow(dead_code, reason = "shared by the examples; each uses a part")]
 mod headless;
@@ -128,30 +128,11 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
         DirectionalLight::default(),
         Transform::from_xyz(3.0, 6.0, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
     ));
-    let scene = world
-        .resource::<AssetServer>()
-        .load(GltfAssetLabel::Scene(0).from_asset(file.clone()));
-    world.spawn(WorldAssetRoot(scene));
     // Until the scene is spawned and its groups made.
-    let mut loaded = false;
-    for _ in 0..600 {
-        headless::step(&mut app);
-        let world = app.world_mut();
-        let spawned = world
-            .query_filtered::<Entity, With<WorldAssetRoot>>()
-            .iter(world)
-            .any(|root| world.get::<Children>(root).is_some_and(|c| !c.is_empty()));
-        if spawned {
-            loaded = true;
-            break;
-        }
-    }
-    if !loaded {
+    if !gltf_scene::load_scene(&mut app, &file) {
         return Err((1, format!("{file} did not load")));
     }
-    headless::step(&mut app);
-    headless::step(&mut app);
-    let Some(sphere) = bounds::scene_sphere(app.world_mut()) else {
+    let Some(sphere) = gltf_scene::scene_sphere(app.world_mut()) else {
         return Err((1, format!("{file} has no mesh")));
     };
     let far = farthest_switch(app.world_mut(), sphere);

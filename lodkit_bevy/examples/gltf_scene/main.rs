@@ -25,14 +25,14 @@
 //!
 //! Exit codes: 0 done, 1 the scene did not load or render, 2 usage or I/O error.
 
-#[path = "../common/bounds.rs"]
-mod bounds;
 #[path = "../common/frames.rs"]
 #[allow(
     dead_code,
     reason = "shared by the examples and tests; each uses a part"
 )]
 mod frames;
+#[path = "../common/gltf_scene.rs"]
+mod gltf_scene;
 #[path = "../common/headless.rs"]
 #[allow(dead_code, reason = "shared by the examples; each uses a part")]
 mod headless;

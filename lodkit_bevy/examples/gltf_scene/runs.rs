@@ -8,14 +8,13 @@ use bevy::camera::RenderTarget;
 use bevy::camera::visibility::VisibilityRange;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
-use bevy::render::gpu_readback::{Readback, ReadbackComplete};
 use lodkit_bevy::frame_sequential::{
     FrameSequentialDefaultCamera, FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod,
     FrameSequentialLodPlugin, LevelMaterial, LodLevels,
 };
 
 use crate::frames::Frame;
-use crate::headless::{build_app_with_assets, render_target, step};
+use crate::headless::{FrameInbox, build_app_with_assets, render_target, start_readback, step};
 
 pub const WIDTH: u32 = 320;
 /// The height `lodkit lod` made the committed file's switch distances for.
@@ -80,10 +79,6 @@ pub fn p11() -> f32 {
     1.0 / std::f32::consts::FRAC_PI_8.tan()
 }
 
-/// Frames read back, in order.
-#[derive(Resource, Default)]
-struct Inbox(Vec<Vec<u8>>);
-
 /// What one run recorded.
 pub struct Run {
     pub frames: Vec<Frame>,
@@ -106,8 +101,7 @@ impl Scene {
     /// only lodkit code is the plugin.
     pub fn load(assets: &Path, file: &str) -> Result<Self, Failure> {
         let mut app = build_app_with_assets(Some(assets), |app| {
-            app.add_plugins(FrameSequentialLodPlugin)
-                .init_resource::<Inbox>();
+            app.add_plugins(FrameSequentialLodPlugin);
         });
         let world = app.world_mut();
         let target = render_target(world, WIDTH, HEIGHT);
@@ -118,28 +112,9 @@ impl Scene {
             },
             Transform::from_xyz(3.0, 6.0, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
         ));
-        let scene = world
-            .resource::<AssetServer>()
-            .load(GltfAssetLabel::Scene(0).from_asset(file.to_owned()));
-        world.spawn(WorldAssetRoot(scene));
-        let mut loaded = false;
-        for _ in 0..600 {
-            step(&mut app);
-            let world = app.world_mut();
-            loaded = world
-                .query_filtered::<Entity, With<WorldAssetRoot>>()
-                .iter(world)
-                .any(|root| world.get::<Children>(root).is_some_and(|c| !c.is_empty()));
-            if loaded {
-                break;
-            }
-        }
-        if !loaded {
+        if !crate::gltf_scene::load_scene(&mut app, file) {
             return Err(Failure(1, format!("{file} did not load")));
         }
-        // The groups are made, their transforms propagated.
-        step(&mut app);
-        step(&mut app);
         let world = app.world_mut();
         let mut groups = Vec::new();
         let mut query = world.query::<(
@@ -181,7 +156,7 @@ impl Scene {
             .query_filtered::<(), With<MeshMaterial3d<StandardMaterial>>>()
             .iter(world)
             .count();
-        let Some(sphere) = crate::bounds::scene_sphere(world) else {
+        let Some(sphere) = crate::gltf_scene::scene_sphere(world) else {
             return Err(Failure(1, format!("{file} has no mesh")));
         };
         Ok(Self {
@@ -258,14 +233,7 @@ impl Scene {
         for _ in 0..WARMUP_UPDATES {
             step(&mut self.app);
         }
-        let world = self.app.world_mut();
-        world.resource_mut::<Inbox>().0.clear();
-        let readback = world
-            .spawn(Readback::texture(self.target.clone()))
-            .observe(|done: On<ReadbackComplete>, mut inbox: ResMut<Inbox>| {
-                inbox.0.push(done.data.clone());
-            })
-            .id();
+        let readback = start_readback(self.app.world_mut(), &self.target);
         let selecting = self.app.world().get::<FrameSequentialLod>(camera).is_some();
         if selecting != (technique == Technique::FrameSequential) {
             return Err(Failure(
@@ -292,7 +260,7 @@ impl Scene {
             }
         }
         for _ in 0..DRAIN_UPDATES {
-            if self.app.world().resource::<Inbox>().0.len() >= poses.len() {
+            if self.app.world().resource::<FrameInbox>().0.len() >= poses.len() {
                 break;
             }
             step(&mut self.app);
@@ -303,7 +271,7 @@ impl Scene {
         for copy in copies {
             world.despawn(copy);
         }
-        let data = std::mem::take(&mut world.resource_mut::<Inbox>().0);
+        let data = std::mem::take(&mut world.resource_mut::<FrameInbox>().0);
         if data.len() < poses.len() {
             return Err(Failure(
                 1,
@@ -314,7 +282,7 @@ impl Scene {
         for _ in 0..4 {
             step(&mut self.app);
         }
-        self.app.world_mut().resource_mut::<Inbox>().0.clear();
+        self.app.world_mut().resource_mut::<FrameInbox>().0.clear();
         Ok(Run {
             frames: data
                 .into_iter()

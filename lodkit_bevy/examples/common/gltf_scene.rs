@@ -1,7 +1,33 @@
-//! The sphere around what a loaded scene shows, for the examples' camera walks.
+//! A glTF scene loaded by Bevy's own loader, and the sphere around what it shows, for the
+//! examples' camera walks.
 
 use bevy::camera::primitives::Aabb;
 use bevy::prelude::*;
+
+/// Spawns scene 0 of `file` (from the app's asset folder) and runs updates until it is spawned
+/// and what the plugins make of it is made; false when it did not load within 600 updates.
+pub fn load_scene(app: &mut App, file: &str) -> bool {
+    let world = app.world_mut();
+    let scene = world
+        .resource::<AssetServer>()
+        .load(GltfAssetLabel::Scene(0).from_asset(file.to_owned()));
+    world.spawn(WorldAssetRoot(scene));
+    for _ in 0..600 {
+        crate::headless::step(app);
+        let world = app.world_mut();
+        let spawned = world
+            .query_filtered::<Entity, With<WorldAssetRoot>>()
+            .iter(world)
+            .any(|root| world.get::<Children>(root).is_some_and(|c| !c.is_empty()));
+        if spawned {
+            // The groups made and their transforms propagated.
+            crate::headless::step(app);
+            crate::headless::step(app);
+            return true;
+        }
+    }
+    false
+}
 
 /// The sphere around every box in the scene (`Aabb`s, kept by LOD groups too): (centre,
 /// radius); None for an empty scene.
