@@ -1,5 +1,6 @@
 //! LOD levels made on the fly: [`AutoLod`] on an entity that already has `Mesh3d` and
-//! `MeshMaterial3d<StandardMaterial>` builds its mesh's LOD chain ([`MeshLodChain`]: levels from
+//! `MeshMaterial3d<StandardMaterial>` (or of a material of the app's own with a
+//! [`FrameSequentialMaterialPlugin`](crate::frame_sequential::FrameSequentialMaterialPlugin)) builds its mesh's LOD chain ([`MeshLodChain`]: levels from
 //! meshoptimizer, each with a bound of its distance from the mesh, and switch distances that keep
 //! the shown level within a pixel error) in a background task on Bevy's `AsyncComputeTaskPool`,
 //! and turns the entity into a [`FrameSequentialGroup`] when it is ready.
@@ -38,13 +39,15 @@ use bevy::tasks::futures::check_ready;
 use bevy::tasks::{AsyncComputeTaskPool, Task};
 use lodkit::select::LodGroup;
 
+use crate::frame_sequential::level_material::LevelMaterialTakers;
 use crate::frame_sequential::levels::{
     FrameSequentialGroup, FrameSequentialSystems, LodLevel, LodLevels,
 };
 use crate::lod_chain::{LodChainDescriptor, MeshLodChain, MeshLodChainError, PixelErrorCamera};
 
-/// Gives an entity with `Mesh3d` and `MeshMaterial3d<StandardMaterial>` LOD levels built from its
-/// mesh in the background (see the [module](self) docs).
+/// Gives an entity with `Mesh3d` and `MeshMaterial3d<StandardMaterial>` (or of a type with a
+/// [`FrameSequentialMaterialPlugin`](crate::frame_sequential::FrameSequentialMaterialPlugin)) LOD
+/// levels built from its mesh in the background (see the [module](self) docs).
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct AutoLod {
     /// How the chain is built. Its `camera` sets the pixel error the switch distances keep
@@ -102,12 +105,14 @@ enum Chain {
 struct Chains(HashMap<AssetId<Mesh>, Vec<(LodChainDescriptor, Chain)>>);
 
 pub(crate) fn build(app: &mut App) {
-    app.init_resource::<Chains>().add_systems(
-        PostUpdate,
-        (start_chains, finish_chains)
-            .chain()
-            .before(FrameSequentialSystems),
-    );
+    app.init_resource::<Chains>()
+        .init_resource::<LevelMaterialTakers>()
+        .add_systems(
+            PostUpdate,
+            (start_chains, finish_chains)
+                .chain()
+                .before(FrameSequentialSystems),
+        );
 }
 
 /// Starts (or joins) the chain of each new [`AutoLod`] entity whose mesh is loaded.
@@ -206,12 +211,17 @@ fn convert(commands: &mut Commands, entity: Entity, coarser: &[Handle<Mesh>], gr
         let Ok(mut e) = world.get_entity_mut(entity) else {
             return;
         };
-        let (Some(mesh), Some(material)) = (
-            e.get::<Mesh3d>().map(|m| m.0.clone()),
-            e.get::<MeshMaterial3d<StandardMaterial>>()
-                .map(|m| m.0.clone()),
-        ) else {
-            let why = "the entity lost its Mesh3d or MeshMaterial3d<StandardMaterial>".to_owned();
+        let Some(mesh) = e.get::<Mesh3d>().map(|m| m.0.clone()) else {
+            let why = "the entity lost its Mesh3d".to_owned();
+            warn!("AutoLod on {entity}: no LOD levels: {why}");
+            e.insert(AutoLodStatus::Failed(why));
+            return;
+        };
+        let material = e.resource_scope(|e, takers: Mut<LevelMaterialTakers>| takers.take(e));
+        let Some(material) = material else {
+            let why = "the entity has no material a level can use: a MeshMaterial3d of \
+                       StandardMaterial or of a type with a FrameSequentialMaterialPlugin"
+                .to_owned();
             warn!("AutoLod on {entity}: no LOD levels: {why}");
             e.insert(AutoLodStatus::Failed(why));
             return;
@@ -221,12 +231,11 @@ fn convert(commands: &mut Commands, entity: Entity, coarser: &[Handle<Mesh>], gr
             .map(|mesh| LodLevel::new(mesh, material.clone()))
             .collect();
         let count = levels.len();
-        e.remove::<(Mesh3d, MeshMaterial3d<StandardMaterial>)>()
-            .insert((
-                LodLevels(levels),
-                FrameSequentialGroup::new(group),
-                AutoLodStatus::Ready(count),
-            ));
+        e.remove::<Mesh3d>().insert((
+            LodLevels(levels),
+            FrameSequentialGroup::new(group),
+            AutoLodStatus::Ready(count),
+        ));
     });
 }
 

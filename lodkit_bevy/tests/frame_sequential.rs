@@ -10,6 +10,7 @@
 )]
 mod frames;
 #[path = "../examples/frame_sequential/measure.rs"]
+#[allow(dead_code, reason = "shared with the other examples; each uses a part")]
 mod measure;
 mod support;
 

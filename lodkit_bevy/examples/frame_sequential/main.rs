@@ -42,6 +42,7 @@ mod frames;
 #[path = "../common/headless.rs"]
 #[allow(dead_code, reason = "shared by the examples; each uses a part")]
 mod headless;
+#[allow(dead_code, reason = "shared with the other examples; each uses a part")]
 mod measure;
 mod report;
 mod run;

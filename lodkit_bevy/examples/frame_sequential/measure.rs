@@ -151,3 +151,67 @@ pub fn coverage(
         })
         .collect()
 }
+
+/// A technique's figures over a run: pop and flicker against the finest and the coarsest
+/// single-level run, see-through pixel-frames where both of `covers` cover, ghost pixel-frames
+/// where neither of `misses` covers, and the lowest [`coverage`].
+pub struct Figures {
+    pub pop: f64,
+    pub flicker_vs_fine: Flicker,
+    pub flicker_vs_coarse: Flicker,
+    pub see_through: usize,
+    pub ghosts: usize,
+    pub min_coverage: f64,
+}
+
+impl Figures {
+    /// The figures of `run` (see [`Figures`]).
+    pub fn of(
+        run: &[Frame],
+        [fine, coarse]: [&[Frame]; 2],
+        covers: [&[Frame]; 2],
+        misses: [&[Frame]; 2],
+        background: [u8; 3],
+    ) -> Result<Self, MetricsError> {
+        Ok(Self {
+            pop: pop(run, fine),
+            flicker_vs_fine: flicker(run, fine)?,
+            flicker_vs_coarse: flicker(run, coarse)?,
+            see_through: see_through(run, covers[0], covers[1], background)
+                .iter()
+                .sum(),
+            ghosts: ghosts(run, misses[0], misses[1], background).iter().sum(),
+            min_coverage: coverage(run, covers[0], covers[1], background)
+                .into_iter()
+                .fold(1.0, f64::min),
+        })
+    }
+
+    /// The figures as a report's JSON object.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "pop": self.pop,
+            "flicker_vs_fine": self.flicker_vs_fine.ratio(),
+            "reversals_vs_fine": self.flicker_vs_fine.reversals,
+            "flicker_vs_coarse": self.flicker_vs_coarse.ratio(),
+            "reversals_vs_coarse": self.flicker_vs_coarse.reversals,
+            "see_through": self.see_through,
+            "ghosts": self.ghosts,
+            "min_coverage": self.min_coverage,
+        })
+    }
+
+    /// One line for the console.
+    pub fn line(&self) -> String {
+        format!(
+            "pop {:.4}, flicker {:.3} vs fine ({} reversals), {:.3} vs coarse, see-through {} \
+             px, ghosts {} px",
+            self.pop,
+            self.flicker_vs_fine.ratio(),
+            self.flicker_vs_fine.reversals,
+            self.flicker_vs_coarse.ratio(),
+            self.see_through,
+            self.ghosts
+        )
+    }
+}

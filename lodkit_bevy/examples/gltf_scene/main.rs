@@ -154,33 +154,24 @@ fn covered(references: &[Run], all: bool, background: [u8; 3]) -> Vec<Frame> {
         .collect()
 }
 
-/// A technique's figures: pop and flicker against the finest and coarsest references;
-/// see-through where every level alone covers (`all`) and the frame shows the background;
-/// ghosts where no level covers (outside `any`) and the frame shows something.
+/// A technique's figures (`measure::Figures`): see-through where every level alone covers
+/// (`all`) and the frame shows the background; ghosts where no level covers (outside `any`) and
+/// the frame shows something.
 fn figures(
     run: &Run,
     references: &[Run],
     [all, any]: [&[Frame]; 2],
     background: [u8; 3],
-) -> Result<Value, Failure> {
+) -> Result<measure::Figures, Failure> {
     let (fine, coarse) = (&references[0], &references[references.len() - 1]);
-    let flicker = |reference: &Run| {
-        measure::flicker(&run.frames, &reference.frames).map_err(|e| Failure(1, e.to_string()))
-    };
-    let (f, fc) = (flicker(fine)?, flicker(coarse)?);
-    let see = measure::see_through(&run.frames, all, all, background);
-    let ghosts = measure::ghosts(&run.frames, any, any, background);
-    let coverage = measure::coverage(&run.frames, all, all, background);
-    Ok(json!({
-        "pop": measure::pop(&run.frames, &fine.frames),
-        "flicker_vs_fine": f.ratio(),
-        "reversals_vs_fine": f.reversals,
-        "flicker_vs_coarse": fc.ratio(),
-        "reversals_vs_coarse": fc.reversals,
-        "see_through": see.iter().sum::<usize>(),
-        "ghosts": ghosts.iter().sum::<usize>(),
-        "min_coverage": coverage.iter().copied().fold(1.0, f64::min),
-    }))
+    measure::Figures::of(
+        &run.frames,
+        [&fine.frames, &coarse.frames],
+        [all, all],
+        [any, any],
+        background,
+    )
+    .map_err(|e| Failure(1, e.to_string()))
 }
 
 fn run(args: &Args) -> Result<(), Failure> {
@@ -243,17 +234,8 @@ fn run(args: &Args) -> Result<(), Failure> {
         }
         if !name.starts_with("reference") {
             let f = figures(run, &references, [&all, &any], background)?;
-            println!(
-                "{name:18} pop {:.4}, flicker {:.3} vs fine ({} reversals), {:.3} vs coarse, \
-                 see-through {} px, ghosts {} px",
-                f["pop"].as_f64().unwrap_or(f64::NAN),
-                f["flicker_vs_fine"].as_f64().unwrap_or(f64::NAN),
-                f["reversals_vs_fine"],
-                f["flicker_vs_coarse"].as_f64().unwrap_or(f64::NAN),
-                f["see_through"],
-                f["ghosts"],
-            );
-            report.insert(name, f);
+            println!("{name:18} {}", f.line());
+            report.insert(name, f.json());
         }
     }
     let groups: Vec<Value> = scene

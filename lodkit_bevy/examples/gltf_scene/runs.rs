@@ -134,7 +134,7 @@ impl Scene {
                 .iter()
                 .map(|level| match &level.material {
                     LevelMaterial::Standard(material) => Ok((level.mesh.clone(), material.clone())),
-                    LevelMaterial::FrameSequential(_) => Err(Failure(
+                    _ => Err(Failure(
                         1,
                         format!("{name}: a level without a StandardMaterial"),
                     )),

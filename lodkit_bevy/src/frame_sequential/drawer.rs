@@ -9,9 +9,8 @@ use bevy::prelude::*;
 use lodkit::frame_sequential::{InstanceKey, TransitionScheduler};
 use lodkit::select::{LodSelection, LodState};
 
-use super::level_material::DerivedMaterials;
+use super::level_material::{DerivedMaterials, DrawerMaterial};
 use super::levels::LodLevels;
-use super::material::FrameSequentialMaterial;
 use super::rects::Bounds;
 
 /// lodkit's transition scheduler for the app's frame-sequential camera, and the key of each
@@ -64,6 +63,7 @@ type NewLevels<'w, 's> = Query<
 pub(super) fn spawn_levels(
     mut commands: Commands,
     mut scheduler: ResMut<Scheduler>,
+    derived: Res<DerivedMaterials>,
     groups: NewLevels,
 ) {
     let Scheduler(scheduler, keys) = &mut *scheduler;
@@ -81,6 +81,17 @@ pub(super) fn spawn_levels(
         }
         if levels.0.len() > 256 {
             warn_once!("a LOD group has more than 256 levels: the rest are ignored");
+        }
+        if let Some(name) = levels
+            .0
+            .iter()
+            .find_map(|l| derived.unregistered(&l.material))
+        {
+            warn!(
+                "LOD group {group}: a level's material is a {name}, which no \
+                 FrameSequentialMaterialPlugin::<{name}> derives a level material from: that \
+                 level is not drawn (add the plugin)"
+            );
         }
         let Some(first) = levels.0.first() else {
             warn_once!("a LOD group has no levels: nothing is drawn");
@@ -111,7 +122,7 @@ pub(super) fn spawn_drawer(
 ) -> Entity {
     let mut drawer = commands.spawn((
         Mesh3d(mesh),
-        MeshMaterial3d(Handle::<FrameSequentialMaterial>::default()),
+        DrawerMaterial::default(),
         MeshTag::new(0),
         Transform::IDENTITY,
         Visibility::Hidden,
@@ -131,7 +142,7 @@ pub(super) fn drawn(
     draw: Option<(u8, u32)>,
     levels: &LodLevels,
     derived: &DerivedMaterials,
-) -> Option<(Handle<Mesh>, Handle<FrameSequentialMaterial>, u32)> {
+) -> Option<(Handle<Mesh>, UntypedHandle, u32)> {
     let (lod, tag) = draw?;
     let level = levels.0.get(usize::from(lod)).or(levels.0.last())?;
     Some((level.mesh.clone(), derived.resolve(&level.material)?, tag))
@@ -144,7 +155,7 @@ pub(super) type DrawerQuery<'w, 's> = Query<
         &'static mut Visibility,
         &'static mut MeshTag,
         &'static mut Mesh3d,
-        &'static mut MeshMaterial3d<FrameSequentialMaterial>,
+        &'static mut DrawerMaterial,
     ),
 >;
 
@@ -169,7 +180,7 @@ pub(super) fn show(
     if mesh.0 != level_mesh {
         mesh.0 = level_mesh;
     }
-    if material.0 != handle {
-        material.0 = handle;
+    if material.0.as_ref() != Some(&handle) {
+        material.0 = Some(handle);
     }
 }

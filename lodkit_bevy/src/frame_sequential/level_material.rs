@@ -1,29 +1,173 @@
-//! The [`FrameSequentialMaterial`] the plugin derives from a level's plain [`StandardMaterial`]
-//! handle (what a glTF scene or an app already spawns; [`LevelMaterial::Standard`]), kept in step
-//! with it.
+//! The materials the plugin derives from a level's plain material handle: a
+//! [`FrameSequentialMaterial`] from a [`StandardMaterial`] (what a glTF scene or an app already
+//! spawns; [`LevelMaterial::Standard`]), a [`FrameSequentialLevel<M>`] from a material of the
+//! app's own ([`LevelMaterial::Custom`], with [`FrameSequentialMaterialPlugin`]), kept in step
+//! with it; and the system that gives a group's drawers the material each frame draws.
 
-use bevy::platform::collections::HashMap;
+use std::any::{Any, TypeId};
+use std::hash::Hash;
+use std::marker::PhantomData;
+
+use bevy::asset::UntypedAssetId;
+use bevy::ecs::world::EntityWorldMut;
+use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialPlugin};
+use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
+use bevy::render::render_resource::{AsBindGroup, Face};
 
 use super::levels::{LevelMaterial, LodLevels};
-use super::material::{FrameSequentialExtension, FrameSequentialMaterial};
+use super::material::{FrameSequentialBindings, FrameSequentialMaterial};
 
-/// The [`FrameSequentialMaterial`] derived from each [`StandardMaterial`] a level names.
+/// A material of the app's own as a level of a LOD group: `M` with [`FrameSequentialBindings`]
+/// (the bindings `lodkit_bevy::frame_sequential_level::lod_level_color` reads, and the shader
+/// def that turns it on). Derived by the plugin from `M`; see [`FrameSequentialMaterialPlugin`].
+pub type FrameSequentialLevel<M> = ExtendedMaterial<M, FrameSequentialBindings>;
+
+/// Lets levels use a material of the app's own, `M`: [`LevelMaterial::custom`] takes an
+/// `M` handle as it is, as a `StandardMaterial` handle is taken ([`LevelMaterial`]), and
+/// [`AutoLod`](crate::auto_lod::AutoLod) takes an entity's `MeshMaterial3d<M>`.
+///
+/// `M`'s fragment shader (a WESL file) makes its output a level's with one call:
+///
+/// ```wgsl
+/// import bevy_pbr::render::forward_io::VertexOutput;
+/// import lodkit_bevy::frame_sequential_level::lod_level_color;
+///
+/// @fragment
+/// fn fragment(in: VertexOutput) -> @location(0) vec4<f32> {
+///     let color = ...; // the material's own shading
+///     return lod_level_color(in, color);
+/// }
+/// ```
+///
+/// `lod_level_color` discards the fragments the screen-door dither drops and writes the
+/// combine's id word in alpha; where `M` is drawn as itself (not a level) it returns `color`
+/// unchanged, so one shader serves both. The plugin derives one [`FrameSequentialLevel<M>`] per
+/// `M` asset a level names (`M` cloned, so textures are the same handles; the bindings of
+/// [`FrameSequentialBindings`] at 100 and 101, which `M` must leave free, as any Bevy material
+/// extension asks), follows the asset's changes, and reads `M::alpha_mode` to tell a blending
+/// material (drawn with the screen-door dither) from an opaque or masked one (the combine). `M`
+/// is taken to cull back faces, Bevy's default, for the levels' silhouettes; a material that
+/// culls none still gets exact coverage, one that culls front faces gets the older-level depth
+/// pass. The fragment shader must write alpha only through `lod_level_color`: an opaque
+/// material's alpha is 1.
+///
+/// `cargo run --example custom_material` shows a material of its own through a transition.
+pub struct FrameSequentialMaterialPlugin<M>(PhantomData<M>);
+
+impl<M> Default for FrameSequentialMaterialPlugin<M> {
+    fn default() -> Self {
+        Self(PhantomData)
+    }
+}
+
+impl<M: Material + Clone> Plugin for FrameSequentialMaterialPlugin<M>
+where
+    <FrameSequentialLevel<M> as AsBindGroup>::Data: PartialEq + Eq + Hash + Clone,
+{
+    fn build(&self, app: &mut App) {
+        app.add_plugins(MaterialPlugin::<FrameSequentialLevel<M>>::default());
+        add_level_material::<M, FrameSequentialBindings>(app);
+    }
+}
+
+/// Registers `B` as a base of derived level materials `ExtendedMaterial<B, E>`: the
+/// derivation, the drawers' material of that type, and [`AutoLod`](crate::auto_lod::AutoLod)'s
+/// taking of `MeshMaterial3d<B>`.
+pub(super) fn add_level_material<B, E>(app: &mut App)
+where
+    B: Material + Clone,
+    E: MaterialExtension + Default,
+{
+    app.init_resource::<DerivedMaterials>()
+        .init_resource::<LevelMaterialTakers>();
+    app.world_mut()
+        .resource_mut::<DerivedMaterials>()
+        .bases
+        .insert(TypeId::of::<B>());
+    if TypeId::of::<B>() != TypeId::of::<StandardMaterial>() {
+        app.world_mut()
+            .resource_mut::<LevelMaterialTakers>()
+            .0
+            .push(take_material::<B>);
+    }
+    app.add_systems(
+        PostUpdate,
+        (
+            sync_derived_materials::<B, E>.in_set(DeriveMaterials),
+            apply_drawer_materials::<ExtendedMaterial<B, E>>.in_set(ApplyDrawerMaterials),
+        ),
+    );
+}
+
+/// The systems that derive level materials: after the groups' drawers are spawned, before
+/// the selection reads what the materials are.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(super) struct DeriveMaterials;
+
+/// The systems that give the drawers the material the selection chose: after it.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(super) struct ApplyDrawerMaterials;
+
+/// What a level's material is to the selection.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Looks {
+    /// Whether it blends with what lies behind it (no id word in its alpha).
+    pub(super) blends: bool,
+    /// The faces it culls.
+    pub(super) cull_mode: Option<Face>,
+}
+
+/// The derived material of one source material: its handle (reserved until the source loads)
+/// and what it is.
+struct Derived {
+    handle: UntypedHandle,
+    looks: Option<Looks>,
+}
+
+/// The material derived from each plain material a level names, by the source's id, and the
+/// material types with a [`FrameSequentialMaterialPlugin`] (or `StandardMaterial`).
 #[derive(Resource, Default)]
-pub(super) struct DerivedMaterials(
-    HashMap<AssetId<StandardMaterial>, Handle<FrameSequentialMaterial>>,
-);
+pub(crate) struct DerivedMaterials {
+    derived: HashMap<UntypedAssetId, Derived>,
+    bases: HashSet<TypeId>,
+}
 
 impl DerivedMaterials {
-    /// The material a level is drawn with (None: derived, but its `StandardMaterial` is not
-    /// loaded yet, or not derived at all).
-    pub(super) fn resolve(
+    /// The material a level is drawn with (None: derived, but its source is not loaded yet, or
+    /// not derived at all).
+    pub(super) fn resolve(&self, material: &LevelMaterial) -> Option<UntypedHandle> {
+        match material {
+            LevelMaterial::FrameSequential(handle) => Some(handle.clone().untyped()),
+            _ => self
+                .derived
+                .get(&material.source_id()?)
+                .map(|d| d.handle.clone()),
+        }
+    }
+
+    /// What a level's material is, once it is loaded.
+    pub(super) fn looks(
         &self,
         material: &LevelMaterial,
-    ) -> Option<Handle<FrameSequentialMaterial>> {
+        materials: &Assets<FrameSequentialMaterial>,
+    ) -> Option<Looks> {
         match material {
-            LevelMaterial::FrameSequential(handle) => Some(handle.clone()),
-            LevelMaterial::Standard(handle) => self.0.get(&handle.id()).cloned(),
+            LevelMaterial::FrameSequential(handle) => materials.get(handle).map(|m| Looks {
+                blends: blends(m.base.alpha_mode),
+                cull_mode: m.base.cull_mode,
+            }),
+            _ => self.derived.get(&material.source_id()?)?.looks,
+        }
+    }
+
+    /// The type name of a level's material where no plugin derives from it.
+    pub(super) fn unregistered(&self, material: &LevelMaterial) -> Option<&'static str> {
+        match material {
+            LevelMaterial::Custom { handle, type_name } => {
+                (!self.bases.contains(&handle.type_id())).then_some(*type_name)
+            }
+            _ => None,
         }
     }
 }
@@ -33,38 +177,57 @@ pub(super) fn blends(mode: AlphaMode) -> bool {
     !matches!(mode, AlphaMode::Opaque | AlphaMode::Mask(_))
 }
 
-/// `standard` as the frame-sequential material of a level.
-fn derive(standard: &StandardMaterial) -> FrameSequentialMaterial {
-    FrameSequentialMaterial {
-        base: standard.clone(),
-        extension: FrameSequentialExtension::default(),
+/// What `material` is to the selection: `StandardMaterial` says its cull mode; any other
+/// material is taken to cull back faces (Bevy's default).
+fn looks_of<B: Material>(material: &B) -> Looks {
+    let cull_mode = (material as &dyn Any)
+        .downcast_ref::<StandardMaterial>()
+        .map_or(Some(Face::Back), |s| s.cull_mode);
+    Looks {
+        blends: blends(material.alpha_mode()),
+        cull_mode,
     }
 }
 
-/// Derives a material for every `StandardMaterial` a new or changed [`LodLevels`] names, copies
-/// each changed one into its derived material, and forgets those the app dropped.
-pub(super) fn sync_derived_materials(
+/// Derives a material for every `B` a new or changed [`LodLevels`] names, copies each changed
+/// one into its derived material, and forgets those the app dropped.
+pub(super) fn sync_derived_materials<B, E>(
     mut derived: ResMut<DerivedMaterials>,
-    mut events: MessageReader<AssetEvent<StandardMaterial>>,
-    standards: Res<Assets<StandardMaterial>>,
-    mut materials: ResMut<Assets<FrameSequentialMaterial>>,
+    mut events: MessageReader<AssetEvent<B>>,
+    bases: Res<Assets<B>>,
+    mut materials: ResMut<Assets<ExtendedMaterial<B, E>>>,
     groups: Query<&LodLevels, Changed<LodLevels>>,
-) {
+) where
+    B: Material + Clone,
+    E: MaterialExtension + Default,
+{
+    let derive = |base: &B| ExtendedMaterial {
+        base: base.clone(),
+        extension: E::default(),
+    };
     for levels in &groups {
         for level in &levels.0 {
-            let LevelMaterial::Standard(handle) = &level.material else {
+            let Some(source) = level.material.source_id() else {
                 continue;
             };
-            if derived.0.contains_key(&handle.id()) {
+            let Ok(id) = source.try_typed::<B>() else {
+                continue;
+            };
+            if derived.derived.contains_key(&source) {
                 continue;
             }
             // Not loaded yet: its `LoadedWithDependencies` (or `Added`) event derives it.
-            if let Some(standard) = standards.get(handle) {
-                let material = materials.add(derive(standard));
-                derived.0.insert(handle.id(), material);
-            } else {
-                derived.0.insert(handle.id(), materials.reserve_handle());
-            }
+            let entry = match bases.get(id) {
+                Some(base) => Derived {
+                    handle: materials.add(derive(base)).untyped(),
+                    looks: Some(looks_of(base)),
+                },
+                None => Derived {
+                    handle: materials.reserve_handle().untyped(),
+                    looks: None,
+                },
+            };
+            derived.derived.insert(source, entry);
         }
     }
     for event in events.read() {
@@ -72,15 +235,92 @@ pub(super) fn sync_derived_materials(
             AssetEvent::Added { id }
             | AssetEvent::Modified { id }
             | AssetEvent::LoadedWithDependencies { id } => {
-                if let (Some(handle), Some(standard)) = (derived.0.get(&id), standards.get(id)) {
+                if let (Some(entry), Some(base)) =
+                    (derived.derived.get_mut(&id.untyped()), bases.get(id))
+                    && let Ok(handle) = entry.handle.clone().try_typed::<ExtendedMaterial<B, E>>()
+                {
                     // A reserved handle gets its asset, a derived one the change.
-                    let _ = materials.insert(handle.id(), derive(standard));
+                    let _ = materials.insert(handle.id(), derive(base));
+                    entry.looks = Some(looks_of(base));
                 }
             }
             AssetEvent::Removed { id } | AssetEvent::Unused { id } => {
-                derived.0.remove(&id);
+                derived.derived.remove(&id.untyped());
             }
         }
+    }
+}
+
+/// The material a group's drawer shows (set by the selection; None while hidden).
+#[derive(Component, Clone, Debug, Default, PartialEq)]
+pub(super) struct DrawerMaterial(pub(super) Option<UntypedHandle>);
+
+/// The drawers whose [`DrawerMaterial`] changed, with their `MeshMaterial3d<T>`, if any.
+type ChangedDrawers<'w, 's, T> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static DrawerMaterial,
+        Option<&'static mut MeshMaterial3d<T>>,
+    ),
+    Changed<DrawerMaterial>,
+>;
+
+/// Gives every drawer whose [`DrawerMaterial`] changed a `MeshMaterial3d<T>` where the handle
+/// is a `T`, and takes it away where it is not (a drawer has one material component at a
+/// time, or Bevy would draw it with each).
+pub(super) fn apply_drawer_materials<T: Material>(
+    mut commands: Commands,
+    mut drawers: ChangedDrawers<T>,
+) {
+    for (entity, material, current) in &mut drawers {
+        let wanted = material
+            .0
+            .as_ref()
+            .and_then(|h| h.clone().try_typed::<T>().ok());
+        match (wanted, current) {
+            (Some(handle), Some(mut current)) => {
+                if current.0 != handle {
+                    current.0 = handle;
+                }
+            }
+            (Some(handle), None) => {
+                commands.entity(entity).insert(MeshMaterial3d(handle));
+            }
+            (None, Some(_)) => {
+                commands.entity(entity).remove::<MeshMaterial3d<T>>();
+            }
+            (None, None) => {}
+        }
+    }
+}
+
+/// Takes an entity's own material as a level's: removes its `MeshMaterial3d<B>` and returns
+/// the handle (None where it has none).
+type TakeMaterial = fn(&mut EntityWorldMut) -> Option<LevelMaterial>;
+
+/// For each material type levels may use, how to take an entity's `MeshMaterial3d` of it
+/// ([`AutoLod`](crate::auto_lod::AutoLod)): `StandardMaterial` first, then each type with a
+/// [`FrameSequentialMaterialPlugin`].
+#[derive(Resource)]
+pub(crate) struct LevelMaterialTakers(pub(crate) Vec<TakeMaterial>);
+
+impl Default for LevelMaterialTakers {
+    fn default() -> Self {
+        Self(vec![take_material::<StandardMaterial>])
+    }
+}
+
+fn take_material<B: Material>(entity: &mut EntityWorldMut) -> Option<LevelMaterial> {
+    let handle = entity.take::<MeshMaterial3d<B>>()?.0;
+    Some(LevelMaterial::custom(handle))
+}
+
+impl LevelMaterialTakers {
+    /// Takes `entity`'s material (the first type registered that it has).
+    pub(crate) fn take(&self, entity: &mut EntityWorldMut) -> Option<LevelMaterial> {
+        self.0.iter().find_map(|take| take(entity))
     }
 }
 
@@ -89,9 +329,23 @@ mod tests {
     use bevy::asset::AssetPlugin;
 
     use super::*;
-    use crate::frame_sequential::LodLevel;
+    use crate::frame_sequential::{FrameSequentialExtension, LodLevel};
 
-    /// An app with the assets and the system, as the plugin schedules it (no renderer).
+    /// A material of an app's own (its shader is not compiled here).
+    #[derive(Asset, TypePath, AsBindGroup, Clone, Debug)]
+    struct Plain {
+        #[uniform(0)]
+        color: LinearRgba,
+        alpha_mode: AlphaMode,
+    }
+
+    impl Material for Plain {
+        fn alpha_mode(&self) -> AlphaMode {
+            self.alpha_mode
+        }
+    }
+
+    /// An app with the assets and the systems, as the plugins schedule them (no renderer).
     fn app() -> App {
         let mut app = App::new();
         app.add_plugins((MinimalPlugins, AssetPlugin::default()))
@@ -99,17 +353,25 @@ mod tests {
             .init_asset::<Mesh>()
             .init_asset::<StandardMaterial>()
             .init_asset::<FrameSequentialMaterial>()
-            .init_resource::<DerivedMaterials>()
-            .add_systems(PostUpdate, sync_derived_materials);
+            .init_asset::<Plain>()
+            .init_asset::<FrameSequentialLevel<Plain>>();
+        add_level_material::<StandardMaterial, FrameSequentialExtension>(&mut app);
+        add_level_material::<Plain, FrameSequentialBindings>(&mut app);
+        app.configure_sets(PostUpdate, DeriveMaterials.before(ApplyDrawerMaterials));
         app
     }
 
-    fn derived(app: &App, standard: &Handle<StandardMaterial>) -> Option<FrameSequentialMaterial> {
+    fn derived<B: Material, E: MaterialExtension>(
+        app: &App,
+        material: LevelMaterial,
+    ) -> Option<ExtendedMaterial<B, E>> {
         let handle = app
             .world()
             .resource::<DerivedMaterials>()
-            .resolve(&standard.clone().into())?;
-        let materials = app.world().resource::<Assets<FrameSequentialMaterial>>();
+            .resolve(&material)?
+            .try_typed::<ExtendedMaterial<B, E>>()
+            .ok()?;
+        let materials = app.world().resource::<Assets<ExtendedMaterial<B, E>>>();
         materials.get(&handle).cloned()
     }
 
@@ -130,11 +392,12 @@ mod tests {
         app.world_mut().spawn(LodLevels(vec![level()]));
         app.update();
         assert_eq!(
-            app.world().resource::<DerivedMaterials>().0.len(),
+            app.world().resource::<DerivedMaterials>().derived.len(),
             1,
             "one derived material for one StandardMaterial"
         );
-        let material = derived(&app, &standard).expect("derived at once");
+        let material: FrameSequentialMaterial =
+            derived(&app, standard.clone().into()).expect("derived at once");
         assert_eq!(material.base.base_color, Color::srgb(0.8, 0.5, 0.2));
         assert_eq!(
             material.base.base_color_texture,
@@ -150,7 +413,7 @@ mod tests {
             .base_color = Color::srgb(0.1, 0.9, 0.3);
         app.update();
         app.update();
-        let material = derived(&app, &standard).unwrap();
+        let material: FrameSequentialMaterial = derived(&app, standard.into()).unwrap();
         assert_eq!(material.base.base_color, Color::srgb(0.1, 0.9, 0.3));
     }
 
@@ -166,15 +429,112 @@ mod tests {
             standard.clone(),
         )]));
         app.update();
-        assert!(derived(&app, &standard).is_none(), "nothing to derive yet");
+        let none: Option<FrameSequentialMaterial> = derived(&app, standard.clone().into());
+        assert!(none.is_none(), "nothing to derive yet");
         app.world_mut()
             .resource_mut::<Assets<StandardMaterial>>()
             .insert(standard.id(), StandardMaterial::from(Color::WHITE))
             .unwrap();
         app.update();
         app.update();
-        let material = derived(&app, &standard).expect("derived once it arrived");
+        let material: FrameSequentialMaterial =
+            derived(&app, standard.into()).expect("derived once it arrived");
         assert_eq!(material.base.base_color, Color::WHITE);
+    }
+
+    /// A material of the app's own is derived and followed as a StandardMaterial is; its alpha
+    /// mode says whether it blends; a drawer showing it gets its `MeshMaterial3d` of the
+    /// derived type and loses the other type's.
+    #[test]
+    fn a_custom_material_is_derived_followed_and_drawn() {
+        let mut app = app();
+        let plain = app.world_mut().resource_mut::<Assets<Plain>>().add(Plain {
+            color: LinearRgba::RED,
+            alpha_mode: AlphaMode::Opaque,
+        });
+        let standard = app
+            .world_mut()
+            .resource_mut::<Assets<StandardMaterial>>()
+            .add(StandardMaterial::default());
+        let custom = LevelMaterial::custom(plain.clone());
+        assert!(matches!(custom, LevelMaterial::Custom { .. }));
+        assert_eq!(
+            LevelMaterial::custom(standard.clone()),
+            LevelMaterial::Standard(standard.clone()),
+            "a StandardMaterial handle stays Standard"
+        );
+        app.world_mut().spawn(LodLevels(vec![
+            LodLevel::new(Handle::default(), custom.clone()),
+            LodLevel::new(Handle::default(), standard.clone()),
+        ]));
+        app.update();
+        let material: FrameSequentialLevel<Plain> =
+            derived(&app, custom.clone()).expect("derived at once");
+        assert_eq!(material.base.color, LinearRgba::RED);
+        let empty = Assets::<FrameSequentialMaterial>::default();
+        let looks = |app: &App| {
+            app.world()
+                .resource::<DerivedMaterials>()
+                .looks(&custom, &empty)
+                .expect("loaded")
+        };
+        assert_eq!(
+            looks(&app),
+            Looks {
+                blends: false,
+                cull_mode: Some(Face::Back)
+            }
+        );
+        app.world_mut()
+            .resource_mut::<Assets<Plain>>()
+            .get_mut(&plain)
+            .unwrap()
+            .alpha_mode = AlphaMode::Blend;
+        app.update();
+        app.update();
+        assert!(looks(&app).blends, "a change of alpha mode is followed");
+
+        // A drawer: the custom material, then the standard one, then hidden.
+        let resolve =
+            |app: &App, m: &LevelMaterial| app.world().resource::<DerivedMaterials>().resolve(m);
+        let (first, second) = (
+            resolve(&app, &custom),
+            resolve(&app, &LevelMaterial::Standard(standard)),
+        );
+        let drawer = app.world_mut().spawn(DrawerMaterial(first.clone())).id();
+        app.update();
+        let has = |app: &App| {
+            (
+                app.world()
+                    .get::<MeshMaterial3d<FrameSequentialLevel<Plain>>>(drawer)
+                    .map(|m| m.0.clone().untyped()),
+                app.world()
+                    .get::<MeshMaterial3d<FrameSequentialMaterial>>(drawer)
+                    .map(|m| m.0.clone().untyped()),
+            )
+        };
+        assert_eq!(has(&app), (first.clone(), None));
+        app.world_mut().get_mut::<DrawerMaterial>(drawer).unwrap().0 = second.clone();
+        app.update();
+        assert_eq!(
+            has(&app),
+            (None, second),
+            "one material component at a time"
+        );
+    }
+
+    #[test]
+    fn a_material_without_its_plugin_is_named() {
+        let mut app = App::new();
+        app.add_plugins((MinimalPlugins, AssetPlugin::default()))
+            .init_asset::<Plain>();
+        let derived = DerivedMaterials::default();
+        let plain = app.world_mut().resource_mut::<Assets<Plain>>().add(Plain {
+            color: LinearRgba::RED,
+            alpha_mode: AlphaMode::Opaque,
+        });
+        let name = derived.unregistered(&LevelMaterial::custom(plain));
+        assert!(name.is_some_and(|n| n.ends_with("Plain")), "{name:?}");
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! What a LOD group is made of: the [`FrameSequentialGroup`] component, its [`LodLevels`], and
 //! each level's mesh and [`LevelMaterial`].
 
+use bevy::asset::UntypedAssetId;
 use bevy::prelude::*;
 use lodkit::select::LodGroup;
 
@@ -34,6 +35,10 @@ pub struct FrameSequentialSystems;
 /// # let _ = level;
 /// ```
 ///
+/// A material of the app's own type `M` takes part the same way through
+/// [`LevelMaterial::custom`] and [`FrameSequentialMaterialPlugin::<M>`](super::FrameSequentialMaterialPlugin),
+/// its fragment shader ending with one call to `lod_level_color`.
+///
 /// Opaque and alpha-mask (`AlphaMode::Mask`) materials take part in the combine. A material
 /// that blends (`Blend`, `Premultiplied`, `Add`, `Multiply`, `AlphaToCoverage`) cannot carry the
 /// combine's id word in its alpha: a group with such a level is drawn with the complementary
@@ -44,6 +49,13 @@ pub enum LevelMaterial {
     Standard(Handle<StandardMaterial>),
     /// A material made for frame-sequential LOD.
     FrameSequential(Handle<FrameSequentialMaterial>),
+    /// A material of the app's own type, used as it is: [`LevelMaterial::custom`].
+    Custom {
+        /// The app's material handle.
+        handle: UntypedHandle,
+        /// Its type's name, for warnings.
+        type_name: &'static str,
+    },
 }
 
 impl From<Handle<StandardMaterial>> for LevelMaterial {
@@ -55,6 +67,32 @@ impl From<Handle<StandardMaterial>> for LevelMaterial {
 impl From<Handle<FrameSequentialMaterial>> for LevelMaterial {
     fn from(handle: Handle<FrameSequentialMaterial>) -> Self {
         Self::FrameSequential(handle)
+    }
+}
+
+impl LevelMaterial {
+    /// A level material of the app's own material handle, of any type with a
+    /// [`FrameSequentialMaterialPlugin`](super::FrameSequentialMaterialPlugin) (a
+    /// `StandardMaterial` handle gives [`LevelMaterial::Standard`]).
+    pub fn custom<M: Material>(handle: Handle<M>) -> Self {
+        let handle = handle.untyped();
+        match handle.clone().try_typed::<StandardMaterial>() {
+            Ok(standard) => Self::Standard(standard),
+            Err(_) => Self::Custom {
+                handle,
+                type_name: std::any::type_name::<M>(),
+            },
+        }
+    }
+
+    /// The app's material the plugin derives the drawn one from (None for a
+    /// [`FrameSequentialMaterial`], drawn as it is).
+    pub(super) fn source_id(&self) -> Option<UntypedAssetId> {
+        match self {
+            Self::Standard(handle) => Some(handle.id().untyped()),
+            Self::FrameSequential(_) => None,
+            Self::Custom { handle, .. } => Some(handle.id()),
+        }
     }
 }
 

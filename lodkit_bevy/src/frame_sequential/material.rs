@@ -2,10 +2,16 @@
 //! PBR functions, extended to write the fragment's LOD-buffer id word in alpha.
 
 use bevy::asset::{RenderAssetUsages, uuid_handle};
-use bevy::pbr::{ExtendedMaterial, MaterialExtension};
+use bevy::mesh::MeshVertexBufferLayoutRef;
+use bevy::pbr::{
+    ExtendedMaterial, MaterialExtension, MaterialExtensionKey, MaterialExtensionPipeline,
+};
 use bevy::prelude::*;
 use bevy::reflect::TypePath;
-use bevy::render::render_resource::{AsBindGroup, Extent3d, TextureDimension, TextureFormat};
+use bevy::render::render_resource::{
+    AsBindGroup, Extent3d, RenderPipelineDescriptor, SpecializedMeshPipelineError,
+    TextureDimension, TextureFormat,
+};
 use bevy::shader::ShaderRef;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
@@ -62,6 +68,68 @@ impl Default for FrameSequentialExtension {
 impl MaterialExtension for FrameSequentialExtension {
     fn fragment_shader() -> ShaderRef {
         LOD_MATERIAL_SHADER.into()
+    }
+
+    fn specialize(
+        _: &MaterialExtensionPipeline,
+        descriptor: &mut RenderPipelineDescriptor,
+        _: &MeshVertexBufferLayoutRef,
+        _: MaterialExtensionKey<Self>,
+    ) -> Result<(), SpecializedMeshPipelineError> {
+        define_level(descriptor);
+        Ok(())
+    }
+}
+
+/// The shader def under which `lodkit_bevy::frame_sequential_level` declares its bindings and
+/// `lod_level_color` does its work.
+pub const LEVEL_SHADER_DEF: &str = "LODKIT_FRAME_SEQUENTIAL_LEVEL";
+
+/// Defines [`LEVEL_SHADER_DEF`] in the fragment stage.
+fn define_level(descriptor: &mut RenderPipelineDescriptor) {
+    if let Some(fragment) = descriptor.fragment.as_mut() {
+        fragment.shader_defs.push(LEVEL_SHADER_DEF.into());
+    }
+}
+
+/// The extension that makes a material of the app's own a level of a frame-sequential LOD
+/// group ([`FrameSequentialLevel<M>`](super::FrameSequentialLevel), derived by
+/// [`FrameSequentialMaterialPlugin`](super::FrameSequentialMaterialPlugin)): the bindings that
+/// `lodkit_bevy::frame_sequential_level::lod_level_color` reads (the same as
+/// [`FrameSequentialExtension`]'s, at 100 and 101) and the shader def [`LEVEL_SHADER_DEF`] that
+/// turns it on. The material's own shaders are used, unchanged.
+#[derive(Asset, AsBindGroup, TypePath, Clone, Debug)]
+pub struct FrameSequentialBindings {
+    /// The visibility texture (as [`FrameSequentialExtension::visibility`]).
+    #[texture(100, sample_type = "float", filterable = false)]
+    pub visibility: Handle<Image>,
+    /// As [`FrameSequentialExtension::pattern_scale`].
+    #[uniform(101)]
+    pub pattern_scale: Vec4,
+}
+
+impl Default for FrameSequentialBindings {
+    fn default() -> Self {
+        let FrameSequentialExtension {
+            visibility,
+            pattern_scale,
+        } = FrameSequentialExtension::default();
+        Self {
+            visibility,
+            pattern_scale,
+        }
+    }
+}
+
+impl MaterialExtension for FrameSequentialBindings {
+    fn specialize(
+        _: &MaterialExtensionPipeline,
+        descriptor: &mut RenderPipelineDescriptor,
+        _: &MeshVertexBufferLayoutRef,
+        _: MaterialExtensionKey<Self>,
+    ) -> Result<(), SpecializedMeshPipelineError> {
+        define_level(descriptor);
+        Ok(())
     }
 }
 

@@ -73,9 +73,11 @@
 //!   derives a [`FrameSequentialMaterial`] from it, sharing its textures, and follows its
 //!   changes: [`LevelMaterial`]), or a [`FrameSequentialMaterial`] (Bevy's `StandardMaterial`,
 //!   lit by Bevy's PBR functions), whose fragment shader ends with
-//!   `lodkit_bevy::frame_sequential::lod_fragment_alpha`: the main pass's HDR color is the LOD
-//!   buffer, its alpha the id word. The WGSL module offers that function to materials of your
-//!   own, but the plugin drives only `StandardMaterial`-based levels for now.
+//!   `lodkit_bevy::frame_sequential_level::lod_level_color`: the main pass's HDR color is the
+//!   LOD buffer, its alpha the id word. A material of the app's own type `M` takes part the
+//!   same way: [`FrameSequentialMaterialPlugin::<M>`] derives a [`FrameSequentialLevel<M>`]
+//!   from each `M` handle a level names ([`LevelMaterial::custom`]), and `M`'s fragment shader
+//!   ends with that one call (the `custom_material` example).
 //! - A glTF file with `MSFT_lod` levels (the files `lodkit lod` writes) loaded by Bevy's glTF
 //!   loader spawns these groups by itself ([`crate::gltf_lod`], feature `gltf`).
 //! - After Bevy's opaque pass, before the transparent pass and post-processing, the plugin
@@ -104,7 +106,7 @@ mod camera;
 mod data;
 mod dither;
 mod drawer;
-mod level_material;
+pub(crate) mod level_material;
 pub(crate) mod levels;
 mod material;
 mod older_depth;
@@ -126,14 +128,15 @@ use lodkit::select::LodSettings;
 
 pub use camera::FrameSequentialDefaultCamera;
 pub use drawer::FrameSequentialLevels;
+pub use level_material::{FrameSequentialLevel, FrameSequentialMaterialPlugin};
 pub use levels::{
     FrameSequentialGroup, FrameSequentialSystems, LevelMaterial, LodLevel, LodLevels,
 };
 /// Where lodkit's visibility pattern is anchored: [`FrameSequentialLod::anchor`].
 pub use lodkit::visibility::VisibilitySpace;
 pub use material::{
-    FrameSequentialExtension, FrameSequentialMaterial, VISIBILITY_TEXTURE, VISIBILITY_TEXTURE_SEED,
-    VISIBILITY_TEXTURE_SIZE,
+    FrameSequentialBindings, FrameSequentialExtension, FrameSequentialMaterial, LEVEL_SHADER_DEF,
+    VISIBILITY_TEXTURE, VISIBILITY_TEXTURE_SEED, VISIBILITY_TEXTURE_SIZE,
 };
 pub use older_depth::OLDER_DEPTH_PASS;
 pub use render::COMBINE_PASS;
@@ -156,6 +159,11 @@ impl Plugin for FrameSequentialLodPlugin {
             app,
             "frame_sequential",
             include_str!("frame_sequential.wesl"),
+        );
+        crate::shaders::register_library(
+            app,
+            "frame_sequential_level",
+            include_str!("frame_sequential_level.wesl"),
         );
         embedded_asset!(app, "combine.wesl");
         embedded_asset!(app, "older_depth.wesl");

@@ -26,14 +26,16 @@ use super::dither::{Fallback, dither_draws};
 use super::drawer::{
     DrawerQuery, FrameSequentialLevels, Scheduler, drawn, show, spawn_drawer, spawn_levels,
 };
-use super::level_material::{DerivedMaterials, blends, sync_derived_materials};
+use super::level_material::{
+    ApplyDrawerMaterials, DeriveMaterials, DerivedMaterials, DrawerMaterial, add_level_material,
+};
 use super::rects::{Bounds, group_hull, group_rect, level_bounds, merge_rows, to_lodkit};
 use super::silhouette::{OutlineView, Surfaces, forget_changed_meshes, outline};
 use super::tag::{decode_tag, encode_tag};
 use super::view::{FrameSequentialView, OlderLevel};
 use super::{
-    CombineRegion, FrameSequentialGroup, FrameSequentialLod, FrameSequentialMaterial,
-    FrameSequentialSystems, LodLevels, OlderCoverage, VisibilitySpace,
+    CombineRegion, FrameSequentialExtension, FrameSequentialGroup, FrameSequentialLod,
+    FrameSequentialMaterial, FrameSequentialSystems, LodLevels, OlderCoverage, VisibilitySpace,
 };
 
 pub(super) fn build(app: &mut App) {
@@ -41,23 +43,35 @@ pub(super) fn build(app: &mut App) {
         .init_resource::<FrameSequentialDefaultCamera>()
         .init_resource::<FrameSequentialStats>()
         .init_resource::<Surfaces>()
-        .init_resource::<DerivedMaterials>()
         .add_systems(
             PostUpdate,
             (
                 default_camera,
                 configure_depth_copies,
                 spawn_levels,
-                sync_derived_materials,
                 forget_changed_meshes,
                 update,
             )
                 .chain()
-                .in_set(FrameSequentialSystems)
-                .after(TransformSystems::Propagate)
-                .after(CameraUpdateSystems)
-                .before(VisibilitySystems::VisibilityPropagate),
+                .in_set(FrameSequentialSystems),
+        )
+        .configure_sets(
+            PostUpdate,
+            (
+                FrameSequentialSystems
+                    .after(TransformSystems::Propagate)
+                    .after(CameraUpdateSystems)
+                    .before(VisibilitySystems::VisibilityPropagate),
+                DeriveMaterials
+                    .in_set(FrameSequentialSystems)
+                    .after(spawn_levels)
+                    .before(update),
+                ApplyDrawerMaterials
+                    .in_set(FrameSequentialSystems)
+                    .after(update),
+            ),
         );
+    add_level_material::<StandardMaterial, FrameSequentialExtension>(app);
 }
 
 /// What the last frame's selection did, for reports and tests.
@@ -308,9 +322,8 @@ fn update(
         let blending = transitioning
             && levels.0.iter().any(|l| {
                 derived
-                    .resolve(&l.material)
-                    .and_then(|m| materials.get(&m))
-                    .is_some_and(|m| blends(m.base.alpha_mode))
+                    .looks(&l.material, &materials)
+                    .is_some_and(|m| m.blends)
             });
         let fallback = Fallback::of(multisampled, blending, prepass);
         if blending {
@@ -347,7 +360,7 @@ fn update(
                     // group's (its own is the identity), or it would be drawn at the origin
                     // this frame.
                     commands.entity(drawer).insert((
-                        MeshMaterial3d(material),
+                        DrawerMaterial(Some(material)),
                         MeshTag::new(tag),
                         Visibility::Inherited,
                         *transform,
@@ -419,9 +432,8 @@ fn update(
             if let Some(other) = other.filter(|_| selection.visible && settings.coverage.is_exact())
             {
                 let cull_mode = derived
-                    .resolve(&other.material)
-                    .and_then(|m| materials.get(&m))
-                    .map_or(Some(Face::Back), |m| m.base.cull_mode);
+                    .looks(&other.material, &materials)
+                    .map_or(Some(Face::Back), |m| m.cull_mode);
                 // Where the level's silhouette can be had on the CPU (a closed triangle mesh
                 // with its positions, culled as usual), it tells the coverage; else the
                 // older-level depth pass draws the level.

@@ -166,6 +166,7 @@ fn a_multisampled_camera_with_a_prepass_switches_at_once() {
 #[test]
 fn changed_levels_release_the_groups_transition() {
     let mut world = World::new();
+    world.init_resource::<DerivedMaterials>();
     let mut scheduler = TransitionScheduler::new();
     let key = scheduler.insert(0);
     scheduler
