@@ -613,7 +613,20 @@ fn errors_outside_lodkit_are_reported_by_the_next_call() {
     let Some(gpu) = own_gpu() else { return };
     // The engine's own mistake on the device: a texture with no usage. No error scope is open,
     // so it reaches the handler lodkit installed, which records it instead of panicking.
-    let _bad = gpu.device.create_texture(&wgpu::TextureDescriptor {
+    let _bad = engine_mistake(&gpu);
+    let e = no_panic("RenderTarget::new", || RenderTarget::new(&gpu, 4, 4)).unwrap_err();
+    say(&format!("after an engine error: {e}"));
+    assert!(
+        matches!(&e, GpuError::Uncaptured { count: 1, call: "RenderTarget::new", first } if first.contains("engine texture")),
+        "{e:?}"
+    );
+    RenderTarget::new(&gpu, 4, 4).expect("the record is cleared once reported");
+}
+
+/// The engine's own mistake on the device, outside lodkit's calls (no error scope is open): a
+/// texture with no usage, labelled "engine texture".
+fn engine_mistake(gpu: &GpuContext) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some("engine texture"),
         size: wgpu::Extent3d {
             width: 4,
@@ -626,14 +639,61 @@ fn errors_outside_lodkit_are_reported_by_the_next_call() {
         format: RGBA8,
         usage: wgpu::TextureUsages::empty(),
         view_formats: &[],
-    });
-    let e = no_panic("RenderTarget::new", || RenderTarget::new(&gpu, 4, 4)).unwrap_err();
-    say(&format!("after an engine error: {e}"));
+    })
+}
+
+/// A context over an engine's device leaves the engine's uncaptured-error handler in place
+/// (`from_parts`): the engine's own mistake reaches its handler, not lodkit's record; asked to
+/// (`DeviceHandlers::Install`), lodkit's handler replaces it and the next call names the error.
+#[test]
+fn an_engines_handlers_stay_unless_lodkit_is_asked_to_install_its_own() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    use lodkit::gpu::{DeviceHandlers, GpuContextDescriptor};
+
+    let Some(own) = own_gpu() else { return };
+    let parts = || {
+        (
+            own.instance.clone(),
+            own.adapter.clone(),
+            own.device.clone(),
+            own.queue.clone(),
+        )
+    };
+    let seen = Arc::new(AtomicUsize::new(0));
+    let counter = Arc::clone(&seen);
+    own.device
+        .on_uncaptured_error(Arc::new(move |_: wgpu::Error| {
+            counter.fetch_add(1, Ordering::SeqCst);
+        }));
+    let (instance, adapter, device, queue) = parts();
+    let kept = GpuContext::from_parts(instance, adapter, device, queue);
+    let _bad = engine_mistake(&kept);
+    assert_eq!(
+        seen.load(Ordering::SeqCst),
+        1,
+        "the engine's handler saw it"
+    );
+    kept.check("check").expect("lodkit recorded nothing");
+    RenderTarget::new(&kept, 4, 4).expect("lodkit's calls work over the engine's device");
+
+    let (instance, adapter, device, queue) = parts();
+    let descriptor = GpuContextDescriptor {
+        handlers: DeviceHandlers::Install,
+    };
+    let installed = GpuContext::from_parts_with(instance, adapter, device, queue, &descriptor);
+    let _bad = engine_mistake(&installed);
+    assert_eq!(
+        seen.load(Ordering::SeqCst),
+        1,
+        "the engine's handler was replaced"
+    );
+    let e = installed.check("check").unwrap_err();
     assert!(
-        matches!(&e, GpuError::Uncaptured { count: 1, call: "RenderTarget::new", first } if first.contains("engine texture")),
+        matches!(&e, GpuError::Uncaptured { count: 1, first, .. } if first.contains("engine texture")),
         "{e:?}"
     );
-    RenderTarget::new(&gpu, 4, 4).expect("the record is cleared once reported");
 }
 
 #[test]

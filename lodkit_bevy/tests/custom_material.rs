@@ -5,10 +5,6 @@
 
 mod support;
 
-use std::ffi::OsStr;
-
-use serde_json::Value;
-
 /// Both routes take every ball through both levels with no background shown and nothing drawn
 /// where no level is, change each pixel one way only (flicker 1 against the fine level, within
 /// 10 %), and pop at most a quarter of switching at once (measured on lavapipe: 0.054 and 0.052
@@ -17,28 +13,9 @@ use serde_json::Value;
 /// frame, one ball of three; at least 0.2). No wgpu validation error is logged.
 #[test]
 fn a_material_of_the_apps_own_transitions_without_a_pop() {
-    let folder = tempfile::Builder::new()
-        .prefix("lodkit-bevy-custom-material-")
-        .tempdir()
-        .expect("a temporary folder");
-    let report = folder.path().join("report.json");
-    let args = [
-        OsStr::new("--out"),
-        folder.path().as_os_str(),
-        OsStr::new("--report"),
-        report.as_os_str(),
-    ];
-    let Some(output) = support::run_example("custom_material", &args) else {
+    let Some(r) = support::example_report("custom_material") else {
         return;
     };
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "custom_material failed: {stderr}");
-    assert!(
-        !stderr.contains("Validation Error") && !stderr.contains("wgpu error"),
-        "{stderr}"
-    );
-    let r: Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).expect("the report")).unwrap();
     let hard = r["hard_switch"]["pop"].as_f64().unwrap();
     assert!(hard >= 0.2, "the hard switch pops: {r}");
     for name in ["frame_sequential", "dither"] {

@@ -4,10 +4,6 @@
 
 mod support;
 
-use std::ffi::OsStr;
-
-use serde_json::Value;
-
 /// The file's two spheres become one group each, with both levels and the switch distance the
 /// file's coverage was written for (view-normalized 3.0, hidden beyond 100: the example writes
 /// `π R² / (4 aspect d²)`, the plugin reads `R sqrt(π / (4 aspect c))`); the camera walking away
@@ -16,27 +12,9 @@ use serde_json::Value;
 /// loads as its finest levels only and the groups are missing.
 #[test]
 fn a_gltf_file_with_msft_lod_becomes_lod_groups() {
-    let folder = tempfile::Builder::new()
-        .prefix("lodkit-bevy-gltf-")
-        .tempdir()
-        .expect("a temporary folder");
-    let report = folder.path().join("report.json");
-    let args = [
-        OsStr::new("--out"),
-        folder.path().as_os_str(),
-        OsStr::new("--report"),
-        report.as_os_str(),
-    ];
-    let Some(output) = support::run_example("gltf_lod", &args) else {
+    let Some(r) = support::example_report("gltf_lod") else {
         return;
     };
-    assert!(
-        output.status.success(),
-        "gltf_lod failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let r: Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).expect("the report")).unwrap();
     let switch = r["intended_switch"].as_f64().unwrap();
     let groups = r["groups"].as_array().expect("groups");
     assert_eq!(groups.len(), 2, "one group per sphere: {r}");

@@ -4,10 +4,6 @@
 
 mod support;
 
-use std::ffi::OsStr;
-
-use serde_json::Value;
-
 /// Every object with levels becomes a group (the tree's two primitives two groups with one set
 /// of distances), each walks through its levels to its last, none shows the background or an
 /// object where no level is, and the transitions pop no more than Bevy's own crossfade's over
@@ -15,28 +11,9 @@ use serde_json::Value;
 /// No wgpu validation error is logged.
 #[test]
 fn a_lodkit_lod_scene_transitions_without_a_pop_or_a_hole_under_msaa() {
-    let folder = tempfile::Builder::new()
-        .prefix("lodkit-bevy-gltf-scene-")
-        .tempdir()
-        .expect("a temporary folder");
-    let report = folder.path().join("report.json");
-    let args = [
-        OsStr::new("--out"),
-        folder.path().as_os_str(),
-        OsStr::new("--report"),
-        report.as_os_str(),
-    ];
-    let Some(output) = support::run_example("gltf_scene", &args) else {
+    let Some(r) = support::example_report("gltf_scene") else {
         return;
     };
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "gltf_scene failed: {stderr}");
-    assert!(
-        !stderr.contains("Validation Error") && !stderr.contains("wgpu error"),
-        "{stderr}"
-    );
-    let r: Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).expect("the report")).unwrap();
     let groups = r["groups"].as_array().expect("groups");
     let names: Vec<&str> = groups.iter().map(|g| g["name"].as_str().unwrap()).collect();
     assert_eq!(

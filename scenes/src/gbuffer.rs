@@ -221,7 +221,7 @@ impl GBufferRenderer {
         const CALL: &str = "GBufferRenderer::render";
         same_color_format(CALL, "target", target.color_format(), self.color_format)?;
         self.draws.check_count(CALL, items.len())?;
-        gpu.guarded(CALL, || {
+        gpu.recording(CALL, || {
             let camera = GCameraUniform {
                 view_proj: (proj * view).to_cols_array_2d(),
                 view: view.to_cols_array_2d(),

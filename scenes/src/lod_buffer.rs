@@ -334,7 +334,7 @@ impl LodBufferRenderer {
         const CALL: &str = "LodBufferRenderer::render";
         same_color_format(CALL, "buffers", buffers.color_format(), self.color_format)?;
         self.draws.check_count(CALL, items.len())?;
-        gpu.guarded(CALL, || {
+        gpu.recording(CALL, || {
             let camera = LodCameraUniform {
                 view_proj: view.view_proj.to_cols_array_2d(),
                 prev_view_proj: view.prev_view_proj.to_cols_array_2d(),

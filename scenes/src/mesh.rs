@@ -398,7 +398,7 @@ impl MeshRenderer {
         } = *frame;
         const CALL: &str = "MeshRenderer::render";
         self.draws.check_count(CALL, items.len())?;
-        gpu.guarded(CALL, || {
+        gpu.recording(CALL, || {
             let camera = CameraUniform {
                 view_proj: view_proj.to_cols_array_2d(),
                 light_dir: light_dir.extend(0.0).to_array(),

@@ -165,7 +165,7 @@ impl TransitionScene {
             b: 0.05,
             a: 1.0,
         };
-        gpu.guarded("TransitionScene::render", || {
+        gpu.recording("TransitionScene::render", || {
             renderer.render(
                 gpu,
                 &self.target,

@@ -32,6 +32,29 @@ pub struct GpuOptions {
     pub limits: Option<wgpu::Limits>,
 }
 
+/// Options for [`GpuContext::from_parts_with`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct GpuContextDescriptor {
+    /// Whose handlers the device keeps (default [`DeviceHandlers::Keep`]: the engine's).
+    pub handlers: DeviceHandlers,
+}
+
+/// Whose uncaptured-error handler and device-lost callback a device has:
+/// [`GpuContextDescriptor::handlers`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DeviceHandlers {
+    /// The engine's, left as they are (the default over an engine's device). Errors outside
+    /// lodkit's calls and the device's loss reach them; lodkit reports neither as
+    /// [`GpuError::Uncaptured`] or a recorded loss.
+    #[default]
+    Keep,
+    /// lodkit's (what [`GpuContext::new_headless`] installs): an uncaptured-error handler that
+    /// records errors instead of panicking, reported by the next lodkit call as
+    /// [`GpuError::Uncaptured`], and a device-lost callback whose loss every later call reports
+    /// as [`GpuError::DeviceLost`]. They replace any the engine set.
+    Install,
+}
+
 /// A device and queue with the adapter they came from, and what lodkit learned about the device:
 /// errors wgpu raised outside lodkit's calls, and whether the device is lost.
 #[derive(Debug)]
@@ -157,7 +180,16 @@ impl GpuContext {
                     adapter: adapter.get_info().name,
                     source,
                 })?;
-            return Ok(Self::from_parts(instance, adapter, device, queue));
+            let descriptor = GpuContextDescriptor {
+                handlers: DeviceHandlers::Install,
+            };
+            return Ok(Self::from_parts_with(
+                instance,
+                adapter,
+                device,
+                queue,
+                &descriptor,
+            ));
         }
         let tried = backends
             .iter()
@@ -167,32 +199,52 @@ impl GpuContext {
         Err(GpuError::NoAdapter { tried })
     }
 
-    /// A context over a device the engine already has. It installs lodkit's uncaptured-error
-    /// handler (it records errors instead of panicking; [`check`](Self::check) and every lodkit
-    /// call report them) and a device-lost callback, replacing any the engine had set: an engine
-    /// that keeps its own handler can set it again afterwards, and lodkit's calls still catch
-    /// their own errors with error scopes.
+    /// A context over a device the engine already has, leaving the engine's uncaptured-error
+    /// handler and device-lost callback in place: lodkit's calls catch their own errors with
+    /// error scopes; errors outside them and the device's loss go to the engine's handlers, and
+    /// lodkit names a lost device when a call's work fails on it. Same as
+    /// [`from_parts_with`](Self::from_parts_with) with the default [`GpuContextDescriptor`].
     pub fn from_parts(
         instance: wgpu::Instance,
         adapter: wgpu::Adapter,
         device: wgpu::Device,
         queue: wgpu::Queue,
     ) -> Self {
+        Self::from_parts_with(
+            instance,
+            adapter,
+            device,
+            queue,
+            &GpuContextDescriptor::default(),
+        )
+    }
+
+    /// A context over a device the engine already has, with the device handlers
+    /// `descriptor` asks for ([`DeviceHandlers`]).
+    pub fn from_parts_with(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        descriptor: &GpuContextDescriptor,
+    ) -> Self {
         let state = Arc::new(DeviceState::default());
-        let recorder = Arc::clone(&state);
-        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
-            recorder.record_error(error.to_string());
-        }));
+        if descriptor.handlers == DeviceHandlers::Install {
+            let recorder = Arc::clone(&state);
+            device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+                recorder.record_error(error.to_string());
+            }));
+            let recorder = Arc::clone(&state);
+            device.set_device_lost_callback(move |reason, message| {
+                let message = if message.is_empty() {
+                    "no message".into()
+                } else {
+                    message
+                };
+                recorder.record_lost(format!("{reason:?}"), message);
+            });
+        }
         let gl = adapter.get_info().backend == wgpu::Backend::Gl;
-        let recorder = Arc::clone(&state);
-        device.set_device_lost_callback(move |reason, message| {
-            let message = if message.is_empty() {
-                "no message".into()
-            } else {
-                message
-            };
-            recorder.record_lost(format!("{reason:?}"), message);
-        });
         let capabilities = GpuCapabilities::of_adapter(&adapter);
         Self {
             instance,
@@ -236,15 +288,23 @@ impl GpuContext {
 
     /// `Ok` while the device is alive and no error was recorded outside lodkit's calls;
     /// otherwise [`GpuError::DeviceLost`], or [`GpuError::Uncaptured`] with the recorded errors
-    /// (which it clears). `call` names the caller in the error. Every lodkit call runs it first.
+    /// (which it clears). `call` names the caller in the error. It polls the device first (no
+    /// wait): wgpu notices a lost or destroyed device, and calls the lost callback, when it is
+    /// polled or a submission is made. An engine that wants a lost device named promptly calls it
+    /// once per frame; lodkit's recordings do not poll (see [`recording`](Self::recording)).
     pub fn check(&self, call: &'static str) -> Result<(), GpuError> {
         let _gate = self.gate();
-        // wgpu notices a destroyed device, and calls the lost callback, when it is polled. A
-        // device the driver lost makes wgpu 30's poll panic instead of returning an error; that
-        // panic is caught here and reported as a lost device.
+        // A device the driver lost makes wgpu 30's poll panic instead of returning an error;
+        // that panic is caught here and reported as a lost device.
         if self.poll(wgpu::PollType::Poll) == Polled::ContextTimeout {
             return Err(GpuError::ContextTimeout { call });
         }
+        self.recorded(call)
+    }
+
+    /// What the device callbacks recorded, without polling: [`check`](Self::check) less the
+    /// poll.
+    fn recorded(&self, call: &'static str) -> Result<(), GpuError> {
         if let Some((reason, message)) = self.state.lost() {
             return Err(GpuError::DeviceLost {
                 call,
@@ -259,32 +319,63 @@ impl GpuContext {
         }
     }
 
-    /// Runs `f` (device work of lodkit call `call`) inside out-of-memory, validation and internal
-    /// error scopes, after and before [`check`](Self::check): the first error wgpu raised during
-    /// `f` comes back as this call's error instead of reaching the uncaptured-error handler.
+    /// Runs `f` (device work of lodkit call `call`: creating or resizing resources, reading
+    /// back) inside out-of-memory, validation and internal error scopes: the first error wgpu
+    /// raised during `f` comes back as this call's error instead of reaching the
+    /// uncaptured-error handler. Before `f` it [`check`](Self::check)s the device (one poll, no
+    /// wait: a device destroyed or lost since is named here, as work on it would otherwise
+    /// succeed silently); after, what the device callbacks recorded is this call's error.
+    /// Per-frame recordings go through [`recording`](Self::recording), which does not poll.
     ///
     /// Inside another guarded call on the same thread it only runs `f`: the outermost call, the
-    /// one the engine made, checks the device and names the error. An application's own passes
-    /// can record through it to get lodkit's error handling (and its host cost, which is what
-    /// the demo's baselines do to be timed fairly against lodkit's passes).
+    /// one the engine made, names the error.
     pub fn guarded<T>(
         &self,
         call: &'static str,
+        f: impl FnOnce() -> Result<T, GpuError>,
+    ) -> Result<T, GpuError> {
+        self.scoped(call, true, f)
+    }
+
+    /// [`guarded`](Self::guarded) for a recording into the engine's encoder, at the cost of the
+    /// error scopes and nothing more: no device poll and no wait. On native wgpu a scope's
+    /// result is ready when it is popped and is read there (a pending one, the browser's WebGPU,
+    /// is waited for). A lost device is noticed when wgpu notices it, at the engine's next
+    /// submission or poll (or [`check`](Self::check)), and named by the next lodkit call. An
+    /// application's own passes can record through it to get lodkit's error handling and its
+    /// host cost (the demo's baselines do, to be timed fairly against lodkit's passes).
+    pub fn recording<T>(
+        &self,
+        call: &'static str,
+        f: impl FnOnce() -> Result<T, GpuError>,
+    ) -> Result<T, GpuError> {
+        self.scoped(call, false, f)
+    }
+
+    /// [`guarded`](Self::guarded), polling first or not.
+    fn scoped<T>(
+        &self,
+        call: &'static str,
+        poll: bool,
         f: impl FnOnce() -> Result<T, GpuError>,
     ) -> Result<T, GpuError> {
         let Some(_outermost) = Outermost::enter() else {
             return f();
         };
         let _gate = self.gate();
-        self.check(call)?;
+        if poll {
+            self.check(call)?;
+        } else {
+            self.recorded(call)?;
+        }
         let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
         let value = f();
         let popped = [internal.pop(), validation.pop(), out_of_memory.pop()];
-        let caught = popped.into_iter().find_map(pollster::block_on);
+        let caught = popped.into_iter().find_map(ready_or_wait);
         let value = value?;
-        self.check(call)?;
+        self.recorded(call)?;
         match caught {
             Some(error) => Err(GpuError::from_wgpu(call, error)),
             None => Ok(value),
@@ -383,6 +474,17 @@ impl GpuContext {
             }
         }
         self.check(CALL)
+    }
+}
+
+/// A future's output: at once where it is ready (native wgpu's error scopes are), else waited
+/// for.
+fn ready_or_wait<F: std::future::Future>(future: F) -> F::Output {
+    let mut future = std::pin::pin!(future);
+    let mut context = std::task::Context::from_waker(std::task::Waker::noop());
+    match future.as_mut().poll(&mut context) {
+        std::task::Poll::Ready(output) => output,
+        std::task::Poll::Pending => pollster::block_on(future),
     }
 }
 

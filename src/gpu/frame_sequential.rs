@@ -7,6 +7,7 @@
 //! [`new_to_old_matrix`](crate::reproject::new_to_old_matrix) to write the final image into its
 //! own target.
 
+mod combine_bindings;
 mod combine_pass;
 
 pub use combine_pass::{

@@ -19,5 +19,5 @@ pub mod select;
 pub mod unpopping;
 
 pub use capabilities::{GlVersion, GpuCapabilities};
-pub use context::{GpuContext, GpuOptions};
+pub use context::{DeviceHandlers, GpuContext, GpuContextDescriptor, GpuOptions};
 pub use error::GpuError;

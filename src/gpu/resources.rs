@@ -6,8 +6,10 @@
 use super::checks::{buffer_size, check_format_usages, target_extent, texture_extent};
 use super::{GpuContext, GpuError};
 
+mod bind_cache;
 mod draw_uniforms;
 mod params;
+pub(crate) use bind_cache::BindGroupCache;
 pub use draw_uniforms::DrawUniforms;
 pub use params::RecordedUniform;
 

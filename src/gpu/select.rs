@@ -417,7 +417,7 @@ impl GpuLodSelector {
             cull: frame.view_proj.is_some() as u32,
         };
         let max_dim = gpu.device.limits().max_compute_workgroups_per_dimension;
-        gpu.guarded(CALL, || {
+        gpu.recording(CALL, || {
             gpu.queue
                 .write_buffer(&v.camera, 0, bytemuck::bytes_of(&uniform));
             if let Some(template) = &self.template {

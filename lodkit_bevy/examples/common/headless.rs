@@ -5,6 +5,8 @@
 use std::path::Path;
 
 use bevy::asset::RenderAssetUsages;
+use bevy::camera::RenderTarget;
+use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
 use bevy::render::RenderPlugin;
 use bevy::render::gpu_readback::{Readback, ReadbackComplete};
@@ -41,6 +43,43 @@ pub fn start_readback(world: &mut World, target: &Handle<Image>) -> Entity {
 /// Where the last screenshot's image lands (filled by the screenshot observer).
 #[derive(Resource, Default)]
 struct ScreenshotInbox(Option<Image>);
+
+/// Ends a run read back since [`start_readback`]: waits (a few updates at most) until `frames`
+/// frames of `width` x `height` came back, despawns the readback and the run's `entities`, lets
+/// the last readbacks in flight land and empties the inbox for the next run. Returns the
+/// frames, or how many came back.
+pub fn finish_readback(
+    app: &mut App,
+    readback: Entity,
+    entities: &[Entity],
+    frames: usize,
+    (width, height): (u32, u32),
+) -> Result<Vec<Frame>, String> {
+    for _ in 0..12 {
+        if app.world().resource::<FrameInbox>().0.len() >= frames {
+            break;
+        }
+        step(app);
+    }
+    let world = app.world_mut();
+    world.despawn(readback);
+    for &entity in entities {
+        world.despawn(entity);
+    }
+    let data = std::mem::take(&mut world.resource_mut::<FrameInbox>().0);
+    if data.len() < frames {
+        return Err(format!("{} of {frames} frames came back", data.len()));
+    }
+    for _ in 0..4 {
+        step(app);
+    }
+    app.world_mut().resource_mut::<FrameInbox>().0.clear();
+    Ok(data
+        .into_iter()
+        .take(frames)
+        .map(|rgba| Frame::new(width, height, rgba))
+        .collect())
+}
 
 /// A headless app with `plugins` added: no window, no runner, shaders compiled synchronously so
 /// the first frames draw.
@@ -82,6 +121,23 @@ pub fn build_app_with_assets(assets: Option<&Path>, plugins: impl FnOnce(&mut Ap
     app.finish();
     app.cleanup();
     app
+}
+
+/// A harness camera drawing into `target`: Bevy's defaults (MSAA `Sample4` included) except
+/// the clear colour, `background`, and no tonemapping or deband dither, so the background is
+/// that colour exactly (the figures count the other pixels).
+pub fn harness_camera(target: &Handle<Image>, background: Color, at: Transform) -> impl Bundle {
+    (
+        Camera3d::default(),
+        Camera {
+            clear_color: ClearColorConfig::Custom(background),
+            ..default()
+        },
+        RenderTarget::from(target.clone()),
+        Tonemapping::None,
+        DebandDither::Disabled,
+        at,
+    )
 }
 
 /// An sRGB image a camera can render into, `width` x `height`.

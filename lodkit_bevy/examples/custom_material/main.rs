@@ -39,8 +39,6 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use bevy::asset::uuid_handle;
-use bevy::camera::RenderTarget;
-use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
 use bevy::render::render_resource::AsBindGroup;
 use bevy::shader::ShaderRef;
@@ -53,7 +51,9 @@ use lodkit_bevy::frame_sequential::{
 use serde_json::{Value, json};
 
 use frames::{Frame, strip};
-use headless::{FrameInbox, build_app, render_target, save_png, start_readback, step};
+use headless::{
+    build_app, finish_readback, harness_camera, render_target, save_png, start_readback, step,
+};
 
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 180;
@@ -143,17 +143,7 @@ fn run(
 ) -> Result<Run, String> {
     let world = app.world_mut();
     let target = render_target(world, WIDTH, HEIGHT);
-    let mut camera = world.spawn((
-        Camera3d::default(),
-        Camera {
-            clear_color: ClearColorConfig::Custom(BACKGROUND),
-            ..default()
-        },
-        RenderTarget::from(target.clone()),
-        Tonemapping::None,
-        DebandDither::Disabled,
-        camera_pose(),
-    ));
+    let mut camera = world.spawn(harness_camera(&target, BACKGROUND, camera_pose()));
     let mut lod = FrameSequentialLod::default();
     lod.settings.bias = biases[0];
     match technique {
@@ -224,36 +214,10 @@ fn run(
             }
         }
     }
-    for _ in 0..12 {
-        if app.world().resource::<FrameInbox>().0.len() >= biases.len() {
-            break;
-        }
-        step(app);
-    }
-    let world = app.world_mut();
-    world.despawn(readback);
-    world.despawn(camera);
-    for ball in balls {
-        world.despawn(ball);
-    }
-    let data = std::mem::take(&mut world.resource_mut::<FrameInbox>().0);
-    if data.len() < biases.len() {
-        return Err(format!(
-            "{} of {} frames came back",
-            data.len(),
-            biases.len()
-        ));
-    }
-    for _ in 0..4 {
-        step(app);
-    }
-    app.world_mut().resource_mut::<FrameInbox>().0.clear();
+    let entities: Vec<Entity> = std::iter::once(camera).chain(balls).collect();
+    let frames = finish_readback(app, readback, &entities, biases.len(), (WIDTH, HEIGHT))?;
     Ok(Run {
-        frames: data
-            .into_iter()
-            .take(biases.len())
-            .map(|rgba| Frame::new(WIDTH, HEIGHT, rgba))
-            .collect(),
+        frames,
         in_transition,
         drawn,
     })

@@ -33,8 +33,6 @@ mod scene;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use bevy::camera::RenderTarget;
-use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use lodkit_bevy::FrameSequentialLodPlugin;
@@ -110,17 +108,9 @@ fn run(out: &Path, report: Option<&Path>, gltf: Option<&Path>) -> Result<(), (u8
     let target = headless::render_target(world, WIDTH, HEIGHT);
     // An app's camera: Bevy's default MSAA is left as it is.
     let camera = world
-        .spawn((
-            Camera3d::default(),
-            Camera {
-                clear_color: ClearColorConfig::Custom(BACKGROUND),
-                ..default()
-            },
-            RenderTarget::from(target.clone()),
-            // No tonemapping or deband dither, so the background is the clear color exactly
-            // (the figure counts the other pixels).
-            Tonemapping::None,
-            DebandDither::Disabled,
+        .spawn(headless::harness_camera(
+            &target,
+            BACKGROUND,
             Transform::default(),
         ))
         .id();

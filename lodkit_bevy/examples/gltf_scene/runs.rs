@@ -4,9 +4,7 @@
 
 use std::path::Path;
 
-use bevy::camera::RenderTarget;
 use bevy::camera::visibility::VisibilityRange;
-use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::prelude::*;
 use lodkit_bevy::frame_sequential::{
     FrameSequentialDefaultCamera, FrameSequentialGroup, FrameSequentialLevels, FrameSequentialLod,
@@ -14,7 +12,9 @@ use lodkit_bevy::frame_sequential::{
 };
 
 use crate::frames::Frame;
-use crate::headless::{FrameInbox, build_app_with_assets, render_target, start_readback, step};
+use crate::headless::{
+    build_app_with_assets, finish_readback, harness_camera, render_target, start_readback, step,
+};
 
 pub const WIDTH: u32 = 320;
 /// The height `lodkit lod` made the committed file's switch distances for.
@@ -22,8 +22,6 @@ pub const HEIGHT: u32 = 180;
 pub const BACKGROUND: Color = Color::srgb_u8(20, 23, 31);
 /// Updates at the first pose before a run is recorded (materials and view resources ready).
 const WARMUP_UPDATES: usize = 3;
-/// Updates to wait for the last readbacks of a run.
-const DRAIN_UPDATES: usize = 12;
 
 /// A failure with its exit code.
 pub struct Failure(pub u8, pub String);
@@ -187,17 +185,7 @@ impl Scene {
         let world = self.app.world_mut();
         // An app's camera: Bevy's default MSAA (Sample4) is left as it is; no tonemapping or
         // deband dither, so the background is the clear colour exactly.
-        let camera = world.spawn((
-            Camera3d::default(),
-            Camera {
-                clear_color: ClearColorConfig::Custom(BACKGROUND),
-                ..default()
-            },
-            RenderTarget::from(self.target.clone()),
-            Tonemapping::None,
-            DebandDither::Disabled,
-            poses[0],
-        ));
+        let camera = world.spawn(harness_camera(&self.target, BACKGROUND, poses[0]));
         let camera = camera.id();
         // The app's camera has no lodkit component: with groups about and no camera selecting,
         // the plugin gives it `FrameSequentialLod::default()`. The other runs' cameras are the
@@ -259,37 +247,15 @@ impl Scene {
                 }
             }
         }
-        for _ in 0..DRAIN_UPDATES {
-            if self.app.world().resource::<FrameInbox>().0.len() >= poses.len() {
-                break;
-            }
-            step(&mut self.app);
-        }
-        let world = self.app.world_mut();
-        world.despawn(readback);
-        world.despawn(camera);
-        for copy in copies {
-            world.despawn(copy);
-        }
-        let data = std::mem::take(&mut world.resource_mut::<FrameInbox>().0);
-        if data.len() < poses.len() {
-            return Err(Failure(
-                1,
-                format!("{} of {} frames came back", data.len(), poses.len()),
-            ));
-        }
-        // Let the last frames' readbacks come in before the next run.
-        for _ in 0..4 {
-            step(&mut self.app);
-        }
-        self.app.world_mut().resource_mut::<FrameInbox>().0.clear();
-        Ok(Run {
-            frames: data
-                .into_iter()
-                .take(poses.len())
-                .map(|rgba| Frame::new(WIDTH, HEIGHT, rgba))
-                .collect(),
-            drawn,
-        })
+        let entities: Vec<Entity> = std::iter::once(camera).chain(copies).collect();
+        let frames = finish_readback(
+            &mut self.app,
+            readback,
+            &entities,
+            poses.len(),
+            (WIDTH, HEIGHT),
+        )
+        .map_err(|e| Failure(1, e))?;
+        Ok(Run { frames, drawn })
     }
 }

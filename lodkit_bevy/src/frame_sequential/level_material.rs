@@ -25,7 +25,7 @@ pub type FrameSequentialLevel<M> = ExtendedMaterial<M, FrameSequentialBindings>;
 
 /// Lets levels use a material of the app's own, `M`: [`LevelMaterial::custom`] takes an
 /// `M` handle as it is, as a `StandardMaterial` handle is taken ([`LevelMaterial`]), and
-/// [`AutoLod`](crate::auto_lod::AutoLod) takes an entity's `MeshMaterial3d<M>`.
+/// `AutoLod` takes an entity's `MeshMaterial3d<M>`.
 ///
 /// `M`'s fragment shader (a WESL file) makes its output a level's with one call:
 ///
@@ -72,7 +72,7 @@ where
 }
 
 /// Registers `B` as a base of derived level materials `ExtendedMaterial<B, E>`: the
-/// derivation, the drawers' material of that type, and [`AutoLod`](crate::auto_lod::AutoLod)'s
+/// derivation, the drawers' material of that type, and `AutoLod`'s
 /// taking of `MeshMaterial3d<B>`.
 pub(super) fn add_level_material<B, E>(app: &mut App)
 where
@@ -301,7 +301,7 @@ pub(super) fn apply_drawer_materials<T: Material>(
 type TakeMaterial = fn(&mut EntityWorldMut) -> Option<LevelMaterial>;
 
 /// For each material type levels may use, how to take an entity's `MeshMaterial3d` of it
-/// ([`AutoLod`](crate::auto_lod::AutoLod)): `StandardMaterial` first, then each type with a
+/// (`AutoLod`): `StandardMaterial` first, then each type with a
 /// [`FrameSequentialMaterialPlugin`].
 #[derive(Resource)]
 pub(crate) struct LevelMaterialTakers(pub(crate) Vec<TakeMaterial>);
@@ -328,8 +328,9 @@ impl LevelMaterialTakers {
 mod tests {
     use bevy::asset::AssetPlugin;
 
-    use super::*;
-    use crate::frame_sequential::{FrameSequentialExtension, LodLevel};
+    use crate::frame_sequential::level_material::*;
+    use crate::frame_sequential::levels::LodLevel;
+    use crate::frame_sequential::material::FrameSequentialExtension;
 
     /// A material of an app's own (its shader is not compiled here).
     #[derive(Asset, TypePath, AsBindGroup, Clone, Debug)]

@@ -48,6 +48,33 @@ pub fn run_example(name: &str, args: &[&OsStr]) -> Option<Output> {
     Some(output)
 }
 
+/// Runs example `name` with `--out DIR --report DIR/report.json` in a temporary folder, and
+/// returns its report (None where the GPU test is skipped, as [`run_example`] says). Fails the
+/// test where the example fails or logs a wgpu validation error.
+#[allow(dead_code, reason = "not every test reads a report")]
+pub fn example_report(name: &str) -> Option<serde_json::Value> {
+    let folder = tempfile::Builder::new()
+        .prefix(&format!("lodkit-bevy-{name}-"))
+        .tempdir()
+        .expect("a temporary folder");
+    let report = folder.path().join("report.json");
+    let args = [
+        OsStr::new("--out"),
+        folder.path().as_os_str(),
+        OsStr::new("--report"),
+        report.as_os_str(),
+    ];
+    let output = run_example(name, &args)?;
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{name} failed: {stderr}");
+    assert!(
+        !stderr.contains("Validation Error") && !stderr.contains("wgpu error"),
+        "{stderr}"
+    );
+    let text = std::fs::read_to_string(&report).expect("the report");
+    Some(serde_json::from_str(&text).expect("the report is JSON"))
+}
+
 /// The newest modification time of the files the example at `path` is built from, as cargo's
 /// dep-info file beside it (`<name>.d`) lists them: the same files that make cargo rebuild it,
 /// so a test-only module edited since does not count. Without that file: everything under

@@ -2,9 +2,9 @@
 //! and recorded with a [`CombineFrame`].
 
 use glam::Mat4;
-use wgpu::util::DeviceExt;
 
 use super::LodBuffers;
+use super::combine_bindings::CombineBindings;
 use crate::combine::{DepthConvention, ScreenRect, merge_rects};
 use crate::combine_coverage::{COMBINE_ANCHORED, COMBINE_LEVEL_DEPTH, CombineData, combine_object};
 use crate::gpu::checks::{check_color_format, has_usage, texture_matches};
@@ -120,7 +120,10 @@ pub struct CombineFrame<'a> {
 /// `combine_at_moved`; buffers without one ([`LodBuffers::without_motion`]) with `combine_at`
 /// (`LODKIT_COMBINE_STILL`), which reads no motion and whose 3x3 search the driver's compiler
 /// removes (the motion is a constant 0). Each recording carries its own parameters
-/// ([`RecordedUniform`]): several recordings in one encoder each read their own.
+/// ([`RecordedUniform`]) and [`CombineData`], copied in the encoder: several recordings in one
+/// encoder each read their own. A recording creates no texture or buffer once the pass has
+/// seen a frame's data that tall, and no bind group while the textures it binds are those of
+/// an earlier recording (it keeps the last six bind groups, and with them their textures).
 #[derive(Debug)]
 pub struct CombinePass {
     pipeline: wgpu::RenderPipeline,
@@ -135,6 +138,10 @@ pub struct CombinePass {
     /// 1x1: bound at the data and level depth bindings when they are not read.
     unused_data: wgpu::Texture,
     unused_depth: wgpu::Texture,
+    /// A view of `still`: bound at the pattern binding when it is not read.
+    still_view: wgpu::TextureView,
+    /// The data texture and the bind groups, kept between recordings.
+    bindings: CombineBindings,
     target_format: wgpu::TextureFormat,
 }
 
@@ -172,19 +179,21 @@ impl CombinePass {
                     "lodkit combine",
                 )
             };
+            let still = texture_2d(
+                gpu,
+                (1, 1),
+                MOTION_FORMAT,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+                "combine: no object motion",
+            )?;
             Ok(Self {
                 pipeline: pipeline(None)?,
                 still_pipeline: pipeline(Some("LODKIT_COMBINE_STILL"))?,
                 known_pipeline: pipeline(Some("LODKIT_COMBINE_KNOWN"))?,
                 layout: group,
                 params: RecordedUniform::new(gpu, size, "combine params")?,
-                still: texture_2d(
-                    gpu,
-                    (1, 1),
-                    MOTION_FORMAT,
-                    wgpu::TextureUsages::TEXTURE_BINDING,
-                    "combine: no object motion",
-                )?,
+                still_view: still.create_view(&Default::default()),
+                still,
                 unused_data: texture_2d(
                     gpu,
                     (1, 1),
@@ -199,6 +208,7 @@ impl CombinePass {
                     wgpu::TextureUsages::TEXTURE_BINDING,
                     "combine: no older-level depth pass",
                 )?,
+                bindings: CombineBindings::new(gpu),
                 target_format,
             })
         })
@@ -287,7 +297,7 @@ impl CombinePass {
             })
             .collect();
         let merged = merge_rects(&clipped);
-        gpu.guarded(CALL, || {
+        gpu.recording(CALL, || {
             encoder.copy_texture_to_texture(
                 buffers.color(frame.newer).as_image_copy(),
                 target.texture().as_image_copy(),
@@ -370,7 +380,7 @@ impl CombinePass {
         rects: Option<&[ScreenRect]>,
     ) -> Result<(), GpuError> {
         let (buffers, newer) = (frame.buffers, frame.newer);
-        gpu.guarded("CombinePass::record", || {
+        gpu.recording("CombinePass::record", || {
             let params = CombineParams {
                 new_to_old: frame.new_to_old.to_cols_array_2d(),
             };
@@ -383,27 +393,9 @@ impl CombinePass {
                 } => (Some((data, level_depth)), pattern),
                 CombineCoverage::Estimated => (None, None),
             };
-            let data = known.map(|(data, _)| {
-                gpu.device.create_texture_with_data(
-                    &gpu.queue,
-                    &wgpu::TextureDescriptor {
-                        label: Some("lodkit combine data"),
-                        size: wgpu::Extent3d {
-                            width: data.width,
-                            height: data.height,
-                            depth_or_array_layers: 1,
-                        },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: wgpu::TextureFormat::Rgba32Uint,
-                        usage: wgpu::TextureUsages::TEXTURE_BINDING,
-                        view_formats: &[],
-                    },
-                    wgpu::util::TextureDataOrder::LayerMajor,
-                    bytemuck::cast_slice(&data.texels),
-                )
-            });
+            let data = known
+                .map(|(data, _)| self.bindings.upload(gpu, encoder, data))
+                .transpose()?;
             let level_depth = known.and_then(|(_, depth)| depth);
             let textures = [
                 buffers.color(newer),
@@ -416,33 +408,11 @@ impl CombinePass {
                 data.as_ref().unwrap_or(&self.unused_data),
                 level_depth.unwrap_or(&self.unused_depth),
             ];
-            let mut views: Vec<wgpu::TextureView> = textures
-                .iter()
-                .map(|t| t.create_view(&Default::default()))
-                .collect();
             // Not read where no older level is displayed at an older_tau: the 1x1 zero motion.
-            views.push(
-                pattern
-                    .cloned()
-                    .unwrap_or_else(|| self.still.create_view(&Default::default())),
-            );
-            let entries: Vec<wgpu::BindGroupEntry> = views
-                .iter()
-                .zip([0, 1, 2, 3, 4, 5, 6, 8, 9, 10])
-                .map(|(view, binding)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: wgpu::BindingResource::TextureView(view),
-                })
-                .chain(std::iter::once(wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: self.params.buffer().as_entire_binding(),
-                }))
-                .collect();
-            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("lodkit combine"),
-                layout: &self.layout,
-                entries: &entries,
-            });
+            let pattern = pattern.unwrap_or(&self.still_view);
+            let bind_group =
+                self.bindings
+                    .group(gpu, &self.layout, self.params.buffer(), textures, pattern)?;
             let label = "lodkit combine";
             let mut pass = match rects {
                 None => begin_color_pass(encoder, frame.target, wgpu::Color::BLACK, label),

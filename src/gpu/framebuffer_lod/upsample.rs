@@ -6,7 +6,7 @@ use super::LowResBuffer;
 use crate::gbuffer::GEOMETRY_FORMAT;
 use crate::gpu::checks::{check_color_format, texture_matches};
 use crate::gpu::resources::{
-    RecordedUniform, begin_color_pass, fullscreen_pipeline, textures_and_uniform,
+    BindGroupCache, RecordedUniform, begin_color_pass, fullscreen_pipeline, textures_and_uniform,
 };
 use crate::gpu::{GpuContext, GpuError};
 
@@ -140,13 +140,19 @@ pub struct UpsampleFrame<'a> {
 /// The upsample pass (`passes/upsample.wgsl`): full-resolution color from L and a full-resolution
 /// depth/normal prepass, eq. 1 (with [`RangeSigmas::OFF`], bilinear). Its parameters are written
 /// into the encoder with each recording, so one encoder may hold any number of recordings, each
-/// with its own parameters.
+/// with its own parameters. A recording creates no bind group while the textures it binds are
+/// those of one of the last four recordings (it keeps their bind groups, and with them the
+/// textures).
 #[derive(Debug)]
 pub struct UpsamplePass {
     pipeline: wgpu::RenderPipeline,
     params: RecordedUniform,
+    groups: BindGroupCache,
     desc: UpsamplePassDescriptor,
 }
+
+/// Bind groups an [`UpsamplePass`] keeps: a few targets or L buffers in turn.
+const KEPT_GROUPS: usize = 4;
 
 impl UpsamplePass {
     /// Builds the pipeline. Errors: a target format the device cannot render to.
@@ -168,6 +174,7 @@ impl UpsamplePass {
             Ok(Self {
                 pipeline: fullscreen_pipeline(gpu, &module, desc.target_format, "lodkit upsample")?,
                 params: RecordedUniform::new(gpu, size, "upsample params")?,
+                groups: BindGroupCache::new(KEPT_GROUPS),
                 desc: *desc,
             })
         })
@@ -269,7 +276,7 @@ impl UpsamplePass {
             format,
             what,
         )?;
-        gpu.guarded(CALL, || {
+        gpu.recording(CALL, || {
             let (vw, vh) = low.viewport(frame.settings.r);
             let (w, h) = low.full_size();
             let params = UpsampleParams {
@@ -281,14 +288,11 @@ impl UpsamplePass {
                 pad: [0.0; 2],
             };
             self.params.write(encoder, &params)?;
-            let layout = self.pipeline.get_bind_group_layout(0);
-            let bind_group = textures_and_uniform(
-                gpu,
-                &layout,
-                &textures,
-                Some(self.params.buffer()),
-                "lodkit upsample",
-            )?;
+            let bind_group = self.groups.get_or_make(&textures, &[], || {
+                let layout = self.pipeline.get_bind_group_layout(0);
+                let uniform = Some(self.params.buffer());
+                textures_and_uniform(gpu, &layout, &textures, uniform, "lodkit upsample")
+            })?;
             let target = frame.target;
             let mut pass = begin_color_pass(encoder, target, wgpu::Color::BLACK, "lodkit upsample");
             pass.set_pipeline(&self.pipeline);

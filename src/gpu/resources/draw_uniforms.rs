@@ -87,7 +87,7 @@ impl DrawUniforms {
             slot[..size].copy_from_slice(bytemuck::bytes_of(item));
         }
         if !data.is_empty() {
-            gpu.guarded(CALL, || {
+            gpu.recording(CALL, || {
                 gpu.queue.write_buffer(&self.buffer, 0, &data);
                 Ok(())
             })?;

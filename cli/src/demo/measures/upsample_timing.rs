@@ -157,7 +157,7 @@ pub(crate) fn record_fullscreen(
     uniform: Option<(&wgpu::Buffer, &[u8])>,
     target: &wgpu::TextureView,
 ) -> Result<(), GpuError> {
-    gpu.guarded("baseline", || {
+    gpu.recording("baseline", || {
         if let Some((buffer, bytes)) = uniform {
             gpu.queue.write_buffer(buffer, 0, bytes);
         }
