@@ -2,6 +2,7 @@
 //! back as glTF with `MSFT_lod` (levels as nodes, screen coverages in `MSFT_screencoverage`), a
 //! table per mesh and an optional JSON report.
 
+mod compressed;
 mod read;
 mod write;
 

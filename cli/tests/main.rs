@@ -17,6 +17,7 @@ mod fast_path;
 mod gpu_report;
 mod impostor;
 mod lod;
+mod lod_compressed;
 mod npm_package;
 mod permutations;
 mod pipes;

@@ -8,6 +8,8 @@ use gltf::Semantic;
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
+use super::compressed;
+
 /// One triangle primitive, as a list of vertices and a triangle list.
 pub struct Primitive {
     /// Index of the primitive in its mesh.
@@ -34,7 +36,8 @@ pub struct MeshInput {
 
 /// Extensions a file may require that `lodkit lod` reads itself, which the gltf crate refuses
 /// when they are required: `KHR_mesh_quantization` (attributes as integers, normalized or not,
-/// which [`floats`] reads; what gltfpack writes by default).
+/// which [`floats`] reads; what gltfpack writes by default). `EXT_meshopt_compression`
+/// (`gltfpack -c`) is decoded on reading ([`compressed`]) and not written again.
 const READ_HERE: [&str; 1] = ["KHR_mesh_quantization"];
 
 /// A file as `lodkit lod` reads it.
@@ -53,6 +56,8 @@ pub fn open(path: &Path) -> Result<Opened, String> {
     let invalid = |e: gltf::Error| format!("not a valid glTF/GLB: {e}");
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(invalid)?;
     let mut root = gltf.document.into_json();
+    // Decoded here, and written without: the output neither uses nor requires it.
+    let taken = compressed::take(&mut root)?;
     let (required_here, other): (Vec<String>, Vec<String>) = root
         .extensions_required
         .drain(..)
@@ -61,8 +66,12 @@ pub fn open(path: &Path) -> Result<Opened, String> {
     // Validated here as `Gltf::from_slice` would have, without the extensions read above.
     let document = gltf::Document::from_json(root).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(base), gltf.blob)
-        .map_err(|e| format!("cannot load its buffers: {e}"))?;
+    let buffers = if taken.views.is_empty() {
+        gltf::import_buffers(&document, Some(base), gltf.blob)
+            .map_err(|e| format!("cannot load its buffers: {e}"))?
+    } else {
+        compressed::load_buffers(&document, base, gltf.blob, &taken)?
+    };
     Ok(Opened {
         document,
         buffers,
