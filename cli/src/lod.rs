@@ -3,6 +3,7 @@
 //! table per mesh and an optional JSON report.
 
 mod compressed;
+mod objects;
 mod read;
 mod write;
 
@@ -29,7 +30,11 @@ pub struct LodArgs {
     pub lock_border: bool,
     pub keep_small: bool,
     pub report: Option<PathBuf>,
+    /// Which meshes share their switch distances (an object switches as a whole).
+    pub grouping: objects::Grouping,
 }
+
+pub use objects::Grouping;
 
 /// One row of the table and the report.
 #[derive(serde::Serialize)]
@@ -49,7 +54,12 @@ struct LevelRow {
 struct MeshReport {
     mesh: usize,
     name: String,
+    /// The node whose meshes switch together with this one (its name), or the mesh itself.
+    object: String,
     radius: f32,
+    /// Half the diagonal of the box around the mesh (what its screen coverage measures).
+    #[serde(skip)]
+    box_radius: f32,
     /// View-normalized distance beyond which the mesh covers less than the pixel error.
     max_distance: f32,
     levels: Vec<LevelRow>,
@@ -125,7 +135,8 @@ pub fn run(args: &LodArgs) -> ExitCode {
     };
     let mut out = write::Output::new(document.clone(), &buffers);
     out.require(&required_here);
-    let mut reports = Vec::new();
+    // Every mesh's chain first: an object's meshes share their distances.
+    let mut planned = Vec::new();
     for mesh in document.meshes() {
         let name = mesh.name().unwrap_or("").to_owned();
         let label = format!("mesh {} '{name}'", mesh.index());
@@ -162,7 +173,35 @@ pub fn run(args: &LodArgs) -> ExitCode {
         for w in &warnings {
             output::eprintln(&format!("warning: {file}: {label}: {w}"));
         }
+        let report = MeshReport {
+            mesh: mesh.index(),
+            name,
+            warnings,
+            ..report
+        };
+        planned.push((input, chains, report));
+    }
+    let objects = objects::objects(&document, &args.grouping);
+    let own: Vec<Vec<f32>> = planned
+        .iter()
+        .map(|(_, _, r)| {
+            let switches = r.levels.iter().map(|l| l.switch_distance);
+            switches.chain(std::iter::once(r.max_distance)).collect()
+        })
+        .collect();
+    let shared = objects::shared(&objects, &own);
+    let mut reports = Vec::new();
+    for ((input, chains, mut report), (object, distances)) in
+        planned.into_iter().zip(objects.iter().zip(&shared))
+    {
+        report.object = object.name.clone();
+        report.max_distance = *distances.last().unwrap_or(&report.max_distance);
         let count = report.levels.len();
+        for (i, row) in report.levels.iter_mut().enumerate() {
+            row.switch_distance = distances[i];
+            let next = distances.get(i + 1).copied().unwrap_or(report.max_distance);
+            row.screen_coverage = coverage(report.box_radius, next, args.aspect);
+        }
         let levels: Vec<Vec<write::LevelPrimitive>> = (0..count)
             .map(|i| {
                 input
@@ -190,14 +229,9 @@ pub fn run(args: &LodArgs) -> ExitCode {
             .collect();
         if count > 1 {
             let coverages: Vec<f32> = report.levels.iter().map(|r| r.screen_coverage).collect();
-            out.add_levels(mesh.index(), &levels, &coverages);
+            out.add_levels(report.mesh, &levels, &coverages);
         }
-        reports.push(MeshReport {
-            mesh: mesh.index(),
-            name,
-            warnings,
-            ..report
-        });
+        reports.push(report);
     }
     if let Err(e) = out.write(&args.output) {
         return fail(2, e);
@@ -286,7 +320,9 @@ fn plan(
     Ok(MeshReport {
         mesh: 0,
         name: String::new(),
+        object: String::new(),
         radius,
+        box_radius,
         max_distance,
         levels,
         warnings: Vec::new(),
@@ -295,8 +331,8 @@ fn plan(
 
 fn table(r: &MeshReport) -> String {
     let mut s = format!(
-        "mesh {} '{}': radius {:.4}, hidden beyond {:.3} (view-normalized)\n",
-        r.mesh, r.name, r.radius, r.max_distance
+        "mesh {} '{}' (switching with {}): radius {:.4}, hidden beyond {:.3} (view-normalized)\n",
+        r.mesh, r.name, r.object, r.radius, r.max_distance
     );
     s.push_str("  level  triangles       error  switch distance  coverage     time\n");
     for l in &r.levels {

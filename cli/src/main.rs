@@ -222,6 +222,19 @@ enum Command {
         /// Also write the table as JSON.
         #[arg(long, value_name = "FILE")]
         report: Option<PathBuf>,
+        /// Give each mesh switch distances of its own (by default the meshes under one
+        /// top-level node share theirs: an object switches as a whole).
+        #[arg(long, conflicts_with_all = ["object", "one_object"])]
+        per_mesh: bool,
+        /// The whole file is one object: every mesh shares the distances (a file whose parts
+        /// are top-level nodes, such as Khronos's FlightHelmet).
+        #[arg(long, conflicts_with = "object")]
+        one_object: bool,
+        /// A node whose meshes switch together (repeatable): the meshes below it share their
+        /// distances, wherever it is in the tree (a file whose one root node holds several
+        /// objects names them).
+        #[arg(long, value_name = "NODE")]
+        object: Vec<String>,
     },
     /// Compose a shader and write it through one of naga's back ends (`--to wesl`: convert a
     /// naga_oil WGSL file to WESL instead).
@@ -421,6 +434,9 @@ fn main() -> ExitCode {
             lock_border,
             strict,
             report,
+            per_mesh,
+            one_object,
+            object,
         } => lod::run(&lod::LodArgs {
             input,
             output,
@@ -433,6 +449,11 @@ fn main() -> ExitCode {
             lock_border,
             keep_small: !strict,
             report,
+            grouping: match (per_mesh, one_object) {
+                (true, _) => lod::Grouping::PerMesh,
+                (false, true) => lod::Grouping::Whole,
+                (false, false) => lod::Grouping::Nodes(object),
+            },
         }),
         Command::Export {
             compose,
