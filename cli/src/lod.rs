@@ -135,6 +135,11 @@ pub fn run(args: &LodArgs) -> ExitCode {
     };
     let mut out = write::Output::new(document.clone(), &buffers);
     out.require(&required_here);
+    // Images beside the input go into the output's buffer: it is whole wherever it is written.
+    let base = args.input.parent().unwrap_or(Path::new("."));
+    for w in out.embed_images(base) {
+        output::eprintln(&format!("warning: {file}: {w}"));
+    }
     // Every mesh's chain first: an object's meshes share their distances.
     let mut planned = Vec::new();
     for mesh in document.meshes() {
@@ -181,7 +186,10 @@ pub fn run(args: &LodArgs) -> ExitCode {
         };
         planned.push((input, chains, report));
     }
-    let objects = objects::objects(&document, &args.grouping);
+    let objects = match objects::objects(&document, &args.grouping) {
+        Ok(o) => o,
+        Err(e) => return fail(2, e),
+    };
     let own: Vec<Vec<f32>> = planned
         .iter()
         .map(|(_, _, r)| {

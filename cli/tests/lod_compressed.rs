@@ -55,8 +55,9 @@ fn read(
 /// encoding's error (0.02 of a unit vector, measured below 0.011) of the true ones, and the
 /// triangles as they were; it writes levels, and a file that neither uses nor requires the
 /// extension (its data is decoded) but still requires `KHR_mesh_quantization` (the normals are
-/// bytes). A file whose view decodes to more than 256 times its compressed size, or whose
-/// compressed bytes lie outside the file, is refused with the view named.
+/// bytes). A file whose view decodes to more than 256 times its compressed size, whose
+/// compressed bytes lie outside the file, or whose fallback buffer claims 1 TiB, is refused with
+/// an error saying so (no allocation of what the file never held).
 #[test]
 fn lod_reads_meshopt_compressed_views() {
     let (positions, indices) = lodkit::lod_chain::uv_sphere(12, 24);
@@ -203,26 +204,27 @@ fn lod_reads_meshopt_compressed_views() {
         .collect();
     assert_eq!(read_indices, indices, "the triangles as they were");
 
-    // Refused, naming the view: a count past the bound, bytes outside the file.
+    // Refused, saying why: a count past the bound, bytes outside the file, a forged fallback
+    // length.
     let mut big = views.clone();
     big[0]["extensions"]["EXT_meshopt_compression"]["count"] = json!(1u64 << 40);
     let mut outside = views.clone();
     outside[2]["extensions"]["EXT_meshopt_compression"]["byteOffset"] = json!(source.len());
-    for (name, views, says) in [
-        ("big", big, "more than 256 times"),
-        ("outside", outside, "are not in the file"),
+    for (name, views, fallback, says) in [
+        ("big", big, total, "bufferView 0 (EXT_meshopt_compression)"),
+        ("outside", outside, total, "are not in the file"),
+        (
+            "forged",
+            views.clone(),
+            1usize << 40,
+            "fallback buffers claim",
+        ),
     ] {
         let file = format!("{name}.gltf");
-        std::fs::write(
-            dir.join(&file),
-            serde_json::to_vec(&doc(&views, total)).unwrap(),
-        )
-        .unwrap();
+        let text = serde_json::to_vec(&doc(&views, fallback)).unwrap();
+        std::fs::write(dir.join(&file), text).unwrap();
         let (code, stdout, stderr) = run(&dir, &["lod", &file, "-o", "x.glb"]);
         assert_eq!(code, 1, "{name}: {stdout}{stderr}");
-        assert!(
-            stderr.contains("bufferView") && stderr.contains(says),
-            "{name}: {stderr}"
-        );
+        assert!(stderr.contains(says), "{name}: {stderr}");
     }
 }

@@ -119,6 +119,12 @@ fn an_objects_meshes_switch_together() {
         assert_eq!(object, "the whole file");
         assert_eq!(d, shared, "one top-level node: the same object");
     }
+    let (code, _, stderr) = run(&dir, &["lod", "h.gltf", "-o", "x.glb", "--object", "visr"]);
+    assert_eq!(code, 2, "a misspelt node is an error: {stderr}");
+    assert!(
+        stderr.contains("--object visr: the file has no node"),
+        "{stderr}"
+    );
     let named = world_distances(&dir, &["--object", "shell", "--object", "visor"]);
     for (k, (object, d)) in named.iter().enumerate() {
         assert_eq!(object, ["shell", "visor"][k]);

@@ -323,8 +323,10 @@ impl GpuContext {
     /// back) inside out-of-memory, validation and internal error scopes: the first error wgpu
     /// raised during `f` comes back as this call's error instead of reaching the
     /// uncaptured-error handler. Before `f` it [`check`](Self::check)s the device (one poll, no
-    /// wait: a device destroyed or lost since is named here, as work on it would otherwise
-    /// succeed silently); after, what the device callbacks recorded is this call's error.
+    /// wait: with lodkit's handlers, [`DeviceHandlers::Install`], a device destroyed or lost
+    /// since is named here, as work on it would otherwise succeed silently); after, what the
+    /// device callbacks recorded is this call's error. Over an engine's own handlers
+    /// ([`DeviceHandlers::Keep`]) the loss goes to the engine's callback instead.
     /// Per-frame recordings go through [`recording`](Self::recording), which does not poll.
     ///
     /// Inside another guarded call on the same thread it only runs `f`: the outermost call, the
@@ -340,8 +342,9 @@ impl GpuContext {
     /// [`guarded`](Self::guarded) for a recording into the engine's encoder, at the cost of the
     /// error scopes and nothing more: no device poll and no wait. On native wgpu a scope's
     /// result is ready when it is popped and is read there (a pending one, the browser's WebGPU,
-    /// is waited for). A lost device is noticed when wgpu notices it, at the engine's next
-    /// submission or poll (or [`check`](Self::check)), and named by the next lodkit call. An
+    /// is waited for). With lodkit's handlers ([`DeviceHandlers::Install`]) a lost device is
+    /// noticed when wgpu notices it, at the engine's next submission or poll (or
+    /// [`check`](Self::check)), and named by the next lodkit call. An
     /// application's own passes can record through it to get lodkit's error handling and its
     /// host cost (the demo's baselines do, to be timed fairly against lodkit's passes).
     pub fn recording<T>(

@@ -2,9 +2,10 @@
 //! compressed in another buffer, decoded here with meshoptimizer's own decoders (the `meshopt`
 //! crate) into the view's place in its fallback buffer, so that the rest of `lodkit lod` reads
 //! plain accessors and writes a file without the extension. Everything is checked against the
-//! file before a decoder sees it: bounds, strides, counts, modes and filters, and a decoded size
-//! at most [`MAX_EXPANSION`] times the compressed one (a zero-filled stream compresses to almost
-//! nothing, and a count taken on trust would allocate what the file never held).
+//! file before a decoder sees it: bounds, strides, counts, modes and filters, a decoded size at
+//! most [`MAX_EXPANSION`] times the compressed one (4 KiB at least), and fallback buffers at most
+//! that many times the bytes the file's other buffers hold (a zero-filled stream compresses to
+//! almost nothing, and a length taken on trust would allocate what the file never held).
 
 use gltf::json;
 use serde_json::Value;
@@ -122,29 +123,36 @@ pub fn load_buffers(
         view.buffer = json::Index::new(0);
     }
     let own = gltf::Document::from_json_without_validation(own);
-    let mut loaded = gltf::import_buffers(&own, Some(base), blob)
+    // The fallback buffers may hold at most MAX_EXPANSION times the bytes the file really
+    // loaded (not what its views claim, which `decode` checks against these bytes later).
+    let loaded: Vec<Vec<u8>> = gltf::import_buffers(&own, Some(base), blob)
         .map_err(|e| format!("cannot load its buffers: {e}"))?
-        .into_iter();
-    let compressed: usize = taken.views.iter().map(|v| v.0.length).sum();
-    let budget = compressed.saturating_mul(MAX_EXPANSION).max(4096);
-    let fallback: usize = root
+        .into_iter()
+        .map(|d| d.0)
+        .collect();
+    let held = loaded.iter().fold(0usize, |n, b| n.saturating_add(b.len()));
+    let budget = held.saturating_mul(MAX_EXPANSION).max(4096);
+    let fallback = root
         .buffers
         .iter()
         .zip(&taken.fallback)
         .filter(|(_, f)| **f)
-        .map(|(b, _)| b.byte_length.0 as usize)
-        .sum();
+        .fold(0usize, |n, (b, _)| {
+            n.saturating_add(b.byte_length.0 as usize)
+        });
     if fallback > budget {
         return Err(format!(
-            "its {EXTENSION} fallback buffers hold {fallback} bytes, more than {MAX_EXPANSION} \
-             times the {compressed} compressed bytes their views decode from"
+            "its {EXTENSION} fallback buffers claim {fallback} bytes, more than {MAX_EXPANSION} \
+             times the {held} bytes of its other buffers, from which their views decode"
         ));
     }
+    let mut loaded = loaded.into_iter();
     let mut buffers: Vec<Vec<u8>> = Vec::with_capacity(root.buffers.len());
     for (b, fallback) in root.buffers.iter().zip(&taken.fallback) {
         buffers.push(match fallback {
+            // Within the budget above: no overflow rounding it up.
             true => vec![0; (b.byte_length.0 as usize).next_multiple_of(4)],
-            false => loaded.next().map(|d| d.0).unwrap_or_default(),
+            false => loaded.next().unwrap_or_default(),
         });
     }
     decode(&taken.views, &root.buffer_views, &mut buffers)?;

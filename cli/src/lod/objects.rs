@@ -34,8 +34,19 @@ pub struct Object {
 }
 
 /// Each mesh's [`Object`] (indexed by mesh), as `grouping` says, from the node tree of the
-/// document's nodes (children lists).
-pub fn objects(document: &gltf::Document, grouping: &Grouping) -> Vec<Object> {
+/// document's nodes (children lists). A node `grouping` names that the file does not have is an
+/// error naming it. A mesh shown by several nodes belongs to the first one's object (the
+/// others' show it with those distances).
+pub fn objects(document: &gltf::Document, grouping: &Grouping) -> Result<Vec<Object>, String> {
+    if let Grouping::Nodes(named) = grouping
+        && let Some(missing) = named
+            .iter()
+            .find(|n| !document.nodes().any(|node| node.name() == Some(n.as_str())))
+    {
+        return Err(format!(
+            "--object {missing}: the file has no node of that name"
+        ));
+    }
     let mut parent: HashMap<usize, usize> = HashMap::new();
     for node in document.nodes() {
         for child in node.children() {
@@ -67,7 +78,7 @@ pub fn objects(document: &gltf::Document, grouping: &Grouping) -> Vec<Object> {
         }
         up
     };
-    document
+    Ok(document
         .meshes()
         .map(|mesh| {
             let shown = document
@@ -108,7 +119,7 @@ pub fn objects(document: &gltf::Document, grouping: &Grouping) -> Vec<Object> {
                 scale,
             }
         })
-        .collect()
+        .collect())
 }
 
 /// The distances each mesh switches at when its object's meshes share them: for each level,

@@ -62,6 +62,73 @@ impl Output {
         }
     }
 
+    /// Embeds every image the input names by a relative URI (a file beside it, `base` its
+    /// folder) in the output's binary buffer (a buffer view and a MIME type in place of the
+    /// URI), so the output is whole wherever it is written, `.glb` or `.gltf`. A `data:` URI
+    /// stays as it is. Returns a warning for each image left as it was: a file that cannot be
+    /// read, or of a type glTF does not embed by MIME type (PNG, JPEG, WebP, KTX2).
+    pub fn embed_images(&mut self, base: &std::path::Path) -> Vec<String> {
+        let mut warnings = Vec::new();
+        for i in 0..self.root.images.len() {
+            let Some(uri) = self.root.images[i].uri.clone() else {
+                continue;
+            };
+            if uri.starts_with("data:") {
+                continue;
+            }
+            let path = percent_decoded(&uri);
+            // Only a file at or below the input's folder: a URI that climbs out of it or names
+            // an absolute path would copy some other local file into the output.
+            let relative = std::path::Path::new(&path);
+            let inside = relative.components().all(|c| {
+                matches!(
+                    c,
+                    std::path::Component::Normal(_) | std::path::Component::CurDir
+                )
+            });
+            if !inside {
+                warnings.push(format!(
+                    "image {i} '{uri}': outside the input's folder, left as a URI"
+                ));
+                continue;
+            }
+            let Some(mime) = mime_type(&path) else {
+                warnings.push(format!(
+                    "image {i} '{uri}': not PNG, JPEG, WebP or KTX2, left as a URI (copy it \
+                     beside the output)"
+                ));
+                continue;
+            };
+            let bytes = match std::fs::read(base.join(&path)) {
+                Ok(b) => b,
+                Err(e) => {
+                    warnings.push(format!(
+                        "image {i} '{uri}': cannot read it ({e}), left as a URI"
+                    ));
+                    continue;
+                }
+            };
+            pad4(&mut self.bin);
+            let offset = self.bin.len();
+            self.bin.extend_from_slice(&bytes);
+            let view = self.root.push(json::buffer::View {
+                buffer: Index::new(0),
+                byte_length: bytes.len().into(),
+                byte_offset: Some(offset.into()),
+                byte_stride: None,
+                name: None,
+                target: None,
+                extensions: None,
+                extras: Default::default(),
+            });
+            let image = &mut self.root.images[i];
+            image.uri = None;
+            image.buffer_view = Some(view);
+            image.mime_type = Some(json::image::MimeType(mime.to_owned()));
+        }
+        warnings
+    }
+
     fn view(&mut self, bytes: &[u8], target: json::buffer::Target) -> Index<json::buffer::View> {
         self.strided_view(bytes, target, None)
     }
@@ -376,4 +443,66 @@ fn element_size(accessor: &json::Accessor) -> usize {
         Checked::Invalid => 1,
     };
     component * count
+}
+
+/// A relative URI's path: `%XX` escapes decoded (a malformed one is kept as written).
+fn percent_decoded(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut k = 0;
+    while k < bytes.len() {
+        let hex = bytes
+            .get(k + 1..k + 3)
+            .filter(|h| h.iter().all(u8::is_ascii_hexdigit))
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (bytes[k], hex) {
+            (b'%', Some(b)) => {
+                out.push(b);
+                k += 3;
+            }
+            (b, _) => {
+                out.push(b);
+                k += 1;
+            }
+        }
+    }
+    String::from_utf8(out).unwrap_or_else(|_| uri.to_owned())
+}
+
+/// The MIME type glTF embeds an image file as, by its extension.
+fn mime_type(path: &str) -> Option<&'static str> {
+    let ext = std::path::Path::new(path)
+        .extension()?
+        .to_str()?
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "png" => Some("image/png"),
+        "jpg" | "jpeg" => Some("image/jpeg"),
+        "webp" => Some("image/webp"),
+        "ktx2" => Some("image/ktx2"),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uris_are_percent_decoded_and_typed() {
+        assert_eq!(
+            percent_decoded("Flight%20Helmet/a%2Bb.png"),
+            "Flight Helmet/a+b.png"
+        );
+        assert_eq!(percent_decoded("50%.png"), "50%.png", "a lone % stays");
+        assert_eq!(
+            percent_decoded("a%+5.png"),
+            "a%+5.png",
+            "two hex digits or nothing"
+        );
+        assert_eq!(mime_type("x/Y.JPG"), Some("image/jpeg"));
+        assert_eq!(mime_type("x.ktx2"), Some("image/ktx2"));
+        assert_eq!(mime_type("x.dds"), None);
+    }
 }

@@ -464,6 +464,12 @@ mod tests {
             LevelMaterial::Standard(standard.clone()),
             "a StandardMaterial handle stays Standard"
         );
+        let made = Handle::<FrameSequentialMaterial>::default();
+        assert_eq!(
+            LevelMaterial::custom(made.clone()),
+            LevelMaterial::FrameSequential(made),
+            "a FrameSequentialMaterial handle is drawn as it is"
+        );
         app.world_mut().spawn(LodLevels(vec![
             LodLevel::new(Handle::default(), custom.clone()),
             LodLevel::new(Handle::default(), standard.clone()),

@@ -73,15 +73,19 @@ impl From<Handle<FrameSequentialMaterial>> for LevelMaterial {
 impl LevelMaterial {
     /// A level material of the app's own material handle, of any type with a
     /// [`FrameSequentialMaterialPlugin`](super::FrameSequentialMaterialPlugin) (a
-    /// `StandardMaterial` handle gives [`LevelMaterial::Standard`]).
+    /// `StandardMaterial` handle gives [`LevelMaterial::Standard`], a
+    /// [`FrameSequentialMaterial`] one [`LevelMaterial::FrameSequential`]).
     pub fn custom<M: Material>(handle: Handle<M>) -> Self {
         let handle = handle.untyped();
-        match handle.clone().try_typed::<StandardMaterial>() {
-            Ok(standard) => Self::Standard(standard),
-            Err(_) => Self::Custom {
-                handle,
-                type_name: std::any::type_name::<M>(),
-            },
+        if let Ok(standard) = handle.clone().try_typed::<StandardMaterial>() {
+            return Self::Standard(standard);
+        }
+        if let Ok(made) = handle.clone().try_typed::<FrameSequentialMaterial>() {
+            return Self::FrameSequential(made);
+        }
+        Self::Custom {
+            handle,
+            type_name: std::any::type_name::<M>(),
         }
     }
 

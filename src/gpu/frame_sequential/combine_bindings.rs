@@ -7,7 +7,7 @@
 
 use std::sync::{Mutex, PoisonError};
 
-use crate::combine_coverage::CombineData;
+use crate::combine_coverage::{COMBINE_DATA_WIDTH, CombineData};
 use crate::gpu::resources::BindGroupCache;
 use crate::gpu::{GpuContext, GpuError};
 
@@ -52,7 +52,17 @@ impl CombineBindings {
     ) -> Result<wgpu::Texture, GpuError> {
         let mut kept = self.data.lock().unwrap_or_else(PoisonError::into_inner);
         let DataTexture { texture, belt } = &mut *kept;
-        let fits = |t: &wgpu::Texture| t.width() == data.width && t.height() >= data.height;
+        // The shader reads the data by linear index (x = index % the texture's width): one row
+        // of data (fewer than COMBINE_DATA_WIDTH texels, whose width then varies from frame to
+        // frame) fits any texture at least as wide; more rows need the data's own width.
+        let fits = |t: &wgpu::Texture| {
+            t.height() >= data.height
+                && (t.width() == data.width || (data.height == 1 && t.width() >= data.width))
+        };
+        let width = match data.height {
+            1 => data.width.max(COMBINE_DATA_WIDTH),
+            _ => data.width,
+        };
         let texture = match texture {
             Some(t) if fits(t) => t.clone(),
             _ => {
@@ -66,7 +76,7 @@ impl CombineBindings {
                 let made = gpu.device.create_texture(&wgpu::TextureDescriptor {
                     label: Some("lodkit combine data"),
                     size: wgpu::Extent3d {
-                        width: data.width,
+                        width,
                         height: rows,
                         depth_or_array_layers: 1,
                     },

@@ -15,9 +15,10 @@ struct Kept {
 
 /// Bind groups by the textures (and texture views) they bind: a pass records with the kept one
 /// where the textures are those of an earlier recording (wgpu compares them by identity), and
-/// makes and keeps one otherwise. It keeps `capacity` of them, the oldest going first, and with
-/// them their textures: an engine's resized buffers are freed once newer bind groups push
-/// theirs out.
+/// makes and keeps one otherwise. It keeps `capacity` of them, the least recently used going
+/// first, and with them their textures; a new group whose first texture (the pass's target-sized
+/// input) has another size than a kept one's drops that one, so an engine's buffers from before
+/// a resize are not kept alive.
 #[derive(Debug)]
 pub(crate) struct BindGroupCache {
     kept: Mutex<Vec<Kept>>,
@@ -47,10 +48,19 @@ impl BindGroupCache {
                 && k.textures.iter().zip(textures).all(|(a, b)| a == *b)
                 && k.views.iter().zip(views).all(|(a, b)| a == *b)
         };
-        if let Some(k) = kept.iter().find(|k| same(k)) {
-            return Ok(k.group.clone());
+        if let Some(at) = kept.iter().position(same) {
+            // Least recently used goes first: a hit moves to the back.
+            let hit = kept.remove(at);
+            let group = hit.group.clone();
+            kept.push(hit);
+            return Ok(group);
         }
         let group = make()?;
+        // A first texture of another size than the new one's: the engine resized its targets,
+        // and what it bound before will not come back.
+        if let Some(first) = textures.first() {
+            kept.retain(|k| k.textures.first().is_none_or(|t| t.size() == first.size()));
+        }
         if kept.len() >= self.capacity {
             kept.remove(0);
         }
