@@ -40,6 +40,9 @@ pub type FrameSequentialLevel<M> = ExtendedMaterial<M, FrameSequentialBindings>;
 /// }
 /// ```
 ///
+/// A material whose shading is costly may begin with `if !lod_level_kept(in) { discard; }` (same
+/// module) so that what the dither drops is not shaded.
+///
 /// `lod_level_color` discards the fragments the screen-door dither drops and writes the
 /// combine's id word in alpha; where `M` is drawn as itself (not a level) it returns `color`
 /// unchanged, so one shader serves both. The plugin derives one [`FrameSequentialLevel<M>`] per
