@@ -5,8 +5,9 @@
 //! the transition instead of one frame. No frame is kept and no combine runs.
 //!
 //! It serves a camera with MSAA (the combine reads the main pass per pixel, and a multisampled
-//! one has no single id per pixel), and groups with a blending material (whose alpha cannot carry
-//! the combine's id word). With a prepass the prepass would write both levels' depth whole and
+//! one has no single id per pixel), groups with a blending material (whose alpha cannot carry
+//! the combine's id word) and groups with a masked material other than a `StandardMaterial`
+//! (whose alpha test the older-level depth pass cannot repeat). With a prepass the prepass would write both levels' depth whole and
 //! the main pass could then show neither at a pixel: such a camera switches at once instead.
 
 use lodkit::select::LodSelection;

@@ -39,10 +39,13 @@ pub struct FrameSequentialSystems;
 /// [`LevelMaterial::custom`] and [`FrameSequentialMaterialPlugin::<M>`](super::FrameSequentialMaterialPlugin),
 /// its fragment shader ending with one call to `lod_level_color`.
 ///
-/// Opaque and alpha-mask (`AlphaMode::Mask`) materials take part in the combine. A material
-/// that blends (`Blend`, `Premultiplied`, `Add`, `Multiply`, `AlphaToCoverage`) cannot carry the
-/// combine's id word in its alpha: a group with such a level is drawn with the complementary
-/// screen-door dither instead (both levels each frame, disjoint pixels), with one warning.
+/// Opaque and alpha-mask (`AlphaMode::Mask`) materials take part in the combine; a masked
+/// `StandardMaterial`'s coverage is its leaves, not its cards (the older-level depth pass
+/// repeats its alpha test). A material that blends (`Blend`, `Premultiplied`, `Add`,
+/// `Multiply`, `AlphaToCoverage`) cannot carry the combine's id word in its alpha, and a masked
+/// material of another type has an alpha test lodkit cannot repeat: a group with such a level
+/// is drawn with the complementary screen-door dither instead (both levels each frame,
+/// disjoint pixels), with one warning.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LevelMaterial {
     /// A material of the app's, used as it is (see above).

@@ -329,7 +329,8 @@ fn update(
         if blending {
             warn_once!(
                 "a LOD group has a blending material (AlphaMode::Blend, ...), whose alpha cannot \
-                 carry the combine's id word: {}",
+                 carry the combine's id word, or a masked one other than a StandardMaterial, \
+                 whose coverage lodkit cannot repeat: {}",
                 if fallback == Fallback::Dither {
                     "it blends with the screen-door dither"
                 } else {
@@ -431,14 +432,15 @@ fn update(
             let mut hull = None;
             if let Some(other) = other.filter(|_| selection.visible && settings.coverage.is_exact())
             {
-                let cull_mode = derived
+                let (cull_mode, alpha_test) = derived
                     .looks(&other.material, &materials)
-                    .map_or(Some(Face::Back), |m| m.cull_mode);
+                    .map_or((Some(Face::Back), None), |m| (m.cull_mode, m.alpha_test));
                 // Where the level's silhouette can be had on the CPU (a closed triangle mesh
-                // with its positions, culled as usual), it tells the coverage; else the
-                // older-level depth pass draws the level.
+                // with its positions, culled as usual, not masked), it tells the coverage; else
+                // the older-level depth pass draws the level (with its alpha test).
                 let wants_outline = settings.coverage == OlderCoverage::Silhouette
-                    && cull_mode != Some(Face::Front);
+                    && cull_mode != Some(Face::Front)
+                    && alpha_test.is_none();
                 let view = OutlineView {
                     clip_from_world: clip_from_view * view_from_world,
                     eye: camera_transform.translation(),
@@ -472,6 +474,7 @@ fn update(
                         mesh: other.mesh.id(),
                         world_from_local: model,
                         cull_mode,
+                        alpha_test,
                     }),
                 }
             }

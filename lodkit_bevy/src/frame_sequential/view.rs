@@ -1,7 +1,8 @@
 //! What the main world hands the render world each frame for a frame-sequential camera: the
 //! view's matrices, thresholds, silhouettes and older levels.
 
-use bevy::mesh::Mesh;
+use bevy::math::Affine2;
+use bevy::mesh::{Mesh, UvChannel};
 use bevy::prelude::*;
 use bevy::render::render_resource::Face;
 
@@ -60,4 +61,41 @@ pub struct OlderLevel {
     pub world_from_local: Mat4,
     /// The level material's face culling (the pass culls as the main pass does).
     pub cull_mode: Option<Face>,
+    /// The alpha test of an alpha-mask level (the pass discards what the main pass does).
+    pub alpha_test: Option<AlphaTest>,
+}
+
+/// What Bevy's main pass discards of a `StandardMaterial` with `AlphaMode::Mask`: a fragment
+/// whose base colour alpha (the material's, times its base colour texture's, sampled at the
+/// transformed UVs with the view's mip bias) is under the cutoff. The older-level depth pass
+/// applies the same test, so the combine knows a masked level's coverage exactly (the leaves
+/// of a card, not the card). A vertex colour's alpha is not read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AlphaTest {
+    /// `AlphaMode::Mask`'s cutoff.
+    pub cutoff: f32,
+    /// The base colour's alpha.
+    pub base_alpha: f32,
+    /// The base colour texture, if any.
+    pub texture: Option<Handle<Image>>,
+    /// The material's UV transform.
+    pub uv_transform: Affine2,
+    /// Whether the texture reads the second UV set (`UvChannel::Uv1`).
+    pub uv_b: bool,
+}
+
+impl AlphaTest {
+    /// The alpha test of `material` (None unless its alpha mode is `Mask`).
+    pub fn of(material: &StandardMaterial) -> Option<Self> {
+        let AlphaMode::Mask(cutoff) = material.alpha_mode else {
+            return None;
+        };
+        Some(Self {
+            cutoff,
+            base_alpha: material.base_color.alpha(),
+            texture: material.base_color_texture.clone(),
+            uv_transform: material.uv_transform,
+            uv_b: material.base_color_channel == UvChannel::Uv1,
+        })
+    }
 }
