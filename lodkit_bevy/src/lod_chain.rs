@@ -40,6 +40,9 @@ pub enum MeshLodChainError {
     /// Only triangle lists are simplified.
     #[error("the mesh is a {0:?}, not a triangle list")]
     NotTriangles(PrimitiveTopology),
+    /// The build stopped on a panic (a bug in lodkit or a dependency: please report it).
+    #[error("building the chain panicked (a bug: please report it)")]
+    Panicked,
     /// The mesh's data has gone to the render world (`RenderAssetUsages::RENDER_WORLD` only).
     #[error("the mesh's vertex data is not in the main world (its asset usage lacks MAIN_WORLD)")]
     Extracted,

@@ -19,7 +19,8 @@
 //!
 //! `--auto-lod N` instead times N entities given `AutoLod` (one 65,536-triangle sphere mesh, so
 //! one chain built in the background): every frame from the one that adds the component until
-//! all are groups, and the frames around; it prints the slowest frame against the median.
+//! all are groups, and the frames around; it prints the median and the slowest frame in between
+//! against the medians before and after, and every frame time.
 
 #[path = "../common/frames.rs"]
 #[allow(
@@ -473,15 +474,16 @@ fn auto_lod_frames(n: usize, args: &Args) {
     }
     let before = median(&times[..AROUND]);
     let after = median(&times[times.len() - AROUND..]);
-    let worst = times[AROUND..times.len() - AROUND + 1]
-        .iter()
-        .copied()
-        .fold(0.0, f64::max);
+    let between = &times[AROUND..times.len() - AROUND + 1];
+    let worst = between.iter().copied().fold(0.0, f64::max);
     println!(
         "{n} entities, AutoLod added at frame {AROUND}, all groups at frame {}: median frame \
-         {before:.2} ms before, {after:.2} ms after; slowest frame in between {worst:.2} ms \
-         ({} frames)",
+         {before:.2} ms before, {after:.2} ms after; in between ({} frames) median {:.2} ms, \
+         slowest {worst:.2} ms",
         all_ready.map_or("never".into(), |f| f.to_string()),
-        times.len() - 2 * AROUND + 1
+        between.len(),
+        median(between),
     );
+    let list: Vec<String> = times.iter().map(|t| format!("{t:.1}")).collect();
+    println!("frame times (ms): {}", list.join(" "));
 }
