@@ -13,7 +13,9 @@
 //!    reprojected through the camera motion (`new_to_old_matrix`), into the frame's target, only
 //!    inside the screen rectangles of the instances in transition (the rest of the frame is a
 //!    copy), told where the level last frame drew covers the screen: its silhouette under this
-//!    frame's camera (`CombineCoverage::Known`, `lodkit::silhouette::Surface`).
+//!    frame's camera (`CombineCoverage::Known` with the data `CoverageLevels::data` lays out
+//!    from each level's `lodkit::silhouette::Surface`, registered once, and the scheduler's
+//!    `older(key)`: lodkit's default route).
 //!
 //! `cargo run --example frame_sequential -- [--out DIR]`
 //! Writes DIR/frame_sequential.png (default DIR: lodkit-out): frames of the camera pulling back
@@ -23,9 +25,7 @@ use std::error::Error;
 
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::screen_rect;
-use lodkit::combine_coverage::{
-    CombineData, CombineDataDescriptor, CombineObjectData, CoverageRoute,
-};
+use lodkit::combine_coverage::{CoverageFrame, CoverageLevels, OlderLevel};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{
@@ -89,11 +89,13 @@ fn main() -> Result<(), Box<dyn Error>> {
             Vec4::new(0.15, 0.3, 0.9, 1.0),
         ),
     ];
-    // Each level's surface, for its silhouette (both are closed meshes).
-    let surfaces = meshes
+    // Each level's surface, registered once (both are closed meshes): the combine is told
+    // where the level the older buffer holds covers the screen by its silhouette.
+    let mut coverage = CoverageLevels::new();
+    let levels = meshes
         .iter()
-        .map(Mesh::surface)
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|m| Ok(coverage.register(m.surface()?)))
+        .collect::<Result<Vec<_>, Box<dyn Error>>>()?;
 
     // Five instances in a row going away from the camera; level 1 beyond a view-normalized
     // distance of 2.5. Selection switches hard: the scheduler spreads each switch over 0.3 s.
@@ -108,8 +110,6 @@ fn main() -> Result<(), Box<dyn Error>> {
     let mut scheduler = TransitionScheduler::new();
     let keys: Vec<_> = positions.iter().map(|_| scheduler.insert(0)).collect();
     let mut states = vec![LodState::NEW; positions.len()];
-    // The level each instance was drawn at last frame: the one the older buffer holds.
-    let mut older_lod: Vec<Option<usize>> = vec![None; positions.len()];
 
     let aspect = w as f32 / h as f32;
     let proj = glam::camera::rh::proj::directx::perspective(0.7, aspect, 0.1, 100.0);
@@ -209,33 +209,27 @@ fn main() -> Result<(), Box<dyn Error>> {
             .collect();
         // Where the level the older buffer holds covers the screen now: its silhouette under
         // this frame's camera (nothing moves by itself, so each instance's matrix is the
-        // camera's).
-        let mut silhouettes = Vec::new();
-        for ((key, &p), older) in keys.iter().zip(&positions).zip(&older_lod) {
-            let (Some(lod), true) = (older, scheduler.in_transition(*key)) else {
-                continue;
-            };
-            let eye = (view * model(p)).inverse().transform_point3(Vec3::ZERO);
-            let segments = surfaces[*lod].silhouette(proj * view * model(p), eye, SIZE, true)?;
-            // The older level is shown at this frame's threshold for it (the pattern is on the
-            // screen): exactly complementary to the level drawn now.
-            let d = scheduler.draw(*key)?;
-            let older_tau = scheduler.schedule().threshold(d.progress, !d.incoming);
-            silhouettes.push((d.id, older_tau, segments));
+        // camera's), shown at this frame's threshold for it (the pattern is on the screen):
+        // exactly complementary to the level drawn now.
+        let mut older = Vec::new();
+        for (key, &p) in keys.iter().zip(&positions) {
+            if let Some(o) = scheduler.older(*key)? {
+                older.push(OlderLevel {
+                    id: o.id,
+                    level: levels[usize::from(o.lod.min(1))],
+                    world_from_local: model(p),
+                    new_to_old: None,
+                    older_tau: Some(o.tau),
+                    displace: None,
+                });
+            }
         }
-        let objects: Vec<CombineObjectData> = silhouettes
-            .iter()
-            .map(|(id, older_tau, segments)| CombineObjectData {
-                id: *id,
-                new_to_old,
-                older_tau: Some(*older_tau),
-                route: CoverageRoute::Silhouette(segments),
-            })
-            .collect();
-        let data = CombineData::new(&CombineDataDescriptor {
+        let data = coverage.data(&CoverageFrame {
+            clip_from_world: proj * view,
+            eye,
+            size: SIZE,
             new_to_old,
-            height: h,
-            objects: &objects,
+            objects: &older,
             ..Default::default()
         })?;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -254,9 +248,6 @@ fn main() -> Result<(), Box<dyn Error>> {
         combine.record(&gpu, &mut encoder, &frame_to_combine)?;
         gpu.queue.submit([encoder.finish()]);
         previous_view = Some(view);
-        for (key, older) in keys.iter().zip(&mut older_lod) {
-            *older = Some(usize::from(scheduler.draw(*key)?.lod.min(1)));
-        }
 
         if frame % (FRAMES / COLUMNS) == FRAMES / COLUMNS - 1 {
             let column = (frame / (FRAMES / COLUMNS)) as i64;

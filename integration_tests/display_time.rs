@@ -7,7 +7,7 @@ use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, LodSample, PixelSource, combine_shown};
 use lodkit::frame_sequential::{Drive, InstanceKey, Schedule, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
-    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
+    CombineCoverage, CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
 };
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::lod_buffer::{
@@ -591,7 +591,7 @@ impl SphereLods {
             new_to_old,
             target: &self.target_view,
             regions: CombineRegions::Everywhere,
-            coverage: Default::default(),
+            coverage: CombineCoverage::Estimated,
         };
         self.combine.record(gpu, &mut encoder, &frame).unwrap();
         gpu.queue.submit([encoder.finish()]);

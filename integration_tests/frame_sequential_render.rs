@@ -5,7 +5,8 @@ use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::{DepthConvention, PixelSource, combine_images};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::frame_sequential::{
-    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers, read_lod_image,
+    CombineCoverage, CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
+    read_lod_image,
 };
 use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::reproject::new_to_old_matrix;
@@ -636,7 +637,7 @@ fn everywhere<'a>(
         new_to_old,
         target,
         regions: CombineRegions::Everywhere,
-        coverage: Default::default(),
+        coverage: CombineCoverage::Estimated,
     }
 }
 
@@ -647,7 +648,7 @@ fn only<'a>(
 ) -> CombineFrame<'a> {
     CombineFrame {
         regions: CombineRegions::Only(regions),
-        coverage: Default::default(),
+        coverage: CombineCoverage::Estimated,
         ..frame
     }
 }

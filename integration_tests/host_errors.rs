@@ -783,6 +783,6 @@ fn whole<'a>(
         new_to_old: CombinePass::NO_HISTORY,
         target,
         regions: CombineRegions::Everywhere,
-        coverage: Default::default(),
+        coverage: CombineCoverage::Estimated,
     }
 }

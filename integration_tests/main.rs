@@ -11,6 +11,7 @@ mod combine_ray;
 mod composition;
 mod cost;
 mod cost_bounds;
+mod coverage_levels;
 mod display_time;
 mod downlevel;
 mod draw_limits;

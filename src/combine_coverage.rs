@@ -7,7 +7,8 @@
 //! older-level depth pass the host draws, or the estimate from last frame's picture alone (the
 //! paper's). A pass drawn over the levels' silhouettes
 //! ([`silhouette_hull`](crate::silhouette::silhouette_hull)) calls the shader's `combine_pixel`
-//! at each of its pixels.
+//! at each of its pixels. The host builds the frame's data from levels registered once per mesh
+//! ([`CoverageLevels`]): the route lodkit takes by default.
 
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
@@ -24,10 +25,15 @@ use crate::reproject::{
 use crate::silhouette::{SILHOUETTE_ON, silhouette_covers, silhouette_texel};
 
 mod data;
+mod levels;
 mod ray;
 pub use data::{
     COMBINE_DATA_WIDTH, COMBINE_MAX_HEIGHT, COMBINE_MAX_ID, CombineData, CombineDataDescriptor,
     CombineDataError, CombineObjectData, CoverageRoute,
+};
+pub use levels::{
+    CoverageError, CoverageFrame, CoverageLevel, CoverageLevels, LevelShape, MissingSilhouette,
+    OlderLevel,
 };
 pub use ray::{
     COMBINE_RAY_REACH, COMBINE_RAY_STEPS, combine_behind_texel, combine_ray_texel,

@@ -129,6 +129,20 @@ pub struct FrameDraw {
     pub incoming: bool,
 }
 
+/// The level of a t-instance that the older LOD buffer holds (the one drawn last frame) and how
+/// this frame displays it: what the combine needs of it ([`TransitionScheduler::older`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OlderDraw {
+    /// The LOD drawn last frame.
+    pub lod: u8,
+    /// The t-instance's id.
+    pub id: u32,
+    /// The threshold at which that level is displayed this frame with the pattern anchored to
+    /// the screen: this frame's threshold for the level not drawn now, exactly complementary to
+    /// [`FrameDraw::tau`] (`CombineObjectData::older_tau`).
+    pub tau: f32,
+}
+
 #[derive(Clone, Debug)]
 struct Transition {
     from: u8,
@@ -413,6 +427,29 @@ impl TransitionScheduler {
                 }
             }
         })
+    }
+
+    /// The older buffer's level of `key` this frame: None for an n-instance. On the frame its
+    /// transition begins that is the level it had (drawn last frame as an n-instance); after
+    /// that, the level its transition drew last frame.
+    pub fn older(&self, key: InstanceKey) -> Result<Option<OlderDraw>, ScheduleError> {
+        let slot = self.slot(key)?;
+        let Some(t) = &slot.transition else {
+            return Ok(None);
+        };
+        let draw = self.draw(key)?;
+        let lod = if self.frame == t.start {
+            t.from
+        } else {
+            let last = self.frame - 1;
+            let incoming = (last - t.start) % 2 == 1 || t.previous >= 1.0;
+            if incoming { t.to } else { t.from }
+        };
+        Ok(Some(OlderDraw {
+            lod,
+            id: t.id,
+            tau: self.schedule.threshold(draw.progress, !draw.incoming),
+        }))
     }
 
     /// Whether `key` is a t-instance.

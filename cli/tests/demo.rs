@@ -390,7 +390,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
         // (`combine_hidden`). Without that test, 7,830 pixel reversals in `simple` at 320x180.
         for (estimated, known) in [
             ("frame-seq-blue-noise", "frame-seq-silhouettes"),
-            ("frame-seq-complementary", "frame-seq-compl-silhouettes"),
+            ("frame-seq-complementary", "frame-seq-default"),
         ] {
             if row(estimated).reversals_static == 0 {
                 assert_eq!(
@@ -423,7 +423,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             "frame-seq-complementary",
             "frame-seq-object-space",
             "frame-seq-silhouettes",
-            "frame-seq-compl-silhouettes",
+            "frame-seq-default",
         ] {
             let r = row(name);
             // The combine follows the object motion, and where an animated object's LODs moved
@@ -506,7 +506,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
         // the estimate with the same schedule. Limit: 3 above the measured.
         for (estimated, known) in [
             ("frame-seq-blue-noise", "frame-seq-silhouettes"),
-            ("frame-seq-complementary", "frame-seq-compl-silhouettes"),
+            ("frame-seq-complementary", "frame-seq-default"),
         ] {
             let wrong = |r: &TransitionMetrics| r.see_through_pixel_frames + r.ghost_pixel_frames;
             let (estimated, known) = (wrong(row(estimated)), wrong(row(known)));

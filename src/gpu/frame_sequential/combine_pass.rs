@@ -61,22 +61,25 @@ pub enum CombineRegions<'a> {
 }
 
 /// What a recording knows of where the older levels (those the older buffer holds) cover the
-/// screen.
-#[derive(Clone, Copy, Debug, Default)]
+/// screen. There is no default: lodkit's route is [`Known`](Self::Known) with the data
+/// [`CoverageLevels::data`](crate::combine_coverage::CoverageLevels::data) builds from the levels
+/// registered once per mesh; the estimate is a choice made knowingly, with the schedule it is
+/// made for.
+#[derive(Clone, Copy, Debug)]
 pub enum CombineCoverage<'a> {
     /// Nothing: `lodkit::combine::combine_at_moved` (or `combine_at`) estimates it from last
     /// frame's picture. Where a level's edge moved by a fraction of a texel, the pixel shows the
-    /// other level or the background every other frame. Schedule the transitions with
-    /// [`Schedule::Paper`](crate::frame_sequential::Schedule::Paper) then: with the default
-    /// complementary schedule the estimate shows the background through an object about twice
-    /// as often.
-    #[default]
+    /// other level or the background every other frame. It is made for
+    /// [`Schedule::Paper`](crate::frame_sequential::Schedule::Paper)
+    /// ([`TransitionScheduler::with_schedule`](crate::frame_sequential::TransitionScheduler::with_schedule)):
+    /// with the default complementary schedule the estimate shows the background through an
+    /// object about twice as often.
     Estimated,
     /// `lodkit::combine_coverage::combine_pixel` with this frame's [`CombineData`]: each
     /// t-instance by its route (its older level's silhouette, the older-level depth pass, the
-    /// estimate). Build the data with the silhouettes of the levels the older buffer holds, seen
-    /// by this frame's camera ([`Surface::silhouette`](crate::silhouette::Surface::silhouette)):
-    /// the route docs/frame-sequential.md recommends.
+    /// estimate), as [`CoverageLevels::data`](crate::combine_coverage::CoverageLevels::data)
+    /// lays them out from the older levels' silhouettes under this frame's camera (the default
+    /// route, docs/frame-sequential.md).
     Known {
         /// The frame's data ([`CombineData::new`]) with its `new_to_old` equal to the
         /// recording's.
@@ -111,7 +114,8 @@ pub struct CombineFrame<'a> {
     pub target: &'a wgpu::TextureView,
     /// Where to combine (default everywhere).
     pub regions: CombineRegions<'a>,
-    /// What is known of the older levels' coverage (default [`CombineCoverage::Estimated`]).
+    /// What is known of the older levels' coverage ([`CombineCoverage::Known`], lodkit's route,
+    /// or the estimate chosen knowingly).
     pub coverage: CombineCoverage<'a>,
 }
 

@@ -9,7 +9,8 @@ use crate::demo::fixtures::edge_frame::FORMAT;
 use crate::demo::measures::reads::{Reads, Texels};
 use crate::demo::measures::upsample_timing::{PassRatio, Side, plain_pass_with, record_fullscreen};
 use lodkit::gpu::frame_sequential::{
-    CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LOD_DEPTH_FORMAT, LodBuffers,
+    CombineCoverage, CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions,
+    LOD_DEPTH_FORMAT, LodBuffers,
 };
 use lodkit::gpu::resources::{one_group_layout, texture_2d, textures_and_uniform};
 use lodkit::gpu::{GpuContext, GpuError};
@@ -180,7 +181,7 @@ pub fn combine_vs_copy(
             new_to_old: m,
             target: &target_view,
             regions: CombineRegions::Everywhere,
-            coverage: Default::default(),
+            coverage: CombineCoverage::Estimated,
         };
         combine.record(gpu, encoder, &frame).map(drop)
     };

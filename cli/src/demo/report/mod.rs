@@ -366,10 +366,12 @@ the middle frame of the moving camera: pixels both LODs cover that show the back
 pixels neither covers that show a transitioning object, as a share of the pixels either covers. \
 The last column counts both kinds on every frame of the transition with both cameras, against \
 what each LOD alone covers at that frame: see-through / ghost pixel-frames. \
-`frame-seq-compl-silhouettes` is frame-sequential LOD with the library's defaults on the route \
-docs/frame-sequential.md recommends where the levels are closed meshes (the complementary \
-schedule, the pattern on the screen, each level known by its silhouette); \
-`frame-seq-silhouettes` the same with the paper's Fig. 2 schedule.\n";
+`frame-seq-default` is frame-sequential LOD with the library's defaults, nothing else chosen: \
+`TransitionScheduler::new()` (the complementary schedule), `CombinePassDescriptor::default()`, \
+the pattern on the screen, each level registered once in `CoverageLevels` (a closed mesh by its \
+surface, an impostor card by its mask's outline) and the frame's data from \
+`CoverageLevels::data` with a default `CoverageFrame`; `frame-seq-silhouettes` the same route \
+with the paper's Fig. 2 schedule.\n";
 
 /// Writes `benchmarks.md` and `quality.md` into `docs`.
 pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
