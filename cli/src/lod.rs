@@ -137,7 +137,11 @@ pub fn run(args: &LodArgs) -> ExitCode {
     out.require(&required_here);
     // Images beside the input go into the output's buffer: it is whole wherever it is written.
     let base = args.input.parent().unwrap_or(Path::new("."));
-    for w in out.embed_images(base) {
+    let embedded = out.embed_images(base);
+    for w in &embedded.warnings {
+        output::eprintln(&format!("warning: {file}: {w}"));
+    }
+    for w in copy_beside(base, &args.output, &embedded.copies) {
         output::eprintln(&format!("warning: {file}: {w}"));
     }
     // Every mesh's chain first: an object's meshes share their distances.
@@ -361,4 +365,40 @@ fn table(r: &MeshReport) -> String {
 fn is_gltf_name(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}
+
+/// Copies the images at `paths` (relative to the input's folder `base`) to the same relative
+/// paths beside `output`, unless that is the input's own folder; a warning for each that could
+/// not be copied (the output then names a file that is not beside it).
+fn copy_beside(base: &Path, output: &Path, paths: &[String]) -> Vec<String> {
+    let target = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let base = if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base
+    };
+    let same = matches!(
+        (base.canonicalize(), target.canonicalize()),
+        (Ok(a), Ok(b)) if a == b
+    );
+    if same {
+        return Vec::new();
+    }
+    let mut warnings = Vec::new();
+    for path in paths {
+        let (from, to) = (base.join(path), target.join(path));
+        let copied = to
+            .parent()
+            .map_or(Ok(()), std::fs::create_dir_all)
+            .and_then(|()| std::fs::copy(&from, &to));
+        if let Err(e) = copied {
+            warnings.push(format!(
+                "image '{path}': cannot copy it beside the output ({e}), left as a URI"
+            ));
+        }
+    }
+    warnings
 }

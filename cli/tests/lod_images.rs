@@ -94,3 +94,84 @@ fn lod_carries_external_images() {
         assert_eq!(images[0].pixels, pixels, "{out}: its pixels as they were");
     }
 }
+
+/// The JSON chunk of the `.glb` at `path`.
+fn glb_json(path: &std::path::Path) -> serde_json::Value {
+    let bytes = std::fs::read(path).unwrap();
+    let glb = gltf::Glb::from_slice(&bytes).unwrap();
+    serde_json::from_slice(&glb.json).unwrap()
+}
+
+/// Whether `value` holds a `null` anywhere.
+fn has_null(value: &serde_json::Value) -> bool {
+    match value {
+        serde_json::Value::Null => true,
+        serde_json::Value::Array(a) => a.iter().any(has_null),
+        serde_json::Value::Object(o) => o.values().any(has_null),
+        _ => false,
+    }
+}
+
+/// What the Khronos validator found in `lodkit lod`'s outputs of Bevy's sample models, kept
+/// from coming back: an absent optional member of an extension the gltf crate models
+/// (`KHR_texture_transform.texCoord`) is left out, not written `null` (TYPE_MISMATCH), and a
+/// KTX2 file a texture names as its core `source` is not embedded with a MIME type a core
+/// source may not have (TEXTURE_INVALID_IMAGE_MIME_TYPE): it keeps its URI and is copied to
+/// the same relative path beside the output, which therefore loads from its own folder.
+/// Tried against throwaway edits: the nulls kept (fails on the first assertion), the KTX2
+/// embedded (fails on the URI).
+#[test]
+fn lod_writes_no_null_and_no_core_ktx2_mime_type() {
+    let dir = Scratch::folder();
+    std::fs::create_dir_all(dir.join("in/tex")).unwrap();
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+    let (positions, indices) = lodkit::lod_chain::uv_sphere(8, 16);
+    let mut bin: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    let index_at = bin.len();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    let ktx2: Vec<u8> = (0u8..64).collect();
+    std::fs::write(dir.join("in/tex/normal.ktx2"), &ktx2).unwrap();
+    let doc = json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_texture_transform"],
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1,
+            "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions":
+            {"KHR_texture_transform": {"offset": [0.25, 0.0]}}}}}],
+        "textures": [{"source": 0}],
+        "images": [{"uri": "tex/normal.ktx2"}],
+        "buffers": [{"uri": "ball.bin", "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": index_at},
+            {"buffer": 0, "byteOffset": index_at, "byteLength": bin.len() - index_at},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": positions.len(), "type": "VEC3",
+             "min": [-1.0, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
+            {"bufferView": 1, "componentType": 5125, "count": indices.len(), "type": "SCALAR"},
+        ],
+    });
+    std::fs::write(dir.join("in/ball.bin"), &bin).unwrap();
+    std::fs::write(dir.join("in/ball.gltf"), serde_json::to_vec(&doc).unwrap()).unwrap();
+    let (code, stdout, stderr) = run(&dir, &["lod", "in/ball.gltf", "-o", "out/ball.glb"]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let written = glb_json(&dir.join("out/ball.glb"));
+    assert!(!has_null(&written), "{written}");
+    let transform = &written["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"]
+        ["KHR_texture_transform"];
+    assert_eq!(transform["offset"], json!([0.25, 0.0]), "{written}");
+    let image = &written["images"][0];
+    assert_eq!(image["uri"], json!("tex/normal.ktx2"), "{written}");
+    assert!(image.get("mimeType").is_none(), "{written}");
+    assert_eq!(
+        std::fs::read(dir.join("out/tex/normal.ktx2")).unwrap(),
+        ktx2
+    );
+}

@@ -20,6 +20,16 @@ pub struct LevelPrimitive<'a> {
     pub carried: &'a [(String, usize)],
 }
 
+/// What [`Output::embed_images`] did not embed.
+#[derive(Debug, Default)]
+pub struct Embedded {
+    /// One line per image left as it was (unreadable, an unknown type, outside the folder).
+    pub warnings: Vec<String>,
+    /// Relative paths of images left as URIs that the caller copies beside the output (KTX2
+    /// and WebP files a texture names as its core source).
+    pub copies: Vec<String>,
+}
+
 /// The output document and its one binary buffer.
 pub struct Output {
     root: json::Root,
@@ -65,10 +75,21 @@ impl Output {
     /// Embeds every image the input names by a relative URI (a file beside it, `base` its
     /// folder) in the output's binary buffer (a buffer view and a MIME type in place of the
     /// URI), so the output is whole wherever it is written, `.glb` or `.gltf`. A `data:` URI
-    /// stays as it is. Returns a warning for each image left as it was: a file that cannot be
-    /// read, or of a type glTF does not embed by MIME type (PNG, JPEG, WebP, KTX2).
-    pub fn embed_images(&mut self, base: &std::path::Path) -> Vec<String> {
-        let mut warnings = Vec::new();
+    /// stays as it is. Returns a warning for each image left as it was (a file that cannot be
+    /// read, or of a type glTF does not embed by MIME type: PNG, JPEG, WebP, KTX2), and the
+    /// KTX2 and WebP files a texture names as its core source, which keep their URI (a core
+    /// source may only be PNG or JPEG by MIME type) and are to be copied beside the output.
+    pub fn embed_images(&mut self, base: &std::path::Path) -> Embedded {
+        let mut embedded = Embedded::default();
+        let warnings = &mut embedded.warnings;
+        // Images a texture names as its core `source`: glTF allows only PNG and JPEG there
+        // (KTX2 and WebP belong in KHR_texture_basisu and EXT_texture_webp).
+        let core_sources: Vec<usize> = self
+            .root
+            .textures
+            .iter()
+            .map(|t| t.source.value())
+            .collect();
         for i in 0..self.root.images.len() {
             let Some(uri) = self.root.images[i].uri.clone() else {
                 continue;
@@ -99,6 +120,12 @@ impl Output {
                 ));
                 continue;
             };
+            if matches!(mime, "image/ktx2" | "image/webp") && core_sources.contains(&i) {
+                // Embedded, it would carry a MIME type a core source may not have: the file is
+                // copied beside the output instead, at the same relative path.
+                embedded.copies.push(path.clone());
+                continue;
+            }
             let bytes = match std::fs::read(base.join(&path)) {
                 Ok(b) => b,
                 Err(e) => {
@@ -126,7 +153,7 @@ impl Output {
             image.buffer_view = Some(view);
             image.mime_type = Some(json::image::MimeType(mime.to_owned()));
         }
-        warnings
+        embedded
     }
 
     fn view(&mut self, bytes: &[u8], target: json::buffer::Target) -> Index<json::buffer::View> {
@@ -386,7 +413,7 @@ impl Output {
             extensions: None,
             extras: Default::default(),
         }];
-        let text = self.root.to_vec().map_err(|e| e.to_string())?;
+        let text = without_nulls(&self.root.to_vec().map_err(|e| e.to_string())?)?;
         let io = |e: std::io::Error| format!("cannot write `{}`: {e}", path.display());
         if glb {
             let glb = gltf::binary::Glb {
@@ -406,6 +433,30 @@ impl Output {
             std::fs::write(bin_path, &self.bin).map_err(io)
         }
     }
+}
+
+/// The JSON `text` with every `null` member left out (outside `extras`, which are the app's):
+/// the gltf crate writes an absent optional member of some extensions as `null`
+/// (`KHR_texture_transform.texCoord`, `KHR_materials_volume.attenuationDistance`), which the
+/// Khronos validator rejects; glTF gives `null` no meaning anywhere.
+fn without_nulls(text: &[u8]) -> Result<Vec<u8>, String> {
+    fn strip(value: &mut json::Value) {
+        match value {
+            json::Value::Object(members) => {
+                members.retain(|_, v| !v.is_null());
+                for (key, v) in members.iter_mut() {
+                    if key != "extras" {
+                        strip(v);
+                    }
+                }
+            }
+            json::Value::Array(items) => items.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    let mut value: json::Value = serde_json::from_slice(text).map_err(|e| e.to_string())?;
+    strip(&mut value);
+    serde_json::to_vec(&value).map_err(|e| e.to_string())
 }
 
 fn serde_json_map<const N: usize>(
