@@ -6,3 +6,4 @@
 
 pub mod demo;
 pub mod npm;
+pub mod progress;

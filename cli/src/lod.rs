@@ -3,6 +3,7 @@
 //! table per mesh and an optional JSON report.
 
 mod compressed;
+mod folder;
 mod objects;
 mod read;
 mod write;
@@ -84,14 +85,51 @@ fn coverage(radius: f32, d: f32, aspect: f32) -> f32 {
     if c.is_finite() { c.min(1.0) } else { 1.0 }
 }
 
-/// Runs `lodkit lod`. Exit 0 on success, 1 when the file or a mesh in it is unusable, 2 for
+/// Runs `lodkit lod` on a file, or on every glTF file of a folder ([`folder::run`]). Exit 0 on
+/// success, 1 when the file or a mesh in it is unusable (a folder: when any file failed), 2 for
 /// I/O errors.
 pub fn run(args: &LodArgs) -> ExitCode {
+    if args.input.is_dir() {
+        return folder::run(args);
+    }
     let file = args.input.display().to_string();
-    let fail = |code: u8, message: String| {
-        output::eprintln(&format!("error: {file}: {message}"));
-        ExitCode::from(code)
+    let mut warn = |w: String| output::eprintln(&format!("warning: {file}: {w}"));
+    let reports = match convert(args, &mut warn) {
+        Ok(r) => r,
+        Err((code, message)) => {
+            output::eprintln(&format!("error: {file}: {message}"));
+            return ExitCode::from(code);
+        }
     };
+    let mut stdout = Output::default();
+    for r in &reports {
+        stdout.println(&table(r));
+    }
+    stdout.println(&format!("wrote {}", args.output.display()));
+    if let Some(path) = &args.report {
+        let report = Report {
+            input: file.clone(),
+            output: args.output.display().to_string(),
+            pixel_error: args.pixel_error,
+            fov_y_degrees: args.fov_y_degrees,
+            viewport_height: args.viewport_height,
+            aspect: args.aspect,
+            meshes: reports,
+        };
+        let text = serde_json::to_string_pretty(&report).expect("a report is JSON");
+        if let Err(e) = std::fs::write(path, text) {
+            output::eprintln(&format!("error: cannot write `{}`: {e}", path.display()));
+            return ExitCode::from(2);
+        }
+    }
+    stdout.finish(ExitCode::SUCCESS)
+}
+
+/// Writes the chains of `args.input` into `args.output` and returns the meshes' reports, or
+/// the exit code and the error (1: the file or a mesh is unusable, 2: I/O); each warning goes
+/// to `warn`.
+fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshReport>, (u8, String)> {
+    let fail = |code: u8, message: String| Err((code, message));
     let camera = PixelErrorCamera {
         fov_y: args.fov_y_degrees.to_radians(),
         viewport_height: args.viewport_height,
@@ -138,11 +176,11 @@ pub fn run(args: &LodArgs) -> ExitCode {
     // Images beside the input go into the output's buffer: it is whole wherever it is written.
     let base = args.input.parent().unwrap_or(Path::new("."));
     let embedded = out.embed_images(base);
-    for w in &embedded.warnings {
-        output::eprintln(&format!("warning: {file}: {w}"));
+    for w in embedded.warnings {
+        warn(w);
     }
     for w in copy_beside(base, &args.output, &embedded.copies) {
-        output::eprintln(&format!("warning: {file}: {w}"));
+        warn(w);
     }
     // Every mesh's chain first: an object's meshes share their distances.
     let mut planned = Vec::new();
@@ -180,7 +218,7 @@ pub fn run(args: &LodArgs) -> ExitCode {
             Err(e) => return fail(1, format!("{label}: {e}")),
         };
         for w in &warnings {
-            output::eprintln(&format!("warning: {file}: {label}: {w}"));
+            warn(format!("{label}: {w}"));
         }
         let report = MeshReport {
             mesh: mesh.index(),
@@ -248,27 +286,7 @@ pub fn run(args: &LodArgs) -> ExitCode {
     if let Err(e) = out.write(&args.output) {
         return fail(2, e);
     }
-    let mut stdout = Output::default();
-    for r in &reports {
-        stdout.println(&table(r));
-    }
-    stdout.println(&format!("wrote {}", args.output.display()));
-    if let Some(path) = &args.report {
-        let report = Report {
-            input: file.clone(),
-            output: args.output.display().to_string(),
-            pixel_error: args.pixel_error,
-            fov_y_degrees: args.fov_y_degrees,
-            viewport_height: args.viewport_height,
-            aspect: args.aspect,
-            meshes: reports,
-        };
-        let text = serde_json::to_string_pretty(&report).expect("a report is JSON");
-        if let Err(e) = std::fs::write(path, text) {
-            return fail(2, format!("cannot write `{}`: {e}", path.display()));
-        }
-    }
-    stdout.finish(ExitCode::SUCCESS)
+    Ok(reports)
 }
 
 /// The mesh's levels: level i is level i of every primitive's chain (its last where it has

@@ -190,9 +190,12 @@ enum Command {
     /// bounded) and write it back with `MSFT_lod`: levels as nodes, switch points as
     /// `MSFT_screencoverage` for the reference camera. Prints a table per mesh.
     Lod {
-        /// The glTF (.gltf) or GLB (.glb) file.
+        /// The glTF (.gltf) or GLB (.glb) file; or a folder: every such file below it, in
+        /// parallel, each written to the same relative path below the output folder (exit 1
+        /// when any file failed, the others written all the same).
         input: PathBuf,
-        /// Output file: .glb, or .gltf with its buffer in <stem>.bin beside it.
+        /// Output file: .glb, or .gltf with its buffer in <stem>.bin beside it; a folder when
+        /// the input is one.
         #[arg(short, long)]
         output: PathBuf,
         /// Largest screen-space deviation from the original, in pixels of the reference camera.
@@ -219,7 +222,7 @@ enum Command {
         /// Fail on a mesh too small to simplify instead of keeping it as a single level.
         #[arg(long)]
         strict: bool,
-        /// Also write the table as JSON.
+        /// Also write the table as JSON (for a folder: every file's, with its status).
         #[arg(long, value_name = "FILE")]
         report: Option<PathBuf>,
         /// Give each mesh switch distances of its own (by default the meshes under one

@@ -10,14 +10,14 @@ use crate::cli::run;
 use crate::support::Scratch;
 
 /// A mesh to write: positions, optional indices, optional RGBA8 colors, primitive mode.
-struct Fixture {
+pub(crate) struct Fixture {
     positions: Vec<[f32; 3]>,
     indices: Option<Vec<u32>>,
     colors: bool,
     mode: u32,
 }
 
-fn sphere(rings: u32, segments: u32) -> Fixture {
+pub(crate) fn sphere(rings: u32, segments: u32) -> Fixture {
     let (positions, indices) = lodkit::lod_chain::uv_sphere(rings, segments);
     Fixture {
         positions,
@@ -28,7 +28,12 @@ fn sphere(rings: u32, segments: u32) -> Fixture {
 }
 
 /// Writes `name`.gltf and `name`.bin into `dir`; `edit` may change the JSON before it is saved.
-fn write_gltf(dir: &Path, name: &str, f: &Fixture, edit: impl FnOnce(&mut serde_json::Value)) {
+pub(crate) fn write_gltf(
+    dir: &Path,
+    name: &str,
+    f: &Fixture,
+    edit: impl FnOnce(&mut serde_json::Value),
+) {
     let mut bin: Vec<u8> = f
         .positions
         .iter()
@@ -107,7 +112,7 @@ fn triangles(mesh: &gltf::Mesh, buffers: &[gltf::buffer::Data]) -> usize {
 
 /// Checks the output the way a second reader sees it: LOD0's node carries `MSFT_lod` with the
 /// level nodes in order (fewer triangles each), one decreasing screen coverage per level.
-fn assert_levels_in_order(path: &Path, levels: usize) {
+pub(crate) fn assert_levels_in_order(path: &Path, levels: usize) {
     let (doc, buffers, _) = gltf::import(path).unwrap();
     assert!(doc.extensions_used().any(|e| e == "MSFT_lod"));
     let lod0 = doc.nodes().next().unwrap();

@@ -18,6 +18,7 @@ mod gpu_report;
 mod impostor;
 mod lod;
 mod lod_compressed;
+mod lod_folder;
 mod lod_images;
 mod lod_objects;
 mod npm_package;

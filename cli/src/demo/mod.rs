@@ -102,69 +102,6 @@ impl Default for DemoOptions {
     }
 }
 
-/// Progress of a run on stderr: a bar on a terminal; elsewhere (a CI log, a pipe, where a bar
-/// is not drawn) a line per part with the seconds since the start, so a log shows where the
-/// time goes.
-struct Progress {
-    bar: indicatif::ProgressBar,
-    lines: bool,
-    start: std::time::Instant,
-}
-
-impl Progress {
-    fn new(enabled: bool, steps: usize) -> Self {
-        use std::io::IsTerminal;
-        let terminal = std::io::stderr().is_terminal();
-        let bar = if enabled && terminal {
-            indicatif::ProgressBar::new(steps as u64)
-        } else {
-            indicatif::ProgressBar::hidden()
-        };
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {bar:32} {pos}/{len} {msg}",
-        ) {
-            bar.set_style(style);
-        }
-        Self {
-            bar,
-            lines: enabled && !terminal,
-            start: std::time::Instant::now(),
-        }
-    }
-
-    /// The part that starts now.
-    fn set_message(&self, message: impl Into<String>) {
-        let message = message.into();
-        if self.lines {
-            let seconds = self.start.elapsed().as_secs_f64();
-            eprintln!("[{seconds:7.1} s] {message}");
-        }
-        self.bar.set_message(message);
-    }
-
-    fn inc(&self, n: u64) {
-        self.bar.inc(n);
-    }
-
-    /// A step that has just ended.
-    fn done(&self, message: String) {
-        if self.lines {
-            let seconds = self.start.elapsed().as_secs_f64();
-            eprintln!("[{seconds:7.1} s] {message}: done");
-        }
-        self.bar.set_message(message);
-        self.bar.inc(1);
-    }
-
-    fn finish(&self) {
-        if self.lines {
-            let seconds = self.start.elapsed().as_secs_f64();
-            eprintln!("[{seconds:7.1} s] done");
-        }
-        self.bar.finish_and_clear();
-    }
-}
-
 /// The most memory the frames of one run may take.
 pub const MAX_FRAME_MEMORY_MIB: u64 = 2048;
 
@@ -252,7 +189,7 @@ pub fn run_on(
     std::fs::create_dir_all(out).map_err(|e| DemoError::io(out, e))?;
     let steps =
         scenes.len() * render::Technique::ALL.len() + upsample_quality::RESIZE_FACTORS.len() + 7;
-    let bar = Progress::new(options.progress, steps);
+    let bar = crate::progress::Progress::new(options.progress, steps);
     let mut transitions = Vec::new();
     let mut counter = String::new();
     for scene in scenes {
