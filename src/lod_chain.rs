@@ -220,6 +220,7 @@ pub struct LodChainLevel {
     error: f32,
     simplifier: Simplifier,
     simplifier_error: f32,
+    error_capped: bool,
     time: std::time::Duration,
 }
 
@@ -252,6 +253,12 @@ impl LodChainLevel {
     /// original's, object units (0 for LOD0).
     pub fn error(&self) -> f32 {
         self.error
+    }
+    /// Whether the bound's work was capped on degenerate geometry (long slivers spanning the
+    /// mesh, where finding distances exactly would cost without limit): [`error`](Self::error)
+    /// is then still an upper bound, a looser one. False on well-shaped meshes.
+    pub fn error_capped(&self) -> bool {
+        self.error_capped
     }
     /// Which simplifier made this level.
     pub fn simplifier(&self) -> Simplifier {

@@ -44,6 +44,8 @@ struct LevelRow {
     triangles: usize,
     /// Upper bound of the Hausdorff distance from LOD0, object units.
     error: f32,
+    /// Whether that bound's work was capped on degenerate geometry (a looser upper bound).
+    error_capped: bool,
     /// View-normalized distance from which the level is used.
     switch_distance: f32,
     /// `MSFT_screencoverage` entry: below this share of the screen the next level takes over.
@@ -337,6 +339,7 @@ fn plan(
                 level: i,
                 triangles: chains.iter().map(|c| at(c, i).triangles()).sum(),
                 error: errors[i],
+                error_capped: chains.iter().any(|c| at(c, i).error_capped()),
                 switch_distance: distances[i],
                 screen_coverage: coverage(box_radius, next, args.aspect),
                 seconds: chains
@@ -367,14 +370,20 @@ fn table(r: &MeshReport) -> String {
     s.push_str("  level  triangles       error  switch distance  coverage     time\n");
     for l in &r.levels {
         s.push_str(&format!(
-            "  {:>5}  {:>9}  {:>10.6}  {:>15.4}  {:>8.5}  {:>5.0} ms\n",
+            "  {:>5}  {:>9}  {:>10.6}{} {:>15.4}  {:>8.5}  {:>5.0} ms\n",
             l.level,
             l.triangles,
             l.error,
+            if l.error_capped { "*" } else { " " },
             l.switch_distance,
             l.screen_coverage,
             l.seconds * 1e3
         ));
+    }
+    if r.levels.iter().any(|l| l.error_capped) {
+        s.push_str(
+            "  * capped on degenerate geometry (long slivers): an upper bound, a looser one\n",
+        );
     }
     s.trim_end().to_owned()
 }

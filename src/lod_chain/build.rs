@@ -119,8 +119,9 @@ pub(super) fn build(
         if indices.is_empty() || !fewer {
             break;
         }
-        let error = level_bound(positions, mesh.indices, &original, &indices, tolerance);
+        let (error, capped) = level_bound(positions, mesh.indices, &original, &indices, tolerance);
         let mut level = make_level(mesh, &indices, error, simplifier, result_error * scale);
+        level.error_capped = capped;
         level.time = started.elapsed();
         levels.push(level);
         current = indices;
@@ -136,18 +137,20 @@ pub(super) fn build(
 }
 
 /// Upper bound of the two-sided Hausdorff distance between the original and `level` (both index
-/// the same vertex buffer).
+/// the same vertex buffer), and whether its work was capped (a looser upper bound).
 fn level_bound(
     positions: &[[f32; 3]],
     original_indices: &[u32],
     original: &Surface,
     level: &[u32],
     tolerance: Tolerance,
-) -> f32 {
+) -> (f32, bool) {
+    let capped_before = original.capped();
     let to_original = directed_bound(positions, level, original, tolerance);
     let simplified = Surface::new(positions, level);
     let to_level = directed_bound(positions, original_indices, &simplified, tolerance);
-    round_up_f32(to_original.max(to_level))
+    let capped = original.capped() > capped_before || simplified.capped() > 0;
+    (round_up_f32(to_original.max(to_level)), capped)
 }
 
 /// A level from `indices` into the original vertices: vertex-cache order, then a compact vertex
@@ -183,6 +186,7 @@ fn make_level(
         error,
         simplifier,
         simplifier_error,
+        error_capped: false,
         time: std::time::Duration::ZERO,
     }
 }

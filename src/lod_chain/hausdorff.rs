@@ -32,6 +32,7 @@ use glam::DVec3;
 use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
 /// A triangle of the target surface in the R-tree.
+#[derive(Clone)]
 struct Tri {
     a: DVec3,
     b: DVec3,
@@ -102,18 +103,50 @@ pub(crate) fn point_triangle_distance2(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -
         .min(point_segment_distance2(p, c, a))
 }
 
+/// A vertex of the target surface and one triangle it is a corner of: the nearest vertex's
+/// triangle is an upper bound of the distance that costs no more on slivers than elsewhere.
+struct Corner {
+    at: [f64; 3],
+    tri: Tri,
+}
+
+impl RTreeObject for Corner {
+    type Envelope = AABB<[f64; 3]>;
+    fn envelope(&self) -> Self::Envelope {
+        AABB::from_point(self.at)
+    }
+}
+
+impl PointDistance for Corner {
+    fn distance_2(&self, point: &[f64; 3]) -> f64 {
+        DVec3::from(self.at).distance_squared(DVec3::from(*point))
+    }
+}
+
+/// The most triangle boxes a point may lie in for the exact nearest-triangle search: past it
+/// (long slivers spanning the mesh: a triangle list read as a fan, positions read from the
+/// wrong place) the search would weigh much of the mesh for every point, and the distance is
+/// bounded instead by the nearest vertex's triangle and the first of those boxes' triangles
+/// (an upper bound still; the bound is then reported as capped).
+const NEAREST_OVERLAP: usize = 64;
+
 /// A triangle mesh to measure distances to.
 pub(crate) struct Surface {
     tree: RTree<Tri>,
+    /// Each vertex used, with a triangle it is a corner of.
+    corners: RTree<Corner>,
     /// Which vertices the triangles use (`d = 0` there).
     vertices: Vec<bool>,
+    /// Distances bounded rather than found ([`NEAREST_OVERLAP`]), and bounds whose budget ran
+    /// out ([`BUDGET_PER_TRIANGLE`]): the work capped on this surface so far.
+    capped: std::sync::atomic::AtomicUsize,
 }
 
 impl Surface {
     /// The triangles `indices` of `positions` (indices already checked).
     pub(crate) fn new(positions: &[[f32; 3]], indices: &[u32]) -> Self {
         let p = |i: u32| DVec3::from(positions[i as usize].map(f64::from));
-        let tris = indices
+        let tris: Vec<Tri> = indices
             .chunks_exact(3)
             .map(|t| {
                 let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
@@ -127,13 +160,33 @@ impl Surface {
             })
             .collect();
         let mut vertices = vec![false; positions.len()];
-        for &i in indices {
-            vertices[i as usize] = true;
+        let mut corners = Vec::new();
+        for (t, tri) in indices.chunks_exact(3).zip(&tris) {
+            for &i in t {
+                if !std::mem::replace(&mut vertices[i as usize], true) {
+                    corners.push(Corner {
+                        at: p(i).to_array(),
+                        tri: tri.clone(),
+                    });
+                }
+            }
         }
         Surface {
             tree: RTree::bulk_load(tris),
+            corners: RTree::bulk_load(corners),
             vertices,
+            capped: std::sync::atomic::AtomicUsize::new(0),
         }
+    }
+
+    /// How much work was capped on this surface so far (see the field).
+    pub(crate) fn capped(&self) -> usize {
+        self.capped.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    pub(super) fn note_capped(&self) {
+        self.capped
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// Its number of triangles.
@@ -164,8 +217,30 @@ impl Surface {
 
     /// Distance from `p` to the surface and the nearest triangle (+inf and `None` for an empty
     /// surface).
+    /// Where the boxes of more than [`NEAREST_OVERLAP`] triangles hold `p`, an upper bound of
+    /// that distance and a triangle at most that far (noted as capped).
     fn nearest(&self, p: DVec3) -> Sample<'_> {
-        match self.tree.nearest_neighbor(&p.to_array()) {
+        let point = AABB::from_point(p.to_array());
+        let overlap = self
+            .tree
+            .locate_in_envelope_intersecting(&point)
+            .take(NEAREST_OVERLAP + 1)
+            .count();
+        let found = if overlap <= NEAREST_OVERLAP {
+            self.tree.nearest_neighbor(&p.to_array())
+        } else {
+            self.note_capped();
+            let corner = self.corners.nearest_neighbor(&p.to_array()).map(|c| &c.tri);
+            corner
+                .into_iter()
+                .chain(
+                    self.tree
+                        .locate_in_envelope_intersecting(&point)
+                        .take(NEAREST_OVERLAP),
+                )
+                .min_by(|a, b| a.distance2(p).total_cmp(&b.distance2(p)))
+        };
+        match found {
             Some(t) => Sample {
                 at: p,
                 distance: t.distance(p),
@@ -209,12 +284,13 @@ const MARGIN: f64 = 0.05;
 
 /// Candidate triangles a bound may weigh in partitions, per triangle of the source and the
 /// target together. The meshes `lodkit lod` was run on here weigh 1 to 20 per triangle (the
-/// sample scene's ball, tree and ring, every level, both directions); long slivers spanning the
-/// mesh (a triangle list read as a fan) weigh much of the target in every partition and every
+/// sample scene's ball, tree and ring, every level, both directions; Bevy's 28 sample models
+/// bound exactly as with 256); long slivers spanning the mesh (a triangle list read as a fan,
+/// positions read from the wrong place) weigh much of the target in every partition and every
 /// cut of a refinement (1,500 per triangle, 31 s for a level of a 57,598-triangle fan). Past
 /// the budget a triangle keeps the Lipschitz and convexity bounds it has (upper bounds still,
-/// looser) and nothing is refined further (that fan's level: 6 s).
-const BUDGET_PER_TRIANGLE: u64 = 256;
+/// looser) and nothing is refined further; the surface notes the bound as capped.
+const BUDGET_PER_TRIANGLE: u64 = 64;
 
 /// What is left of a bound's budget of candidate triangles ([`BUDGET_PER_TRIANGLE`]).
 struct Budget(std::sync::atomic::AtomicU64);
@@ -362,6 +438,7 @@ pub(crate) fn directed_bound_within(
             .max(centre.map_or(0.0, |c| c.distance));
         let Some(candidates) = budget.candidates(target, &corners, 2.0 * local + MARGIN * longest)
         else {
+            target.note_capped();
             return best;
         };
         match partition::partition_bound(corners, &candidates) {
@@ -384,6 +461,7 @@ pub(crate) fn directed_bound_within(
     for k in open {
         let (bound, at) = first[k];
         if budget.exhausted() {
+            target.note_capped();
             // No refinement left to pay for: the first bound (an upper bound) stands.
             reported = reported.max(bound);
             continue;

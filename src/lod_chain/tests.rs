@@ -436,3 +436,57 @@ fn a_bound_past_its_budget_is_still_an_upper_bound() {
         "the coarse sphere is not the fine one: {measured}"
     );
 }
+
+/// A sphere's triangle list read as a fan (what a wrong primitive mode makes: long slivers from
+/// one vertex across the whole sphere): its chain is built with the bound's work capped, the
+/// level says so, its bound is still at least the distance from each side's vertices and
+/// triangle centroids to the other side (points of the surfaces, found by brute force), and a
+/// well-shaped mesh's levels are never capped. Tried against a throwaway edit that counts no
+/// cap (fails on `error_capped`).
+#[test]
+fn degenerate_geometry_caps_the_bound_and_says_so() {
+    let (p, list) = uv_sphere(12, 24);
+    let fan: Vec<u32> = (1..list.len() - 1)
+        .flat_map(|k| [list[0], list[k], list[k + 1]])
+        .collect();
+    let descriptor = LodChainDescriptor {
+        levels: 2,
+        ..Default::default()
+    };
+    let mesh = MeshData {
+        positions: &p,
+        indices: &fan,
+        normals: None,
+        uvs: None,
+    };
+    let chain = LodChain::build(&mesh, &descriptor).unwrap();
+    let level = &chain.levels()[1];
+    assert!(level.error_capped(), "the fan's bound is capped");
+    // Points of a surface: its vertices and its triangles' centroids.
+    let points = |p: &[[f32; 3]], idx: &[u32]| -> Vec<DVec3> {
+        let v = |k: u32| DVec3::from(p[k as usize].map(f64::from));
+        idx.iter()
+            .map(|&k| v(k))
+            .chain(
+                idx.chunks_exact(3)
+                    .map(|t| (v(t[0]) + v(t[1]) + v(t[2])) / 3.0),
+            )
+            .collect()
+    };
+    let (lp, li) = (level.positions(), level.indices());
+    let measured =
+        directed_max(&points(lp, li), &p, &fan).max(directed_max(&points(&p, &fan), lp, li));
+    assert!(
+        f64::from(level.error()) >= measured,
+        "capped bound {} below the measured {measured}",
+        level.error()
+    );
+    let list_mesh = MeshData {
+        positions: &p,
+        indices: &list,
+        normals: None,
+        uvs: None,
+    };
+    let chain = LodChain::build(&list_mesh, &LodChainDescriptor::default()).unwrap();
+    assert!(chain.levels().iter().all(|l| !l.error_capped()));
+}

@@ -53,7 +53,11 @@ pub(super) fn refine<'a>(
         }
     }
     // Past the budget the piece keeps the bound it has: cutting it would weigh more.
-    if bound <= *lb + tolerance.slack(*lb) || depth >= MAX_DEPTH || spent {
+    let within = bound <= *lb + tolerance.slack(*lb);
+    if within || depth >= MAX_DEPTH || spent {
+        if !within {
+            target.note_capped();
+        }
         return bound;
     }
     let m = [
