@@ -370,8 +370,9 @@ what each LOD alone covers at that frame: see-through / ghost pixel-frames. \
 `TransitionScheduler::new()` (the complementary schedule), `CombinePassDescriptor::default()`, \
 the pattern on the screen, each level registered once in `CoverageLevels` (a closed mesh by its \
 surface, an impostor card by its mask's outline) and the frame's data from \
-`CoverageLevels::data` with a default `CoverageFrame`; `frame-seq-silhouettes` the same route \
-with the paper's Fig. 2 schedule.\n";
+`CoverageLevels::data` with a default `CoverageFrame` (a scene with a swaying impostor card, \
+which has no exact silhouette, names the estimate for it); `frame-seq-silhouettes` the same \
+route with the paper's Fig. 2 schedule.\n";
 
 /// Writes `benchmarks.md` and `quality.md` into `docs`.
 pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
