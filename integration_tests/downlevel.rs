@@ -163,10 +163,12 @@ fn the_binding_layout_capability_says_what_the_device_does() {
 
 /// What each pass binds, read off `shader_lib/passes/*.wgsl` (no shader defs): whether it needs
 /// several textures or uniform buffers in one pipeline, and whether it is a compute pass.
-const PASSES: [(&str, bool, bool); 7] = [
+const PASSES: [(&str, bool, bool); 9] = [
     ("blit", false, false),           // 1 texture + its sampler
     ("combine", true, false),         // 7 textures, 1 uniform buffer
     ("gbuffer_mesh", true, false),    // 2 uniform buffers
+    ("impostor", true, false),        // 2 textures, 1 uniform buffer
+    ("impostor_bake", false, false),  // 1 texture, 1 uniform buffer
     ("lod_buffer_mesh", true, false), // 2 textures, 2 uniform buffers
     ("lod_mesh", true, false),        // 1 texture, 2 uniform buffers
     ("select", false, true),          // compute, storage buffers

@@ -281,10 +281,16 @@ pub fn run_on(
         let wesl = lodkit::shaders::naga_oil_to_wesl(&source, "", "")
             .unwrap_or_else(|e| panic!("the probe has no WESL form: {e}\n{source}"));
         let wesl_words = run(&wesl, SourceLanguage::Wesl);
-        assert!(
-            wesl_words == words,
-            "the WESL modules compute other results than the naga_oil modules (defs {defs:?})\n{wesl}"
-        );
+        if let Some(k) = (0..words.len()).find(|&k| wesl_words.get(k) != words.get(k)) {
+            panic!(
+                "the WESL modules compute other results than the naga_oil modules (defs {defs:?}): \
+                 first at case {} word {}: {:#x} vs {:#x}\n{wesl}",
+                k / probe.outputs,
+                k % probe.outputs,
+                wesl_words.get(k).copied().unwrap_or_default(),
+                words[k]
+            );
+        }
     }
     words
 }

@@ -26,6 +26,8 @@ mod gpu_twins;
 mod harness;
 mod host_errors;
 mod house;
+mod impostor;
+mod impostor_render;
 mod lod_chain;
 mod object_motion;
 mod older_threshold;

@@ -19,6 +19,9 @@
 //!   [`silhouette`]: where the level not drawn this frame covers the screen, from its mesh's
 //!   silhouette (no rasterization); [`combine_coverage`]: the combine that reads the older
 //!   level where its silhouette (or a depth pass) says it covers the pixel.
+//! - [`impostor`]: octahedral impostors, the last level of a chain: Rust twins of
+//!   `lodkit::impostor`, the atlas layout, the CPU steps of a bake and the switch distance with
+//!   a pixel bound (the bake itself: `gpu::impostor`, feature `wgpu`).
 //! - [`noise`]: seeded blue-noise (void-and-cluster) and white-noise patterns.
 //! - [`metrics`]: how a transition looks on read-back frames: pop, flicker (change over net
 //!   change, direction reversals), PSNR, medians.
@@ -54,6 +57,7 @@ pub mod frame_sequential;
 pub mod framebuffer_lod;
 pub mod fullscreen;
 pub mod gbuffer;
+pub mod impostor;
 pub mod lod_buffer;
 pub mod metrics;
 pub mod noise;

@@ -45,7 +45,7 @@
 use thiserror::Error;
 
 mod coverage;
-pub use coverage::{ghosts, see_through};
+pub use coverage::{coverage_distance, ghosts, see_through};
 
 /// A pixel's step smaller than this in every channel (in 8-bit levels) is not a direction: it
 /// neither counts as a reversal nor sets the direction a later step reverses (rounding in a renderer's
@@ -81,7 +81,7 @@ pub enum MetricsError {
     /// A coverage mask ([`see_through`], [`ghosts`]) with another pixel count than `fine`.
     #[error("the {what} mask has {len} pixels where the fine one has {expected}")]
     MaskMismatch {
-        /// "coarse" or "shown".
+        /// "coarse" or "shown" (or, for [`coverage_distance`], "first" or "second").
         what: &'static str,
         /// Its length in pixels.
         len: usize,

@@ -7,7 +7,8 @@
 //! - [`lod_buffer`]: the forward pass into frame-sequential LOD's LOD buffers (color, depth, ids,
 //!   motion);
 //! - [`gbuffer`]: the low-resolution (or full-resolution prepass) G-buffer pass of framebuffer
-//!   LOD, and the edge scene its measures use.
+//!   LOD, and the edge scene its measures use;
+//! - [`tree`]: a tree with alpha-masked leaf cards, what impostors are baked from.
 
 #![warn(missing_docs)]
 
@@ -15,3 +16,4 @@ pub mod gbuffer;
 pub mod lod_buffer;
 pub mod mesh;
 pub mod transition;
+pub mod tree;

@@ -13,6 +13,7 @@ pub mod counters;
 mod error;
 pub mod frame_sequential;
 pub mod framebuffer_lod;
+pub mod impostor;
 pub mod readback;
 pub mod resources;
 pub mod select;

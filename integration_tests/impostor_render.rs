@@ -1,0 +1,343 @@
+//! An impostor baked from a tree with alpha-masked leaves and drawn by `passes/impostor.wgsl`,
+//! held to the mesh drawn from the same camera: from directions between the atlas's frames (the
+//! centroids of grid triangles, where a view is farthest from the frames it blends), at the
+//! switch distance for a pixel error `p`, the two pictures' outlines stay within `p` pixels of
+//! each other (`lodkit::metrics::coverage_distance`).
+
+use glam::{Mat4, UVec2, Vec2, Vec3};
+use lodkit::gpu::GpuContext;
+use lodkit::gpu::impostor::{
+    ImpostorBakeDescriptor, ImpostorBaker, ImpostorInstance, ImpostorMaterial, ImpostorMesh,
+    ImpostorPart, ImpostorPass, ImpostorPassDescriptor, ImpostorTexture, ImpostorTextures,
+    ImpostorView,
+};
+use lodkit::gpu::readback::read_texture_rgba8;
+use lodkit::impostor::{
+    ImpostorShape, impostor_decode, impostor_frame_dir, impostor_switch_distance,
+};
+use lodkit::lod_chain::PixelErrorCamera;
+use lodkit::metrics::coverage_distance;
+use lodkit_scenes::tree::{LeafyTree, TREE_TEXTURE_SIZE};
+
+/// Target side in pixels.
+const SIZE: u32 = 256;
+/// Vertical field of view.
+const FOV: f32 = 30.0;
+/// The pixel error the switch distance is derived for.
+const PIXELS: f32 = 4.0;
+
+/// Views between frames: the centroids of the grid triangles around these cells (lower and
+/// upper triangle of each), from near the horizon to near the top, plus one view on a frame.
+fn views(frames: u32) -> Vec<Vec3> {
+    let at = |g: Vec2| impostor_decode(g * (2.0 / (frames - 1) as f32) - 1.0, true);
+    let mut out = Vec::new();
+    for cell in [
+        UVec2::new(0, 3),
+        UVec2::new(2, 1),
+        UVec2::new(3, 3),
+        UVec2::new(5, 2),
+        UVec2::new(4, 6),
+    ] {
+        let c = cell.as_vec2();
+        out.push(at(c + Vec2::splat(1.0 / 3.0)));
+        out.push(at(c + Vec2::splat(2.0 / 3.0)));
+    }
+    out.push(impostor_frame_dir(UVec2::new(4, 8), frames, true));
+    out
+}
+
+/// The camera at `distance` from `center` along `view`.
+fn clip_from_world(center: Vec3, view: Vec3, distance: f32) -> Mat4 {
+    let eye = center + view * distance;
+    let up = if view.y.abs() > 0.95 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    let v = glam::camera::rh::view::look_at_mat4(eye, center, up);
+    let p = glam::camera::rh::proj::directx::perspective(
+        FOV.to_radians(),
+        1.0,
+        distance * 0.05,
+        distance * 3.0,
+    );
+    p * v
+}
+
+/// Pixels covered in an impostor drawn with `clip` from `eye`.
+fn impostor_coverage(
+    gpu: &GpuContext,
+    pass: &ImpostorPass,
+    textures: &ImpostorTextures,
+    clip: Mat4,
+    eye: Vec3,
+) -> Vec<bool> {
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let color = lodkit::gpu::resources::texture_2d(
+        gpu,
+        (SIZE, SIZE),
+        wgpu::TextureFormat::Rgba8Unorm,
+        usage,
+        "impostor test",
+    )
+    .unwrap();
+    let depth = lodkit::gpu::resources::texture_2d(
+        gpu,
+        (SIZE, SIZE),
+        wgpu::TextureFormat::Depth32Float,
+        usage,
+        "impostor test depth",
+    )
+    .unwrap();
+    let view = ImpostorView {
+        view_proj: clip,
+        eye,
+        light: Vec3::new(0.3, 0.8, 0.5).normalize(),
+        ambient: 0.4,
+    };
+    let prepared = pass
+        .prepare(
+            gpu,
+            textures,
+            &view,
+            &[ImpostorInstance {
+                model: Mat4::IDENTITY,
+            }],
+        )
+        .unwrap();
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    {
+        let color_view = color.create_view(&Default::default());
+        let depth_view = depth.create_view(&Default::default());
+        let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("impostor test"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.draw(&mut rp, &prepared);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    read_texture_rgba8(gpu, &color)
+        .unwrap()
+        .chunks(4)
+        .map(|p| p[3] > 127)
+        .collect()
+}
+
+/// The largest outline distance, in pixels, between mesh and impostor over `views` at
+/// `distance` (object units from the centre), and the pixels the mesh covers in the first view.
+fn worst_distance(
+    gpu: &GpuContext,
+    baker: &ImpostorBaker,
+    pass: &ImpostorPass,
+    textures: &ImpostorTextures,
+    views: &[Vec3],
+    distance: f32,
+) -> (f32, usize) {
+    let center = Vec3::from(textures.layout.center);
+    let mut worst = 0.0f32;
+    let mut covered = 0;
+    for (k, view) in views.iter().enumerate() {
+        let clip = clip_from_world(center, *view, distance);
+        let mesh: Vec<bool> = baker
+            .render(gpu, clip, SIZE, SIZE)
+            .unwrap()
+            .iter()
+            .map(|t| t[3] > 0.5)
+            .collect();
+        if k == 0 {
+            covered = mesh.iter().filter(|c| **c).count();
+        }
+        let imp = impostor_coverage(gpu, pass, textures, clip, center + *view * distance);
+        let d = coverage_distance(&mesh, &imp, SIZE as usize).unwrap();
+        crate::harness::say(&format!("  view {k} {view:?} at {distance:.2}: {d:.2} px"));
+        worst = worst.max(d);
+    }
+    (worst, covered)
+}
+
+#[test]
+fn impostor_stays_within_the_pixel_bound_between_frames() {
+    let gpu = lodkit_test_gpu!();
+    let tree = LeafyTree::new(40, 7);
+    let mesh = ImpostorMesh {
+        positions: &tree.positions,
+        indices: &tree.indices,
+        normals: Some(&tree.normals),
+        uvs: Some(&tree.uvs),
+    };
+    let material = ImpostorMaterial {
+        base_color_texture: Some(ImpostorTexture {
+            width: TREE_TEXTURE_SIZE,
+            height: TREE_TEXTURE_SIZE,
+            rgba8: &tree.texture,
+        }),
+        alpha_cutoff: Some(0.5),
+        double_sided: true,
+        ..Default::default()
+    };
+    // The defaults: 12 x 12 frames of 128 texels, hemisphere.
+    let descriptor = ImpostorBakeDescriptor::default();
+    assert_eq!(descriptor.shape, ImpostorShape::Hemi);
+    let baker = ImpostorBaker::new(gpu, &[ImpostorPart { mesh, material }]).unwrap();
+    let atlas = baker.bake(gpu, &descriptor).unwrap();
+    let textures = ImpostorTextures::new(gpu, &atlas).unwrap();
+    let pass = ImpostorPass::new(
+        gpu,
+        &ImpostorPassDescriptor {
+            color_format: wgpu::TextureFormat::Rgba8Unorm,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let camera = PixelErrorCamera {
+        fov_y: FOV.to_radians(),
+        viewport_height: SIZE as f32,
+        pixel_error: PIXELS,
+        hysteresis: 0.0,
+    };
+    let normalized = impostor_switch_distance(&atlas.layout, &camera).unwrap();
+    let distance = normalized * camera.p11() as f32;
+    let views = views(descriptor.frames);
+    let (at_switch, covered) = worst_distance(gpu, &baker, &pass, &textures, &views, distance);
+    let (nearer, _) = worst_distance(gpu, &baker, &pass, &textures, &views, distance * 0.5);
+    crate::harness::say(&format!(
+        "switch distance {distance:.2} (radius {:.2}): worst {at_switch:.2} px, {covered} px covered; at half: {nearer:.2} px",
+        atlas.layout.radius
+    ));
+    assert!(
+        covered >= 100,
+        "the tree covers only {covered} pixels: nothing to compare"
+    );
+    assert!(
+        at_switch <= PIXELS,
+        "at its switch distance the impostor's outline is {at_switch} px from the mesh's (bound {PIXELS})"
+    );
+    assert!(
+        nearer > PIXELS,
+        "at half the switch distance the outline is still within {PIXELS} px ({nearer}): the bound is loose"
+    );
+}
+
+/// Bad input is an error naming the field and the part, before any GPU work; nothing panics.
+#[test]
+fn the_bake_refuses_bad_input_by_name() {
+    let gpu = lodkit_test_gpu!();
+    let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let good = ImpostorMesh {
+        positions: &positions,
+        indices: &[0, 1, 2],
+        ..Default::default()
+    };
+    let expect = |parts: &[ImpostorPart], descriptor: &ImpostorBakeDescriptor, field: &str| {
+        let result = ImpostorBaker::new(gpu, parts).and_then(|b| b.bake(gpu, descriptor));
+        match result {
+            Err(lodkit::gpu::GpuError::Invalid {
+                parameter, value, ..
+            }) => {
+                assert_eq!(parameter, field, "{value}")
+            }
+            other => panic!("{field}: {other:?}"),
+        }
+    };
+    let d = ImpostorBakeDescriptor::default();
+    expect(&[], &d, "parts");
+    let part = |mesh, material| ImpostorPart { mesh, material };
+    let m = ImpostorMaterial::default();
+    expect(
+        &[
+            part(good, m),
+            part(
+                ImpostorMesh {
+                    indices: &[0, 1, 3],
+                    ..good
+                },
+                m,
+            ),
+        ],
+        &d,
+        "mesh.indices",
+    );
+    expect(
+        &[part(
+            ImpostorMesh {
+                indices: &[0, 1],
+                ..good
+            },
+            m,
+        )],
+        &d,
+        "mesh",
+    );
+    let nan = [[f32::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    expect(
+        &[part(
+            ImpostorMesh {
+                positions: &nan,
+                ..good
+            },
+            m,
+        )],
+        &d,
+        "mesh.positions",
+    );
+    let normals = [[0.0, 0.0, 1.0]];
+    expect(
+        &[part(
+            ImpostorMesh {
+                normals: Some(&normals),
+                ..good
+            },
+            m,
+        )],
+        &d,
+        "mesh.normals",
+    );
+    let short = ImpostorMaterial {
+        base_color_texture: Some(ImpostorTexture {
+            width: 2,
+            height: 2,
+            rgba8: &[255; 12],
+        }),
+        ..m
+    };
+    expect(&[part(good, short)], &d, "material.base_color_texture");
+    let odd = ImpostorBakeDescriptor {
+        frame_size: 48,
+        ..d
+    };
+    expect(&[part(good, m)], &odd, "descriptor");
+    // And a good one bakes, with a full-sphere layout too.
+    let full = ImpostorBakeDescriptor {
+        frames: 4,
+        frame_size: 8,
+        shape: ImpostorShape::Full,
+    };
+    let atlas = ImpostorBaker::new(gpu, &[part(good, m)])
+        .unwrap()
+        .bake(gpu, &full)
+        .unwrap();
+    assert_eq!(atlas.color.len(), 4);
+    assert!(
+        atlas.color[0].texels.iter().any(|t| t[3] > 0.5),
+        "the triangle is in the atlas"
+    );
+}

@@ -1,0 +1,151 @@
+//! The CPU steps of a bake: the atlas images, padding each frame's empty texels with its
+//! nearest covered texel (so filtering and mipmaps never blend the background's colour, normal
+//! or depth into the object's edge), and the mip chain that keeps frames whole.
+
+use super::ImpostorLayout;
+
+/// A square image of RGBA floats, row-major from the top row.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImpostorImage {
+    /// Texels per side.
+    pub size: u32,
+    /// `size * size` texels.
+    pub texels: Vec<[f32; 4]>,
+}
+
+impl ImpostorImage {
+    /// An image of `size x size` texels, all `value`.
+    pub fn filled(size: u32, value: [f32; 4]) -> Self {
+        Self {
+            size,
+            texels: vec![value; (size as usize) * (size as usize)],
+        }
+    }
+
+    /// The texel at column `x`, row `y`.
+    pub fn texel(&self, x: u32, y: u32) -> [f32; 4] {
+        self.texels[(y * self.size + x) as usize]
+    }
+
+    /// The texels as RGBA8 (unorm, rounded, clamped to [0, 1]).
+    pub fn to_rgba8(&self) -> Vec<u8> {
+        self.texels
+            .iter()
+            .flat_map(|t| t.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8))
+            .collect()
+    }
+}
+
+/// A baked impostor: its layout and two atlases, each with its mip chain (level 0 first, down to
+/// one texel per frame).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImpostorAtlas {
+    /// Frames, frame size, shape, bounding sphere.
+    pub layout: ImpostorLayout,
+    /// Base colour (linear) and coverage in alpha; empty texels carry their nearest covered
+    /// texel's colour with alpha 0.
+    pub color: Vec<ImpostorImage>,
+    /// Object-space normal `* 0.5 + 0.5` in rgb, the stored depth (`dot(q, dir) * 0.5 + 0.5`) in
+    /// alpha; empty texels padded as in `color`.
+    pub normal_depth: Vec<ImpostorImage>,
+}
+
+/// Pads every frame of `images` (which share one layout of `frames x frames` frames of
+/// `frame_size` texels): each texel whose coverage (`coverage`'s alpha) is 0 takes the rgb of
+/// the nearest covered texel of its own frame (4-neighbour steps, ties to the first reached),
+/// and, for images other than `coverage` itself, every channel of it. Frames with no covered
+/// texel are left as they are. Linear in the number of texels.
+pub fn dilate_frames(
+    coverage: &mut ImpostorImage,
+    others: &mut [&mut ImpostorImage],
+    frames: u32,
+    frame_size: u32,
+) {
+    let size = coverage.size as usize;
+    let fs = frame_size as usize;
+    let mut source = vec![usize::MAX; size * size];
+    let mut queue = std::collections::VecDeque::new();
+    for fy in 0..frames as usize {
+        for fx in 0..frames as usize {
+            queue.clear();
+            let (x0, y0) = (fx * fs, fy * fs);
+            for y in y0..y0 + fs {
+                for x in x0..x0 + fs {
+                    let i = y * size + x;
+                    if coverage.texels[i][3] > 0.0 {
+                        source[i] = i;
+                        queue.push_back((x, y));
+                    }
+                }
+            }
+            while let Some((x, y)) = queue.pop_front() {
+                let from = source[y * size + x];
+                let mut visit = |nx: usize, ny: usize| {
+                    let j = ny * size + nx;
+                    if source[j] == usize::MAX {
+                        source[j] = from;
+                        queue.push_back((nx, ny));
+                    }
+                };
+                if x > x0 {
+                    visit(x - 1, y);
+                }
+                if x + 1 < x0 + fs {
+                    visit(x + 1, y);
+                }
+                if y > y0 {
+                    visit(x, y - 1);
+                }
+                if y + 1 < y0 + fs {
+                    visit(x, y + 1);
+                }
+            }
+        }
+    }
+    for (i, &from) in source.iter().enumerate() {
+        if from == usize::MAX || from == i {
+            continue;
+        }
+        let c = coverage.texels[from];
+        let t = &mut coverage.texels[i];
+        *t = [c[0], c[1], c[2], t[3]];
+        for image in others.iter_mut() {
+            image.texels[i] = image.texels[from];
+        }
+    }
+}
+
+/// The mip chain of an atlas level of `frames x frames` frames of `frame_size` texels (a power
+/// of two): `image` first, then each level the 2x2 box average of the one before, down to one
+/// texel per frame, so no texel of a level straddles two frames.
+pub fn mip_chain(image: ImpostorImage, frames: u32, frame_size: u32) -> Vec<ImpostorImage> {
+    let mut levels = vec![image];
+    let mut fs = frame_size;
+    while fs > 1 {
+        fs /= 2;
+        let prev = levels.last().expect("the chain starts with one level");
+        let size = frames * fs;
+        let mut next = ImpostorImage::filled(size, [0.0; 4]);
+        for y in 0..size {
+            for x in 0..size {
+                let mut sum = [0.0f32; 4];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let t = prev.texel(2 * x + dx, 2 * y + dy);
+                    for c in 0..4 {
+                        sum[c] += t[c];
+                    }
+                }
+                next.texels[(y * size + x) as usize] = sum.map(|s| s * 0.25);
+            }
+        }
+        levels.push(next);
+    }
+    levels
+}
+
+impl ImpostorAtlas {
+    /// Mip levels of each atlas: `log2(frame_size) + 1`.
+    pub fn mip_levels(layout: &ImpostorLayout) -> u32 {
+        layout.frame_size.max(1).ilog2() + 1
+    }
+}

@@ -1,0 +1,108 @@
+//! How far an impostor's picture can be from the mesh's, and the distance beyond which that
+//! stays within a pixel bound. The derivation is in docs/impostors.md ("The switch distance").
+
+use glam::{UVec2, Vec2};
+
+use super::{ImpostorLayout, ImpostorShape, impostor_decode};
+
+/// Steps per triangle edge at which [`impostor_angle`] samples the grid.
+const ANGLE_STEPS: u32 = 16;
+
+/// The angle, in radians, within which the frames that hold at least half of a view's blend
+/// weight lie, largest over every view the grid covers (for [`ImpostorShape::Hemi`], every view
+/// from above the horizon). A coverage test at 0.5 on a weighted blend follows its weighted
+/// median, so this, not the farthest frame blended, is how far off the picture's frames are.
+/// Each grid triangle is sampled at 16 steps per edge in the map's plane, and the largest angle
+/// between neighbouring samples is added, so the value bounds the true maximum.
+///
+/// ```
+/// # use lodkit::impostor::{ImpostorShape, impostor_angle};
+/// let coarse = impostor_angle(8, ImpostorShape::Hemi);
+/// let fine = impostor_angle(16, ImpostorShape::Hemi);
+/// assert!(fine < coarse && coarse < 0.5);
+/// ```
+pub fn impostor_angle(frames: u32, shape: ImpostorShape) -> f32 {
+    let n = frames.max(2);
+    let hemi = shape.is_hemi();
+    let dir = |e: Vec2| impostor_decode(e, hemi).as_dvec3();
+    let at = |g: Vec2| g * (2.0 / (n - 1) as f32) - 1.0;
+    let mut worst = 0.0f64;
+    let mut step = 0.0f64;
+    for cy in 0..n - 1 {
+        for cx in 0..n - 1 {
+            let c = UVec2::new(cx, cy).as_vec2();
+            for corners in [
+                [c, c + Vec2::X, c + Vec2::Y],
+                [c + Vec2::ONE, c + Vec2::X, c + Vec2::Y],
+            ] {
+                let frames = corners.map(|g| dir(at(g)));
+                for i in 0..=ANGLE_STEPS {
+                    for j in 0..=ANGLE_STEPS - i {
+                        let (a, b) = (i as f32 / ANGLE_STEPS as f32, j as f32 / ANGLE_STEPS as f32);
+                        let w = [1.0 - a - b, a, b];
+                        let g = corners[0]
+                            + a * (corners[1] - corners[0])
+                            + b * (corners[2] - corners[0]);
+                        let v = dir(at(g));
+                        let mut by = frames
+                            .map(|f| v.angle_between(f))
+                            .into_iter()
+                            .zip(w)
+                            .collect::<Vec<_>>();
+                        by.sort_by(|x, y| x.0.total_cmp(&y.0));
+                        let mut sum = 0.0;
+                        for (angle, w) in by {
+                            sum += w;
+                            if sum >= 0.5 {
+                                worst = worst.max(angle);
+                                break;
+                            }
+                        }
+                        let along = |da: f32, db: f32| {
+                            let g = corners[0]
+                                + (a + da) * (corners[1] - corners[0])
+                                + (b + db) * (corners[2] - corners[0]);
+                            v.angle_between(dir(at(g)))
+                        };
+                        let d = 1.0 / ANGLE_STEPS as f32;
+                        step = step.max(along(d, 0.0)).max(along(0.0, d));
+                    }
+                }
+            }
+        }
+    }
+    (worst + step) as f32
+}
+
+/// The largest distance, in object units, between the impostor's picture and the mesh's, both
+/// measured across the view ray: `radius (sin(a) + 2 / frame_size)`, with `a` the
+/// [`impostor_angle`]. A frame seen `a` off its direction shows each point at height `h` above
+/// its plane displaced by `h sin(a)` (`|h| <= radius`); its texels are `2 radius / frame_size`
+/// wide, and an edge filtered from them moves by up to one.
+pub fn impostor_error(layout: &ImpostorLayout) -> f32 {
+    let a = impostor_angle(layout.frames, layout.shape).min(std::f32::consts::FRAC_PI_2);
+    layout.radius * (a.sin() + 2.0 / layout.frame_size.max(1) as f32)
+}
+
+/// The view-normalized distance (lodkit's selection distance: centre distance over
+/// `|P[1][1]|`, plus half the camera's hysteresis) beyond which the impostor's picture stays
+/// within the camera's pixel error of the mesh's: the switch distance of a level whose error is
+/// [`impostor_error`].
+///
+/// ```
+/// # use lodkit::impostor::{ImpostorLayout, ImpostorShape, impostor_switch_distance};
+/// # use lodkit::lod_chain::PixelErrorCamera;
+/// let layout = ImpostorLayout { frames: 12, frame_size: 128, shape: ImpostorShape::Hemi, center: [0.0; 3], radius: 1.0 };
+/// let near = impostor_switch_distance(&layout, &PixelErrorCamera::default()).unwrap();
+/// let finer = ImpostorLayout { frames: 24, ..layout };
+/// assert!(impostor_switch_distance(&finer, &PixelErrorCamera::default()).unwrap() < near);
+/// ```
+#[cfg(feature = "lod_chain")]
+pub fn impostor_switch_distance(
+    layout: &ImpostorLayout,
+    camera: &crate::lod_chain::PixelErrorCamera,
+) -> Result<f32, crate::lod_chain::LodChainError> {
+    let d =
+        crate::lod_chain::switch_distances(&[0.0, impostor_error(layout)], layout.radius, camera)?;
+    Ok(d[1])
+}

@@ -1,0 +1,109 @@
+//! The CPU steps of a bake and the sampling twins on atlases whose answers are known by hand.
+
+use glam::{UVec2, Vec2, Vec3};
+
+use super::*;
+
+fn layout(frames: u32, frame_size: u32, shape: ImpostorShape) -> ImpostorLayout {
+    ImpostorLayout {
+        frames,
+        frame_size,
+        shape,
+        center: [0.0; 3],
+        radius: 1.0,
+    }
+}
+
+#[test]
+fn padding_fills_each_frame_from_its_own_covered_texels() {
+    // Two frames of 4 x 4 side by side (an 8-wide atlas of 2 x 2 frames); one covered texel in
+    // frame (0, 0), none in the others.
+    let mut color = ImpostorImage::filled(8, [0.0; 4]);
+    let mut depth = ImpostorImage::filled(8, [0.0; 4]);
+    color.texels[8 + 1] = [0.2, 0.4, 0.6, 1.0];
+    depth.texels[8 + 1] = [0.5, 0.5, 1.0, 0.75];
+    dilate_frames(&mut color, &mut [&mut depth], 2, 4);
+    for y in 0..8u32 {
+        for x in 0..8u32 {
+            let (c, d) = (color.texel(x, y), depth.texel(x, y));
+            if x < 4 && y < 4 {
+                assert_eq!(&c[..3], &[0.2, 0.4, 0.6], "({x}, {y})");
+                assert_eq!(c[3], if (x, y) == (1, 1) { 1.0 } else { 0.0 });
+                assert_eq!(d, [0.5, 0.5, 1.0, 0.75]);
+            } else {
+                assert_eq!((c, d), ([0.0; 4], [0.0; 4]), "({x}, {y}) is another frame");
+            }
+        }
+    }
+}
+
+#[test]
+fn mip_chains_keep_frames_whole() {
+    // 2 x 2 frames of 4 texels: each frame one value, so every level of it is that value.
+    let mut image = ImpostorImage::filled(8, [0.0; 4]);
+    for y in 0..8u32 {
+        for x in 0..8u32 {
+            let v = (x / 4 + 2 * (y / 4)) as f32;
+            image.texels[(y * 8 + x) as usize] = [v, 0.0, 0.0, 1.0];
+        }
+    }
+    let chain = mip_chain(image, 2, 4);
+    assert_eq!(chain.iter().map(|i| i.size).collect::<Vec<_>>(), [8, 4, 2]);
+    assert_eq!(
+        ImpostorAtlas::mip_levels(&layout(2, 4, ImpostorShape::Full)),
+        3
+    );
+    let last = &chain[2];
+    for (k, t) in last.texels.iter().enumerate() {
+        assert_eq!(t[0], k as f32, "texel {k} of the last level is frame {k}");
+    }
+}
+
+/// An atlas whose frames are each one colour (red = column, green = row, alpha 1) and one
+/// depth (the plane: 0.5).
+fn flat_atlas(frames: u32, shape: ImpostorShape) -> ImpostorAtlas {
+    let fs = 4;
+    let size = frames * fs;
+    let mut color = ImpostorImage::filled(size, [0.0; 4]);
+    for y in 0..size {
+        for x in 0..size {
+            color.texels[(y * size + x) as usize] = [(x / fs) as f32, (y / fs) as f32, 0.0, 1.0];
+        }
+    }
+    let normal_depth = ImpostorImage::filled(size, [0.5, 1.0, 0.5, 0.5]);
+    ImpostorAtlas {
+        layout: layout(frames, fs, shape),
+        color: mip_chain(color, frames, fs),
+        normal_depth: mip_chain(normal_depth, frames, fs),
+    }
+}
+
+#[test]
+fn a_view_on_a_frame_sees_that_frame_and_between_frames_their_blend() {
+    for shape in [ImpostorShape::Full, ImpostorShape::Hemi] {
+        let atlas = flat_atlas(5, shape);
+        let hemi = shape.is_hemi();
+        // Straight at frame (1, 3) through the centre: that frame alone, at height 0.
+        let dir = impostor_frame_dir(UVec2::new(1, 3), 5, hemi);
+        let s = impostor_sample(&atlas, dir * 4.0, -dir, 0.0);
+        assert!(
+            (s.color.truncate() - Vec3::new(1.0, 3.0, 0.0)).length() < 1e-4,
+            "{shape:?} {s:?}"
+        );
+        assert!(s.point.length() < 1e-4);
+        assert!((s.normal - Vec3::Y).length() < 1e-4);
+        // At the centroid of the grid triangle (1, 1), (2, 1), (1, 2): a third of each.
+        let view = impostor_decode((Vec2::new(4.0, 4.0) / 3.0) * 0.5 - 1.0, hemi);
+        let s = impostor_sample(&atlas, view * 4.0, -view, 0.0);
+        let want = Vec3::new(4.0 / 3.0, 4.0 / 3.0, 0.0);
+        assert!(
+            (s.color.truncate() - want).length() < 1e-3,
+            "{shape:?} {s:?}"
+        );
+        assert!((s.color.w - 1.0).abs() < 1e-5);
+        // A ray that misses the frames' squares sees nothing.
+        let side = impostor_frame_basis(dir).x_axis;
+        let s = impostor_sample(&atlas, dir * 4.0 + side * 1.5, -dir, 0.0);
+        assert_eq!(s.color.w, 0.0);
+    }
+}
