@@ -28,6 +28,7 @@ mod host_errors;
 mod house;
 mod impostor;
 mod impostor_render;
+mod impostor_sample;
 mod lod_chain;
 mod object_motion;
 mod older_threshold;

@@ -4,6 +4,7 @@
 
 mod compressed;
 mod folder;
+mod impostor;
 mod objects;
 mod read;
 mod write;
@@ -33,8 +34,11 @@ pub struct LodArgs {
     pub report: Option<PathBuf>,
     /// Which meshes share their switch distances (an object switches as a whole).
     pub grouping: objects::Grouping,
+    /// Bake each mesh's impostor as its last level (`--impostor`).
+    pub impostor: Option<ImpostorOptions>,
 }
 
+pub use impostor::{ImpostorFlags, ImpostorOptions};
 pub use objects::Grouping;
 
 /// One row of the table and the report.
@@ -51,6 +55,9 @@ struct LevelRow {
     /// `MSFT_screencoverage` entry: below this share of the screen the next level takes over.
     screen_coverage: f32,
     seconds: f64,
+    /// The level is the mesh's impostor (`--impostor`): `error` is `impostor_error` of its atlas.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    impostor: bool,
 }
 
 #[derive(serde::Serialize)]
@@ -153,6 +160,18 @@ fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshRepor
     if !(args.aspect.is_finite() && args.aspect > 0.0) {
         return fail(2, format!("--aspect {} must be > 0", args.aspect));
     }
+    if let Some(o) = &args.impostor {
+        let layout = lodkit::impostor::ImpostorLayout {
+            frames: o.frames,
+            frame_size: o.frame_size,
+            shape: o.shape,
+            center: [0.0; 3],
+            radius: 1.0,
+        };
+        if let Err(e) = layout.validate() {
+            return fail(2, format!("--impostor-frames / --impostor-frame-size: {e}"));
+        }
+    }
     let descriptor = LodChainDescriptor {
         levels: args.levels,
         ratio: args.ratio,
@@ -186,6 +205,7 @@ fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshRepor
     }
     // Every mesh's chain first: an object's meshes share their distances.
     let mut planned = Vec::new();
+    let mut gpu = None;
     for mesh in document.meshes() {
         let name = mesh.name().unwrap_or("").to_owned();
         let label = format!("mesh {} '{name}'", mesh.index());
@@ -215,9 +235,35 @@ fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshRepor
                 Err(e) => return fail(1, format!("{label} primitive {}: {e}", p.index)),
             }
         }
-        let report = match plan(&chains, args, &camera) {
+        let mut report = match plan(&chains, args, &camera) {
             Ok(rows) => rows,
             Err(e) => return fail(1, format!("{label}: {e}")),
+        };
+        let atlas = match &args.impostor {
+            Some(options) => {
+                let gpu = match &gpu {
+                    Some(g) => g,
+                    None => match lodkit::gpu::GpuContext::new_headless(&Default::default()) {
+                        Ok(g) => gpu.insert(g),
+                        Err(e) => return fail(2, format!("--impostor needs a GPU: {e}")),
+                    },
+                };
+                let mut note = |w: String| warnings.push(w);
+                let start = std::time::Instant::now();
+                let atlas = impostor::bake(gpu, &mesh, &input, &buffers, base, options, &mut note)
+                    .and_then(|atlas| {
+                        let seconds = start.elapsed().as_secs_f64();
+                        add_impostor_row(&mut report, &atlas, &camera, seconds).map(|()| atlas)
+                    });
+                match atlas {
+                    Ok(atlas) => Some(atlas),
+                    Err(e) => {
+                        warnings.push(e);
+                        None
+                    }
+                }
+            }
+            None => None,
         };
         for w in &warnings {
             warn(format!("{label}: {w}"));
@@ -228,7 +274,7 @@ fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshRepor
             warnings,
             ..report
         };
-        planned.push((input, chains, report));
+        planned.push((input, chains, report, atlas));
     }
     let objects = match objects::objects(&document, &args.grouping) {
         Ok(o) => o,
@@ -236,14 +282,14 @@ fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshRepor
     };
     let own: Vec<Vec<f32>> = planned
         .iter()
-        .map(|(_, _, r)| {
+        .map(|(_, _, r, _)| {
             let switches = r.levels.iter().map(|l| l.switch_distance);
             switches.chain(std::iter::once(r.max_distance)).collect()
         })
         .collect();
     let shared = objects::shared(&objects, &own);
     let mut reports = Vec::new();
-    for ((input, chains, mut report), (object, distances)) in
+    for ((input, chains, mut report, atlas), (object, distances)) in
         planned.into_iter().zip(objects.iter().zip(&shared))
     {
         report.object = object.name.clone();
@@ -254,7 +300,23 @@ fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshRepor
             let next = distances.get(i + 1).copied().unwrap_or(report.max_distance);
             row.screen_coverage = coverage(report.box_radius, next, args.aspect);
         }
-        let levels: Vec<Vec<write::LevelPrimitive>> = (0..count)
+        let impostor = match &atlas {
+            Some(atlas) => {
+                let base = document
+                    .meshes()
+                    .nth(report.mesh)
+                    .and_then(|m| m.name().map(str::to_owned))
+                    .unwrap_or_else(|| format!("mesh{}", report.mesh));
+                let (color, normal_depth) = match impostor::pngs(atlas) {
+                    Ok(p) => p,
+                    Err(e) => return fail(2, e),
+                };
+                Some(out.add_impostor(&base, &color, &normal_depth, &atlas.layout))
+            }
+            None => None,
+        };
+        let mesh_levels = count - usize::from(impostor.is_some());
+        let levels: Vec<Vec<write::LevelPrimitive>> = (0..mesh_levels)
             .map(|i| {
                 input
                     .primitives
@@ -281,7 +343,7 @@ fn convert(args: &LodArgs, warn: &mut dyn FnMut(String)) -> Result<Vec<MeshRepor
             .collect();
         if count > 1 {
             let coverages: Vec<f32> = report.levels.iter().map(|r| r.screen_coverage).collect();
-            out.add_levels(report.mesh, &levels, &coverages);
+            out.add_levels(report.mesh, &levels, impostor.as_ref(), &coverages);
         }
         reports.push(report);
     }
@@ -347,6 +409,7 @@ fn plan(
                     .filter(|c| i < c.levels().len())
                     .map(|c| c.levels()[i].time().as_secs_f64())
                     .sum(),
+                impostor: false,
             }
         })
         .collect();
@@ -360,6 +423,44 @@ fn plan(
         levels,
         warnings: Vec::new(),
     })
+}
+
+/// Appends the impostor of `atlas` to `report`'s levels: its error (`impostor_error`), from the
+/// distance where its picture stays within the pixel error (never before the last mesh level);
+/// an error when that is beyond the hide distance (the impostor would never be shown).
+fn add_impostor_row(
+    report: &mut MeshReport,
+    atlas: &lodkit::impostor::ImpostorAtlas,
+    camera: &PixelErrorCamera,
+    seconds: f64,
+) -> Result<(), String> {
+    let own = lodkit::impostor::impostor_switch_distance(&atlas.layout, camera)
+        .map_err(|e| format!("impostor: {e}"))?;
+    let last = report.levels.last().map_or(0.0, |l| l.switch_distance);
+    let distance = own.max(last);
+    if last >= report.max_distance {
+        return Err(format!(
+            "impostor left out: the last level is shown up to where the mesh is hidden ({:.3}, view-normalized)",
+            report.max_distance
+        ));
+    }
+    if own >= report.max_distance {
+        return Err(format!(
+            "impostor left out: its picture is within the pixel error only from {own:.3} (view-normalized), where the mesh is already hidden ({:.3}); more frames (--impostor-frames) bring it nearer",
+            report.max_distance
+        ));
+    }
+    report.levels.push(LevelRow {
+        level: report.levels.len(),
+        triangles: 2,
+        error: lodkit::impostor::impostor_error(&atlas.layout),
+        error_capped: false,
+        switch_distance: distance,
+        screen_coverage: 0.0,
+        seconds,
+        impostor: true,
+    });
+    Ok(())
 }
 
 fn table(r: &MeshReport) -> String {
@@ -379,6 +480,10 @@ fn table(r: &MeshReport) -> String {
             l.screen_coverage,
             l.seconds * 1e3
         ));
+        if l.impostor {
+            s.truncate(s.trim_end().len());
+            s.push_str("  impostor\n");
+        }
     }
     if r.levels.iter().any(|l| l.error_capped) {
         s.push_str(

@@ -238,6 +238,8 @@ enum Command {
         /// objects names them).
         #[arg(long, value_name = "NODE")]
         object: Vec<String>,
+        #[command(flatten)]
+        impostor: lod::ImpostorFlags,
     },
     /// Compose a shader and write it through one of naga's back ends (`--to wesl`: convert a
     /// naga_oil WGSL file to WESL instead).
@@ -440,6 +442,7 @@ fn main() -> ExitCode {
             per_mesh,
             one_object,
             object,
+            impostor,
         } => lod::run(&lod::LodArgs {
             input,
             output,
@@ -457,6 +460,7 @@ fn main() -> ExitCode {
                 (false, true) => lod::Grouping::Whole,
                 (false, false) => lod::Grouping::Nodes(object),
             },
+            impostor: impostor.options(),
         }),
         Command::Export {
             compose,

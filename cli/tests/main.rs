@@ -20,6 +20,7 @@ mod lod;
 mod lod_compressed;
 mod lod_folder;
 mod lod_images;
+mod lod_impostor;
 mod lod_objects;
 mod npm_package;
 mod permutations;

@@ -98,7 +98,7 @@ fn every_pass_exports_to_wesl_that_checks_under_every_def_set() {
         );
         converted.push(out);
     }
-    assert_eq!(converted.len(), 7, "lodkit's passes");
+    assert_eq!(converted.len(), 9, "lodkit's passes");
     let check = crate::cli::lodkit()
         .args(["check", "--permute"])
         .args(&converted)
@@ -112,7 +112,7 @@ fn every_pass_exports_to_wesl_that_checks_under_every_def_set() {
     );
     assert_eq!(
         stdout.lines().filter(|l| l.starts_with("ok: ")).count(),
-        7,
+        9,
         "{stdout}"
     );
 }

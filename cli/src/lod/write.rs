@@ -6,6 +6,10 @@ use std::path::Path;
 
 use gltf::json::{self, Index, validation::Checked};
 
+mod impostor;
+
+pub use impostor::ImpostorLevel;
+
 /// One generated primitive of a level.
 pub struct LevelPrimitive<'a> {
     /// The primitive of the input mesh it stands for (material, carried attributes).
@@ -97,22 +101,12 @@ impl Output {
             if uri.starts_with("data:") {
                 continue;
             }
-            let path = percent_decoded(&uri);
-            // Only a file at or below the input's folder: a URI that climbs out of it or names
-            // an absolute path would copy some other local file into the output.
-            let relative = std::path::Path::new(&path);
-            let inside = relative.components().all(|c| {
-                matches!(
-                    c,
-                    std::path::Component::Normal(_) | std::path::Component::CurDir
-                )
-            });
-            if !inside {
+            let Some(path) = local_path(&uri) else {
                 warnings.push(format!(
                     "image {i} '{uri}': outside the input's folder, left as a URI"
                 ));
                 continue;
-            }
+            };
             let Some(mime) = mime_type(&path) else {
                 warnings.push(format!(
                     "image {i} '{uri}': not PNG, JPEG, WebP or KTX2, left as a URI (copy it \
@@ -277,13 +271,15 @@ impl Output {
         })
     }
 
-    /// Adds a mesh for each generated level of input mesh `mesh` (levels 1.. of `levels`), a node
-    /// for it beside every node that shows `mesh`, and `MSFT_lod` with the screen coverages on
-    /// those nodes. Returns the new nodes' indices per input node.
+    /// Adds a mesh for each generated level of input mesh `mesh` (levels 1.. of `levels`), then
+    /// the `impostor` level if any, a node for each beside every node that shows `mesh`, and
+    /// `MSFT_lod` with the screen coverages on those nodes. Returns the new nodes' indices per
+    /// input node.
     pub fn add_levels(
         &mut self,
         mesh: usize,
         levels: &[Vec<LevelPrimitive>],
+        impostor: Option<&ImpostorLevel>,
         coverage: &[f32],
     ) -> Vec<Vec<usize>> {
         let source = self.root.meshes[mesh].clone();
@@ -348,6 +344,7 @@ impl Output {
                 weights: None,
             }));
         }
+        lod_meshes.extend(impostor.map(|i| i.mesh));
         let showing: Vec<usize> = (0..self.root.nodes.len())
             .filter(|&n| self.root.nodes[n].mesh.map(|m| m.value()) == Some(mesh))
             .collect();
@@ -359,13 +356,17 @@ impl Output {
                 .enumerate()
                 .map(|(k, &m)| {
                     let name = node.name.clone().unwrap_or_else(|| format!("node{n}"));
+                    let is_impostor = impostor.is_some() && k + 1 == lod_meshes.len();
+                    let extras = impostor.filter(|_| is_impostor).map(|i| {
+                        json::extras::RawValue::from_string(i.extras.to_string()).expect("JSON")
+                    });
                     self.root
                         .push(json::Node {
                             mesh: Some(m),
                             name: Some(format!("{name}_LOD{}", k + 1)),
                             children: None,
                             extensions: None,
-                            extras: Default::default(),
+                            extras,
                             camera: None,
                             weights: None,
                             ..node.clone()
@@ -494,6 +495,20 @@ fn element_size(accessor: &json::Accessor) -> usize {
         Checked::Invalid => 1,
     };
     component * count
+}
+
+/// The path of a URI naming a file at or below the input's folder, `%XX` escapes decoded;
+/// `None` for one that climbs out of it or names an absolute path (reading it would take some
+/// other local file into the output).
+pub(super) fn local_path(uri: &str) -> Option<String> {
+    let path = percent_decoded(uri);
+    let inside = std::path::Path::new(&path).components().all(|c| {
+        matches!(
+            c,
+            std::path::Component::Normal(_) | std::path::Component::CurDir
+        )
+    });
+    inside.then_some(path)
 }
 
 /// A relative URI's path: `%XX` escapes decoded (a malformed one is kept as written).

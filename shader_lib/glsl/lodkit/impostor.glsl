@@ -25,7 +25,7 @@
 //   lodkit_impostor_sample(n, hemi, origin, ray, level) -> lodkit_ImpostorSample   (hooks)
 //   lodkit_impostor_keep(alpha) -> bool
 // Hooks (GLSL cannot pass a texture to a function on every target, so the two sampling
-// functions read the atlases through functions the includer defines, after its samplers; they
+// functions read the atlases through functions the includer defines after the include; they
 // are compiled only where LODKIT_IMPOSTOR_HOOKS is defined before the include):
 //   vec4 lodkit_impostor_fetch_color(vec2 uv, float level)   the colour atlas (linear, clamp)
 //   vec4 lodkit_impostor_fetch_normal_depth(vec2 uv, float level)   the normal-depth atlas
