@@ -14,15 +14,12 @@ use std::error::Error;
 use glam::{Mat4, Vec3};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::impostor::{
-    ImpostorBakeDescriptor, ImpostorBaker, ImpostorInstance, ImpostorMaterial, ImpostorMesh,
-    ImpostorPart, ImpostorPass, ImpostorPassDescriptor, ImpostorTexture, ImpostorTextures,
-    ImpostorView,
+    ImpostorBakeDescriptor, ImpostorBaker, ImpostorInstance, ImpostorPass, ImpostorPassDescriptor,
+    ImpostorTextures, ImpostorView,
 };
-use lodkit::gpu::readback::read_texture_rgba8;
-use lodkit::gpu::resources::texture_2d;
 use lodkit::impostor::impostor_switch_distance;
 use lodkit::lod_chain::PixelErrorCamera;
-use lodkit_scenes::tree::{LeafyTree, TREE_TEXTURE_SIZE};
+use lodkit_scenes::tree::LeafyTree;
 
 const SIZE: u32 = 240;
 const FOV: f32 = 30.0;
@@ -38,24 +35,8 @@ fn main() -> Result<(), Box<dyn Error>> {
 
     // 1. Bake: the mesh, its material (base colour texture, alpha mask, double-sided), a layout.
     let tree = LeafyTree::new(40, 7);
-    let mesh = ImpostorMesh {
-        positions: &tree.positions,
-        indices: &tree.indices,
-        normals: Some(&tree.normals),
-        uvs: Some(&tree.uvs),
-    };
-    let material = ImpostorMaterial {
-        base_color_texture: Some(ImpostorTexture {
-            width: TREE_TEXTURE_SIZE,
-            height: TREE_TEXTURE_SIZE,
-            rgba8: &tree.texture,
-        }),
-        alpha_cutoff: Some(0.5),
-        double_sided: true,
-        ..Default::default()
-    };
     let start = std::time::Instant::now();
-    let baker = ImpostorBaker::new(&gpu, &[ImpostorPart { mesh, material }])?;
+    let baker = ImpostorBaker::new(&gpu, &[tree.part()])?;
     let atlas = baker.bake(&gpu, &ImpostorBakeDescriptor::default())?;
     let baked = start.elapsed();
     let size = atlas.layout.atlas_size();
@@ -109,21 +90,6 @@ fn main() -> Result<(), Box<dyn Error>> {
         // The mesh, as the bake draws it (unlit base colour).
         let reference = baker.render(&gpu, clip, SIZE, SIZE)?;
         // The impostor.
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-        let color = texture_2d(
-            &gpu,
-            (SIZE, SIZE),
-            wgpu::TextureFormat::Rgba8UnormSrgb,
-            usage,
-            "color",
-        )?;
-        let depth = texture_2d(
-            &gpu,
-            (SIZE, SIZE),
-            wgpu::TextureFormat::Depth32Float,
-            usage,
-            "depth",
-        )?;
         let view = ImpostorView {
             view_proj: clip,
             eye,
@@ -133,38 +99,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         let instances = [ImpostorInstance {
             model: Mat4::IDENTITY,
         }];
-        let prepared = pass.prepare(&gpu, &textures, &view, &instances)?;
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        {
-            let color_view = color.create_view(&Default::default());
-            let depth_view = depth.create_view(&Default::default());
-            let mut render_pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("impostor example"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.draw(&mut render_pass, &prepared);
-        }
-        gpu.queue.submit([encoder.finish()]);
-        let drawn = read_texture_rgba8(&gpu, &color)?;
+        let drawn = pass.render(&gpu, &textures, &view, &instances, (SIZE, SIZE))?;
         // Both enlarged 4x around the centre so the small pictures can be seen.
         for y in 0..SIZE {
             for x in 0..SIZE {

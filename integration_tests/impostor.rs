@@ -165,6 +165,11 @@ fn impostor_maps_match_rust_twins() {
     assert_eq!(impostor_octa_encode(Vec3::X), Vec2::X);
     assert_eq!(impostor_hemi_encode(Vec3::X), Vec2::ONE);
     assert_eq!(impostor_hemi_encode(Vec3::Z), Vec2::new(1.0, -1.0));
+    assert_eq!(
+        impostor_hemi_encode(-Vec3::Y),
+        Vec2::ONE,
+        "straight below: the +x horizon"
+    );
     for (route, language, header, body) in twin_runs(
         gpu,
         (MAPS_WGSL_HEADER, MAPS_WGSL),

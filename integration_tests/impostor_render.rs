@@ -11,13 +11,12 @@ use lodkit::gpu::impostor::{
     ImpostorPart, ImpostorPass, ImpostorPassDescriptor, ImpostorTexture, ImpostorTextures,
     ImpostorView,
 };
-use lodkit::gpu::readback::read_texture_rgba8;
 use lodkit::impostor::{
     ImpostorShape, impostor_decode, impostor_frame_dir, impostor_switch_distance,
 };
 use lodkit::lod_chain::PixelErrorCamera;
 use lodkit::metrics::coverage_distance;
-use lodkit_scenes::tree::{LeafyTree, TREE_TEXTURE_SIZE};
+use lodkit_scenes::tree::LeafyTree;
 
 /// Target side in pixels.
 const SIZE: u32 = 256;
@@ -72,70 +71,16 @@ fn impostor_coverage(
     clip: Mat4,
     eye: Vec3,
 ) -> Vec<bool> {
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let color = lodkit::gpu::resources::texture_2d(
-        gpu,
-        (SIZE, SIZE),
-        wgpu::TextureFormat::Rgba8Unorm,
-        usage,
-        "impostor test",
-    )
-    .unwrap();
-    let depth = lodkit::gpu::resources::texture_2d(
-        gpu,
-        (SIZE, SIZE),
-        wgpu::TextureFormat::Depth32Float,
-        usage,
-        "impostor test depth",
-    )
-    .unwrap();
     let view = ImpostorView {
         view_proj: clip,
         eye,
         light: Vec3::new(0.3, 0.8, 0.5).normalize(),
         ambient: 0.4,
     };
-    let prepared = pass
-        .prepare(
-            gpu,
-            textures,
-            &view,
-            &[ImpostorInstance {
-                model: Mat4::IDENTITY,
-            }],
-        )
-        .unwrap();
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    {
-        let color_view = color.create_view(&Default::default());
-        let depth_view = depth.create_view(&Default::default());
-        let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("impostor test"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.draw(&mut rp, &prepared);
-    }
-    gpu.queue.submit([encoder.finish()]);
-    read_texture_rgba8(gpu, &color)
+    let instances = [ImpostorInstance {
+        model: Mat4::IDENTITY,
+    }];
+    pass.render(gpu, textures, &view, &instances, (SIZE, SIZE))
         .unwrap()
         .chunks(4)
         .map(|p| p[3] > 127)
@@ -178,26 +123,10 @@ fn worst_distance(
 fn impostor_stays_within_the_pixel_bound_between_frames() {
     let gpu = lodkit_test_gpu!();
     let tree = LeafyTree::new(40, 7);
-    let mesh = ImpostorMesh {
-        positions: &tree.positions,
-        indices: &tree.indices,
-        normals: Some(&tree.normals),
-        uvs: Some(&tree.uvs),
-    };
-    let material = ImpostorMaterial {
-        base_color_texture: Some(ImpostorTexture {
-            width: TREE_TEXTURE_SIZE,
-            height: TREE_TEXTURE_SIZE,
-            rgba8: &tree.texture,
-        }),
-        alpha_cutoff: Some(0.5),
-        double_sided: true,
-        ..Default::default()
-    };
     // The defaults: 12 x 12 frames of 128 texels, hemisphere.
     let descriptor = ImpostorBakeDescriptor::default();
     assert_eq!(descriptor.shape, ImpostorShape::Hemi);
-    let baker = ImpostorBaker::new(gpu, &[ImpostorPart { mesh, material }]).unwrap();
+    let baker = ImpostorBaker::new(gpu, &[tree.part()]).unwrap();
     let atlas = baker.bake(gpu, &descriptor).unwrap();
     let textures = ImpostorTextures::new(gpu, &atlas).unwrap();
     let pass = ImpostorPass::new(

@@ -156,8 +156,9 @@ pub fn impostor_octa_decode(e: Vec2) -> Vec3 {
 }
 
 /// Unit direction `d` of the upper hemisphere (y clamped to >= 0) on `[-1, 1]²`: the diamond of
-/// the octahedron's upper half turned by 45 degrees to fill the square. A view from straight
-/// below (no horizontal part) maps to the centre.
+/// the octahedron's upper half turned by 45 degrees to fill the square. A view from below the
+/// horizon maps onto the rim; one from straight below (no horizontal part) to the corner
+/// (1, 1), the horizon's +x.
 ///
 /// ```
 /// # use lodkit::impostor::{impostor_hemi_decode, impostor_hemi_encode};
@@ -168,6 +169,9 @@ pub fn impostor_octa_decode(e: Vec2) -> Vec3 {
 /// assert!((impostor_hemi_decode(impostor_hemi_encode(d)) - d).length() < 1e-6);
 /// ```
 pub fn impostor_hemi_encode(d: Vec3) -> Vec2 {
+    if d.x.abs() + d.z.abs() == 0.0 && d.y < 0.0 {
+        return Vec2::ONE;
+    }
     let p = Vec2::new(d.x, d.z) / (d.x.abs() + d.y.max(0.0) + d.z.abs()).max(1e-30);
     Vec2::new(p.x + p.y, p.x - p.y)
 }
@@ -196,10 +200,11 @@ pub fn impostor_decode(e: Vec2, hemi: bool) -> Vec3 {
     }
 }
 
-/// The direction (from the centre toward the camera) frame `frame` of an `n x n` grid was baked
-/// from: the grid spans `[-1, 1]²` corner to corner, frame (0, 0) at (-1, -1).
+/// The direction (from the centre toward the camera) frame `frame` of an `n x n` grid (`n < 2`
+/// is taken as 2) was baked from: the grid spans `[-1, 1]²` corner to corner, frame (0, 0) at
+/// (-1, -1).
 pub fn impostor_frame_dir(frame: UVec2, n: u32, hemi: bool) -> Vec3 {
-    let e = frame.as_vec2() * (2.0 / (n - 1) as f32) - 1.0;
+    let e = frame.as_vec2() * (2.0 / (n.max(2) - 1) as f32) - 1.0;
     impostor_decode(e, hemi)
 }
 
@@ -224,7 +229,7 @@ pub struct ImpostorBlend {
     pub weights: Vec3,
 }
 
-/// The frames of an `n x n` grid (n >= 2) to blend for unit view direction `view` (object
+/// The frames of an `n x n` grid (`n < 2` is taken as 2) to blend for unit view direction `view` (object
 /// space, from the centre toward the eye), with their barycentric weights in the grid triangle
 /// that holds it: each cell is split along its anti-diagonal.
 ///
@@ -238,7 +243,7 @@ pub struct ImpostorBlend {
 /// assert!((impostor_frame_dir(b.frames[0], 5, false) - Vec3::Y).length() < 1e-6);
 /// ```
 pub fn impostor_blend(view: Vec3, n: u32, hemi: bool) -> ImpostorBlend {
-    let last = (n - 1) as f32;
+    let last = (n.max(2) - 1) as f32;
     let g = (impostor_encode(view, hemi) * 0.5 + 0.5).clamp(Vec2::ZERO, Vec2::ONE) * last;
     let cell = g.floor().min(Vec2::splat(last - 1.0));
     let f = g - cell;

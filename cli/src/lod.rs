@@ -436,6 +436,21 @@ fn add_impostor_row(
 ) -> Result<(), String> {
     let own = lodkit::impostor::impostor_switch_distance(&atlas.layout, camera)
         .map_err(|e| format!("impostor: {e}"))?;
+    // Mesh levels that would switch in only where the impostor is already within the pixel
+    // error give way to it: it is cheaper there and as close to the mesh.
+    let keep = report
+        .levels
+        .iter()
+        .position(|l| l.level > 0 && l.switch_distance >= own)
+        .unwrap_or(report.levels.len());
+    if keep < report.levels.len() {
+        report.warnings.push(format!(
+            "levels {}..={} left out: the impostor is within the pixel error from {own:.3} (view-normalized), nearer than they switch in",
+            keep,
+            report.levels.len() - 1
+        ));
+        report.levels.truncate(keep);
+    }
     let last = report.levels.last().map_or(0.0, |l| l.switch_distance);
     let distance = own.max(last);
     if last >= report.max_distance {

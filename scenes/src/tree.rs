@@ -2,6 +2,7 @@
 //! (the objects of a forest), built from a seed so a test and the demo draw the same one.
 
 use glam::{Quat, Vec2, Vec3};
+use lodkit::gpu::impostor::{ImpostorMaterial, ImpostorMesh, ImpostorPart, ImpostorTexture};
 
 /// Texels per side of [`LeafyTree::texture`].
 pub const TREE_TEXTURE_SIZE: u32 = 64;
@@ -91,6 +92,33 @@ impl LeafyTree {
         }
         self.indices
             .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+    }
+
+    /// Its material: the texture, alpha-masked at 0.5, double-sided.
+    pub fn material(&self) -> ImpostorMaterial<'_> {
+        ImpostorMaterial {
+            base_color_texture: Some(ImpostorTexture {
+                width: TREE_TEXTURE_SIZE,
+                height: TREE_TEXTURE_SIZE,
+                rgba8: &self.texture,
+            }),
+            alpha_cutoff: Some(0.5),
+            double_sided: true,
+            ..Default::default()
+        }
+    }
+
+    /// The whole tree with its material: what an impostor of it is baked from.
+    pub fn part(&self) -> ImpostorPart<'_> {
+        ImpostorPart {
+            mesh: ImpostorMesh {
+                positions: &self.positions,
+                indices: &self.indices,
+                normals: Some(&self.normals),
+                uvs: Some(&self.uvs),
+            },
+            material: self.material(),
+        }
     }
 
     /// Triangles in the mesh.

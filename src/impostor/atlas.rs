@@ -54,13 +54,20 @@ pub struct ImpostorAtlas {
 /// `frame_size` texels): each texel whose coverage (`coverage`'s alpha) is 0 takes the rgb of
 /// the nearest covered texel of its own frame (4-neighbour steps, ties to the first reached),
 /// and, for images other than `coverage` itself, every channel of it. Frames with no covered
-/// texel are left as they are. Linear in the number of texels.
+/// texel are left as they are. Linear in the number of texels. Images that are not all
+/// `frames x frame_size` texels a side (with that many texels) are left as they are.
 pub fn dilate_frames(
     coverage: &mut ImpostorImage,
     others: &mut [&mut ImpostorImage],
     frames: u32,
     frame_size: u32,
 ) {
+    let side = u64::from(frames) * u64::from(frame_size);
+    let fits =
+        |i: &ImpostorImage| u64::from(i.size) == side && i.texels.len() as u64 == side * side;
+    if side == 0 || !fits(coverage) || !others.iter().all(|i| fits(i)) {
+        return;
+    }
     let size = coverage.size as usize;
     let fs = frame_size as usize;
     let mut source = vec![usize::MAX; size * size];
@@ -117,9 +124,16 @@ pub fn dilate_frames(
 
 /// The mip chain of an atlas level of `frames x frames` frames of `frame_size` texels (a power
 /// of two): `image` first, then each level the 2x2 box average of the one before, down to one
-/// texel per frame, so no texel of a level straddles two frames.
+/// texel per frame, so no texel of a level straddles two frames. An image that is not
+/// `frames x frame_size` texels a side, or a frame size that is not a power of two, gives the
+/// image alone.
 pub fn mip_chain(image: ImpostorImage, frames: u32, frame_size: u32) -> Vec<ImpostorImage> {
+    let side = u64::from(frames) * u64::from(frame_size);
+    let fits = u64::from(image.size) == side && image.texels.len() as u64 == side * side;
     let mut levels = vec![image];
+    if !(fits && frame_size.is_power_of_two()) {
+        return levels;
+    }
     let mut fs = frame_size;
     while fs > 1 {
         fs /= 2;

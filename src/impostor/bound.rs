@@ -13,7 +13,9 @@ const ANGLE_STEPS: u32 = 16;
 /// from above the horizon). A coverage test at 0.5 on a weighted blend follows its weighted
 /// median, so this, not the farthest frame blended, is how far off the picture's frames are.
 /// Each grid triangle is sampled at 16 steps per edge in the map's plane, and the largest angle
-/// between neighbouring samples is added, so the value bounds the true maximum.
+/// between neighbouring samples is added as a margin for what the samples miss (an estimate of
+/// the maximum from above, not a proof: the frame that holds the median can change between
+/// samples).
 ///
 /// ```
 /// # use lodkit::impostor::{ImpostorShape, impostor_angle};

@@ -22,9 +22,15 @@ pub struct ImpostorSample {
 
 /// `images` (a mip chain, level 0 first) at `uv` and mip `level`: bilinear within a level
 /// (texel centres at half-integers, clamped to the edge), linear between the two levels around
-/// `level` (clamped to the chain).
+/// `level` (clamped to the chain). Zero for an empty chain or one with an image whose texel
+/// count is not its size squared.
 pub fn impostor_sample_level(images: &[ImpostorImage], uv: glam::Vec2, level: f32) -> Vec4 {
-    let Some(last) = images.len().checked_sub(1) else {
+    let whole = |i: &ImpostorImage| i.size > 0 && i.texels.len() == (i.size as usize).pow(2);
+    let Some(last) = images
+        .len()
+        .checked_sub(1)
+        .filter(|_| images.iter().all(whole))
+    else {
         return Vec4::ZERO;
     };
     let level = level.clamp(0.0, last as f32);

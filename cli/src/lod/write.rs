@@ -366,6 +366,9 @@ impl Output {
                             name: Some(format!("{name}_LOD{}", k + 1)),
                             children: None,
                             extensions: None,
+                            // A card has no joints: the impostor of a skinned mesh shows its
+                            // bind pose, unskinned.
+                            skin: if is_impostor { None } else { node.skin },
                             extras,
                             camera: None,
                             weights: None,

@@ -57,8 +57,12 @@ vec3 lodkit_impostor_octa_decode(vec2 e) {
     return normalize(vec3(xz.x, y, xz.y));
 }
 
-/// Unit direction d of the upper hemisphere (y clamped to >= 0) on [-1, 1]^2.
+/// Unit direction d of the upper hemisphere (y clamped to >= 0) on [-1, 1]^2; straight below
+/// maps to (1, 1).
 vec2 lodkit_impostor_hemi_encode(vec3 d) {
+    if (abs(d.x) + abs(d.z) == 0.0 && d.y < 0.0) {
+        return vec2(1.0);
+    }
     vec2 p = d.xz / max(abs(d.x) + max(d.y, 0.0) + abs(d.z), 1e-30);
     return vec2(p.x + p.y, p.x - p.y);
 }
@@ -87,7 +91,7 @@ vec3 lodkit_impostor_decode(vec2 e, bool hemi) {
 
 /// The direction frame `frame` of an n x n grid was baked from.
 vec3 lodkit_impostor_frame_dir(uvec2 frame, uint n, bool hemi) {
-    vec2 e = vec2(frame) * (2.0 / float(n - 1u)) - 1.0;
+    vec2 e = vec2(frame) * (2.0 / float(max(n, 2u) - 1u)) - 1.0;
     return lodkit_impostor_decode(e, hemi);
 }
 
@@ -107,9 +111,9 @@ struct lodkit_ImpostorBlend {
     vec3 weights;
 };
 
-/// The frames of an n x n grid (n >= 2) to blend for unit view direction `view`.
+/// The frames of an n x n grid (n < 2 taken as 2) to blend for unit view direction `view`.
 lodkit_ImpostorBlend lodkit_impostor_blend(vec3 view, uint n, bool hemi) {
-    float last = float(n - 1u);
+    float last = float(max(n, 2u) - 1u);
     vec2 g = clamp(lodkit_impostor_encode(view, hemi) * 0.5 + 0.5, vec2(0.0), vec2(1.0)) * last;
     vec2 cell = min(floor(g), vec2(last - 1.0));
     vec2 f = g - cell;

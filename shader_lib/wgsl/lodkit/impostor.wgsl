@@ -67,9 +67,13 @@ fn impostor_octa_decode(e: vec2<f32>) -> vec3<f32> {
 }
 
 /// Unit direction `d` of the upper hemisphere (y clamped to >= 0) on [-1, 1]^2: the diamond of
-/// the octahedron's upper half turned by 45 degrees to fill the square. A view from straight
-/// below (no horizontal part) maps to the centre.
+/// the octahedron's upper half turned by 45 degrees to fill the square. A view from below the
+/// horizon maps onto the rim; one from straight below (no horizontal part) to the corner
+/// (1, 1), the horizon's +x.
 fn impostor_hemi_encode(d: vec3<f32>) -> vec2<f32> {
+    if (abs(d.x) + abs(d.z) == 0.0 && d.y < 0.0) {
+        return vec2<f32>(1.0);
+    }
     let p = d.xz / max(abs(d.x) + max(d.y, 0.0) + abs(d.z), 1e-30);
     return vec2<f32>(p.x + p.y, p.x - p.y);
 }
@@ -96,10 +100,11 @@ fn impostor_decode(e: vec2<f32>, hemi: bool) -> vec3<f32> {
     return impostor_octa_decode(e);
 }
 
-/// The direction (from the centre toward the camera) frame `frame` of an `n` x `n` grid was
-/// baked from: the grid spans [-1, 1]^2 corner to corner, frame (0, 0) at (-1, -1).
+/// The direction (from the centre toward the camera) frame `frame` of an `n` x `n` grid (n < 2
+/// is taken as 2) was baked from: the grid spans [-1, 1]^2 corner to corner, frame (0, 0) at
+/// (-1, -1).
 fn impostor_frame_dir(frame: vec2<u32>, n: u32, hemi: bool) -> vec3<f32> {
-    let e = vec2<f32>(frame) * (2.0 / f32(n - 1u)) - 1.0;
+    let e = vec2<f32>(frame) * (2.0 / f32(max(n, 2u) - 1u)) - 1.0;
     return impostor_decode(e, hemi);
 }
 
@@ -122,9 +127,10 @@ struct ImpostorBlend {
     weights: vec3<f32>,
 }
 
-/// The frames of an `n` x `n` grid (n >= 2) to blend for unit view direction `view`.
+/// The frames of an `n` x `n` grid (n < 2 is taken as 2) to blend for unit view direction
+/// `view`.
 fn impostor_blend(view: vec3<f32>, n: u32, hemi: bool) -> ImpostorBlend {
-    let last = f32(n - 1u);
+    let last = f32(max(n, 2u) - 1u);
     let g = clamp(impostor_encode(view, hemi) * 0.5 + 0.5, vec2<f32>(0.0), vec2<f32>(1.0)) * last;
     let cell = min(floor(g), vec2<f32>(last - 1.0));
     let f = g - cell;

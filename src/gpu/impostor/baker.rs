@@ -26,6 +26,14 @@ struct BakeParams {
     material: [f32; 4],
 }
 
+/// One draw of a part: its parameters and the viewport it fills.
+#[derive(Clone, Copy, Debug)]
+struct Draw {
+    part: usize,
+    params: BakeParams,
+    viewport: [f32; 4],
+}
+
 /// Colour and normal-depth targets of the bake (linear, exact enough for the CPU steps).
 const BAKE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const BAKE_DEPTH: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -249,18 +257,20 @@ impl ImpostorBaker {
         (to_frame * normalize, dir)
     }
 
-    /// The view's parameters, one per part.
-    fn params(&self, clip_from_object: Mat4, dir: Vec3) -> Vec<BakeParams> {
-        self.parts
-            .iter()
-            .map(|part| BakeParams {
+    /// Part `part` drawn through `clip_from_object` into `viewport`.
+    fn draw_of(&self, part: usize, clip_from_object: Mat4, dir: Vec3, viewport: [f32; 4]) -> Draw {
+        let p = &self.parts[part];
+        Draw {
+            part,
+            params: BakeParams {
                 clip_from_object: clip_from_object.to_cols_array(),
                 dir: dir.extend(0.0).to_array(),
                 sphere: Vec3::from(self.center).extend(self.radius).to_array(),
-                base_color: part.base_color,
-                material: part.material,
-            })
-            .collect()
+                base_color: p.base_color,
+                material: p.material,
+            },
+            viewport,
+        }
     }
 
     /// Bakes the atlas `descriptor` describes: one render pass draws every frame into its
@@ -286,17 +296,18 @@ impl ImpostorBaker {
             rule: "must describe an atlas lodkit can bake",
         })?;
         let n = layout.frames;
-        let views: Vec<(Vec<BakeParams>, [f32; 4])> = (0..n * n)
-            .map(|f| {
+        let mut draws = Vec::with_capacity((n * n) as usize * self.parts.len());
+        for part in 0..self.parts.len() {
+            for f in 0..n * n {
                 let frame = glam::UVec2::new(f % n, f / n);
                 let (m, dir) = self.frame_matrix(&layout, frame);
                 let s = layout.frame_size as f32;
                 let viewport = [frame.x as f32 * s, frame.y as f32 * s, s, s];
-                (self.params(m, dir), viewport)
-            })
-            .collect();
+                draws.push(self.draw_of(part, m, dir, viewport));
+            }
+        }
         let size = layout.atlas_size();
-        let (color, normal_depth) = self.draw(gpu, CALL, (size, size), &views)?;
+        let (color, normal_depth) = self.draw(gpu, CALL, (size, size), &draws)?;
         let mut color = to_image(size, &color);
         let mut normal_depth = to_image(size, &normal_depth);
         dilate_frames(&mut color, &mut [&mut normal_depth], n, layout.frame_size);
@@ -318,26 +329,56 @@ impl ImpostorBaker {
         width: u32,
         height: u32,
     ) -> Result<Vec<[f32; 4]>, GpuError> {
-        const CALL: &str = "ImpostorBaker::render";
-        let view = (
-            self.params(clip_from_object, Vec3::Z),
-            [0.0, 0.0, width.max(1) as f32, height.max(1) as f32],
-        );
-        let (color, _) = self.draw(gpu, CALL, (width, height), &[view])?;
+        let instances: Vec<(usize, Mat4)> =
+            (0..self.parts.len()).map(|k| (k, Mat4::IDENTITY)).collect();
+        self.render_instances(gpu, clip_from_object, &instances, width, height)
+    }
+
+    /// Instances of single parts, `(part, object to world)`, drawn through `clip_from_world`
+    /// into one `width x height` image as [`render`](Self::render) draws: a scene of objects
+    /// (a forest), each at the level of detail its part holds. At most as many instances as
+    /// the device's uniform buffer takes at once (a slot each).
+    pub fn render_instances(
+        &self,
+        gpu: &GpuContext,
+        clip_from_world: Mat4,
+        instances: &[(usize, Mat4)],
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<[f32; 4]>, GpuError> {
+        const CALL: &str = "ImpostorBaker::render_instances";
+        if let Some((k, (part, _))) = instances
+            .iter()
+            .enumerate()
+            .find(|(_, (part, _))| *part >= self.parts.len())
+        {
+            return Err(GpuError::Invalid {
+                call: CALL,
+                parameter: "instances",
+                value: format!("part {part} at instance {k}"),
+                rule: "must name one of the baker's parts",
+            });
+        }
+        let viewport = [0.0, 0.0, width.max(1) as f32, height.max(1) as f32];
+        let draws: Vec<Draw> = instances
+            .iter()
+            .map(|(part, model)| self.draw_of(*part, clip_from_world * *model, Vec3::Z, viewport))
+            .collect();
+        let (color, _) = self.draw(gpu, CALL, (width, height), &draws)?;
         Ok(to_image(width.max(1), &color).texels)
     }
 
-    /// Draws each view into its viewport of a `size` target pair; returns both targets'
+    /// Makes each draw into its viewport of a `size` target pair; returns both targets'
     /// Rgba16Float bytes.
     fn draw(
         &self,
         gpu: &GpuContext,
         call: &'static str,
         (width, height): (u32, u32),
-        views: &[(Vec<BakeParams>, [f32; 4])],
+        draws: &[Draw],
     ) -> Result<(Vec<u8>, Vec<u8>), GpuError> {
         crate::gpu::checks::texture_extent(gpu, call, width, height)?;
-        let params: Vec<BakeParams> = views.iter().flat_map(|(p, _)| p.iter().copied()).collect();
+        let params: Vec<BakeParams> = draws.iter().map(|d| d.params).collect();
         let uniforms =
             DrawUniforms::new(gpu, size_of::<BakeParams>(), params.len(), "impostor bake")?;
         uniforms.write(gpu, &params)?;
@@ -379,17 +420,20 @@ impl ImpostorBaker {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                let parts = self.parts.len();
-                for (j, part) in self.parts.iter().enumerate() {
-                    pass.set_pipeline(&self.pipelines[usize::from(part.double_sided)]);
-                    pass.set_bind_group(1, &part.texture_group, &[]);
-                    pass.set_vertex_buffer(0, part.vertices.slice(..));
-                    pass.set_index_buffer(part.indices.slice(..), wgpu::IndexFormat::Uint32);
-                    for (k, (_, [x, y, w, h])) in views.iter().enumerate() {
-                        pass.set_viewport(*x, *y, *w, *h, 0.0, 1.0);
-                        pass.set_bind_group(0, &params_group, &[uniforms.offset(k * parts + j)]);
-                        pass.draw_indexed(0..part.index_count, 0, 0..1);
+                let mut bound = None;
+                for (k, d) in draws.iter().enumerate() {
+                    let part = &self.parts[d.part];
+                    if bound != Some(d.part) {
+                        pass.set_pipeline(&self.pipelines[usize::from(part.double_sided)]);
+                        pass.set_bind_group(1, &part.texture_group, &[]);
+                        pass.set_vertex_buffer(0, part.vertices.slice(..));
+                        pass.set_index_buffer(part.indices.slice(..), wgpu::IndexFormat::Uint32);
+                        bound = Some(d.part);
                     }
+                    let [x, y, w, h] = d.viewport;
+                    pass.set_viewport(x, y, w, h, 0.0, 1.0);
+                    pass.set_bind_group(0, &params_group, &[uniforms.offset(k)]);
+                    pass.draw_indexed(0..part.index_count, 0, 0..1);
                 }
             }
             gpu.queue.submit([encoder.finish()]);

@@ -61,6 +61,7 @@ struct ViewUniform {
 pub struct ImpostorPass {
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroupLayout,
+    descriptor: ImpostorPassDescriptor,
 }
 
 /// What one [`ImpostorPass::draw`] needs: the view's uniform, the atlas's bind group and the
@@ -139,7 +140,11 @@ impl ImpostorPass {
                 multiview_mask: None,
                 cache: None,
             });
-            Ok(Self { pipeline, group })
+            Ok(Self {
+                pipeline,
+                group,
+                descriptor: *descriptor,
+            })
         })
     }
 
@@ -217,5 +222,50 @@ impl ImpostorPass {
         pass.set_bind_group(0, &prepared.bind_group, &[]);
         pass.set_vertex_buffer(0, prepared.instances.slice(..));
         pass.draw(0..6, 0..prepared.count);
+    }
+
+    /// `instances` drawn into a new `width x height` target of the descriptor's colour format
+    /// (cleared to transparent) and depth format, read back: tightly packed rows of 4 bytes a
+    /// pixel (an RGBA8 or BGRA8 colour format; others are [`GpuError::Mismatch`]). For tests,
+    /// tools and previews; a renderer draws into its own pass with [`draw`](Self::draw).
+    pub fn render(
+        &self,
+        gpu: &GpuContext,
+        textures: &ImpostorTextures,
+        view: &ImpostorView,
+        instances: &[ImpostorInstance],
+        (width, height): (u32, u32),
+    ) -> Result<Vec<u8>, GpuError> {
+        use crate::gpu::resources::{begin_targets_pass, texture_2d};
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let size = (width, height);
+        let color = texture_2d(gpu, size, self.descriptor.color_format, usage, "impostors")?;
+        let depth = texture_2d(
+            gpu,
+            size,
+            self.descriptor.depth_format,
+            usage,
+            "impostor depth",
+        )?;
+        let prepared = self.prepare(gpu, textures, view, instances)?;
+        gpu.guarded("ImpostorPass::render", || {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            {
+                let color_view = color.create_view(&Default::default());
+                let depth_view = depth.create_view(&Default::default());
+                let mut pass = begin_targets_pass(
+                    &mut encoder,
+                    &[(&color_view, wgpu::Color::TRANSPARENT)],
+                    &depth_view,
+                    1.0,
+                    None,
+                    "impostors",
+                );
+                self.draw(&mut pass, &prepared);
+            }
+            gpu.queue.submit([encoder.finish()]);
+            Ok(())
+        })?;
+        crate::gpu::readback::read_texture_rgba8(gpu, &color)
     }
 }

@@ -96,7 +96,10 @@ impl Output {
             ..Default::default()
         });
         let hemi = layout.shape == ImpostorShape::Hemi;
-        let front = impostor_blend(glam::Vec3::Z, layout.frames, hemi).frames[0];
+        let b = impostor_blend(glam::Vec3::Z, layout.frames, hemi);
+        let w = b.weights.to_array();
+        let heaviest = (0..3).fold(0, |k, i| if w[i] > w[k] { i } else { k });
+        let front = b.frames[heaviest];
         let basis = impostor_frame_basis(impostor_frame_dir(front, layout.frames, hemi));
         let (c, r) = (glam::Vec3::from(layout.center), layout.radius);
         let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
