@@ -13,7 +13,7 @@ mod atlas;
 mod bound;
 mod sample;
 
-pub use atlas::{ImpostorAtlas, ImpostorImage, dilate_frames, mip_chain};
+pub use atlas::{ImpostorAtlas, ImpostorImage, dilate_frames, mip_chain, preserve_coverage};
 #[cfg(feature = "lod_chain")]
 pub use bound::impostor_switch_distance;
 pub use bound::{impostor_angle, impostor_error};

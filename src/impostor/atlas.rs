@@ -157,6 +157,72 @@ pub fn mip_chain(image: ImpostorImage, frames: u32, frame_size: u32) -> Vec<Impo
     levels
 }
 
+/// Scales the alpha of every frame of every level after the first so that as large a share of
+/// its texels passes the alpha test (>= 0.5) as of the frame's texels at level 0: a box filter
+/// alone averages thin covered features (leaves, twigs, fences) below the test and they vanish
+/// at a distance (Castaño's coverage-preserving alpha mipmaps). `chain` is a [`mip_chain`] of
+/// `frames x frames` frames; one that is not (sizes that do not halve down from a multiple of
+/// `frames`) is left as it is. Alpha stays within [0, 1].
+pub fn preserve_coverage(chain: &mut [ImpostorImage], frames: u32) {
+    let Some(first) = chain.first() else {
+        return;
+    };
+    let frames = frames as usize;
+    let whole = |i: &ImpostorImage| {
+        frames > 0 && i.size as usize % frames == 0 && i.texels.len() == (i.size as usize).pow(2)
+    };
+    let halving = chain
+        .iter()
+        .enumerate()
+        .all(|(k, i)| whole(i) && i.size == first.size >> k);
+    if !halving {
+        return;
+    }
+    // The texels of frame (fx, fy) of an image.
+    fn frame_texels(image: &ImpostorImage, frames: usize, fx: usize, fy: usize) -> Vec<usize> {
+        let (size, fs) = (image.size as usize, image.size as usize / frames);
+        (0..fs)
+            .flat_map(|y| (0..fs).map(move |x| (fy * fs + y) * size + fx * fs + x))
+            .collect()
+    }
+    let share = |image: &ImpostorImage, texels: &[usize], scale: f32| {
+        let kept = texels
+            .iter()
+            .filter(|&&i| image.texels[i][3] * scale >= 0.5)
+            .count();
+        kept as f32 / texels.len().max(1) as f32
+    };
+    let (top, rest) = chain.split_at_mut(1);
+    for fy in 0..frames {
+        for fx in 0..frames {
+            let want = share(&top[0], &frame_texels(&top[0], frames, fx, fy), 1.0);
+            for image in rest.iter_mut() {
+                let texels = frame_texels(image, frames, fx, fy);
+                if share(image, &texels, 1.0) >= want {
+                    continue;
+                }
+                // The smallest scale whose share reaches level 0's (the share grows with it).
+                let (mut lo, mut hi) = (1.0f32, 2.0f32);
+                while share(image, &texels, hi) < want && hi < 1e6 {
+                    lo = hi;
+                    hi *= 2.0;
+                }
+                for _ in 0..24 {
+                    let mid = 0.5 * (lo + hi);
+                    if share(image, &texels, mid) >= want {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                for &i in &texels {
+                    image.texels[i][3] = (image.texels[i][3] * hi).min(1.0);
+                }
+            }
+        }
+    }
+}
+
 impl ImpostorAtlas {
     /// Mip levels of each atlas: `log2(frame_size) + 1`.
     pub fn mip_levels(layout: &ImpostorLayout) -> u32 {

@@ -107,3 +107,23 @@ fn a_view_on_a_frame_sees_that_frame_and_between_frames_their_blend() {
         assert_eq!(s.color.w, 0.0);
     }
 }
+
+#[test]
+fn coverage_preserving_mips_keep_thin_features() {
+    // One frame of 8 x 8 texels with a one-texel-wide vertical line at alpha 0.9: an eighth of
+    // the texels pass the test.
+    let mut image = ImpostorImage::filled(8, [0.0; 4]);
+    for y in 0..8 {
+        image.texels[y * 8 + 3] = [1.0, 1.0, 1.0, 0.9];
+    }
+    let mut chain = mip_chain(image, 1, 8);
+    // The box filter takes the line to 0.45 at level 1: nothing passes.
+    assert!(chain[1].texels.iter().all(|t| t[3] < 0.5));
+    preserve_coverage(&mut chain, 1);
+    // Each level again has at least an eighth passing: the line's column of texels (4 of 16
+    // at level 1, 2 of 4 at level 2, the one texel of level 3); level 0 as it was.
+    let passing = |i: &ImpostorImage| i.texels.iter().filter(|t| t[3] >= 0.5).count();
+    let counts: Vec<usize> = chain.iter().map(passing).collect();
+    assert_eq!(counts, [8, 4, 2, 1]);
+    assert!(chain.iter().flat_map(|i| &i.texels).all(|t| t[3] <= 1.0));
+}

@@ -12,7 +12,7 @@ use crate::gpu::resources::{
 use crate::gpu::{GpuContext, GpuError};
 use crate::impostor::{
     ImpostorAtlas, ImpostorImage, ImpostorLayout, dilate_frames, impostor_frame_basis,
-    impostor_frame_dir, mip_chain,
+    impostor_frame_dir, mip_chain, preserve_coverage,
 };
 
 /// Rust mirror of `BakeParams` in `passes/impostor_bake.wgsl`.
@@ -311,9 +311,11 @@ impl ImpostorBaker {
         let mut color = to_image(size, &color);
         let mut normal_depth = to_image(size, &normal_depth);
         dilate_frames(&mut color, &mut [&mut normal_depth], n, layout.frame_size);
+        let mut color = mip_chain(color, n, layout.frame_size);
+        preserve_coverage(&mut color, n);
         Ok(ImpostorAtlas {
             layout,
-            color: mip_chain(color, n, layout.frame_size),
+            color,
             normal_depth: mip_chain(normal_depth, n, layout.frame_size),
         })
     }
