@@ -169,7 +169,9 @@ pub fn preserve_coverage(chain: &mut [ImpostorImage], frames: u32) {
     };
     let frames = frames as usize;
     let whole = |i: &ImpostorImage| {
-        frames > 0 && i.size as usize % frames == 0 && i.texels.len() == (i.size as usize).pow(2)
+        frames > 0
+            && (i.size as usize).is_multiple_of(frames)
+            && i.texels.len() == (i.size as usize).pow(2)
     };
     let halving = chain
         .iter()
