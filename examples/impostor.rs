@@ -96,9 +96,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             light: Vec3::new(0.3, 0.8, 0.5).normalize(),
             ambient: 1.0,
         };
-        let instances = [ImpostorInstance {
-            model: Mat4::IDENTITY,
-        }];
+        let instances = [ImpostorInstance::new(Mat4::IDENTITY)];
         let drawn = pass.render(&gpu, &textures, &view, &instances, (SIZE, SIZE))?;
         // Both enlarged 4x around the centre so the small pictures can be seen.
         for y in 0..SIZE {

@@ -155,7 +155,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         tri_full += chain.levels()[0].triangles();
         tri_chain += chain.levels()[level].triangles();
         if d >= impostor_at {
-            far.push(ImpostorInstance { model: *model });
+            far.push(ImpostorInstance::new(*model));
             tri_impostor += 2;
         } else {
             let level = kept[1..].iter().filter(|&&s| s <= d).count();

@@ -1,17 +1,20 @@
 // passes/impostor — octahedral impostors drawn from their atlas (lodkit::impostor): one
 // camera-facing card per instance that covers the bounding sphere's projection; each fragment
 // blends the three frames nearest its view ray (one parallax step each), drops what the atlas
-// does not cover, and writes the depth of the surface the frames saw, so the depth test sees
-// the object, not the card.
+// does not cover (and, in a transition, what its screen-door pattern leaves to the other
+// level), and writes the depth of the surface the frames saw, so the depth test sees the
+// object, not the card.
 //
 // Entry points:
 //   vs_main   no vertex buffer: six vertices per instance; per instance @location(0..3) the
-//             columns of the object-to-world matrix (rotation, uniform scale, translation)
+//             columns of the object-to-world matrix (rotation, uniform scale, translation),
+//             @location(4).x the screen-door alpha (lodkit::screen_door; 1: every pixel)
 //   fs_main   location 0: colour (base colour x Lambert from `view.light`); @builtin(frag_depth)
 // Bindings: group 0: 0 `view: ImpostorView` (uniform), 1 `color_atlas`, 2 `normal_atlas`
 //   (filterable, with mips), 3 `atlas_sampler` (linear, mipmapped, clamp to edge).
 // Shader defs: none.
 #import lodkit::impostor::{ImpostorSample, impostor_sample, impostor_keep}
+#import lodkit::screen_door::screen_door_keep
 
 /// The view and the atlas.
 struct ImpostorView {
@@ -41,6 +44,7 @@ struct VertexOut {
     @location(3) @interpolate(flat) model_1: vec4<f32>,
     @location(4) @interpolate(flat) model_2: vec4<f32>,
     @location(5) @interpolate(flat) model_3: vec4<f32>,
+    @location(6) @interpolate(flat) alpha: f32,
 }
 
 /// The card: six vertices per instance around the bounding sphere's centre, facing the eye.
@@ -51,6 +55,7 @@ fn vs_main(
     @location(1) model_1: vec4<f32>,
     @location(2) model_2: vec4<f32>,
     @location(3) model_3: vec4<f32>,
+    @location(4) door: vec4<f32>,
 ) -> VertexOut {
     let model = mat4x4<f32>(model_0, model_1, model_2, model_3);
     let scale = length(model_0.xyz);
@@ -83,6 +88,7 @@ fn vs_main(
     out.model_1 = model_1;
     out.model_2 = model_2;
     out.model_3 = model_3;
+    out.alpha = door.x;
     return out;
 }
 
@@ -100,7 +106,7 @@ fn fs_main(in: VertexOut) -> FragmentOut {
     let footprint = max(length(dpdx(in.card)), length(dpdy(in.card)));
     let level = max(log2(footprint * f32(view.atlas.z) * 0.5), 0.0);
     let s = impostor_sample(color_atlas, normal_atlas, atlas_sampler, view.atlas.x, view.atlas.y != 0u, in.eye, in.card - in.eye, level);
-    if (!impostor_keep(s.color.w)) {
+    if (!impostor_keep(s.color.w) || !screen_door_keep(in.position.xy, in.alpha)) {
         discard;
     }
     let model = mat4x4<f32>(in.model_0, in.model_1, in.model_2, in.model_3);

@@ -38,11 +38,22 @@ pub struct ImpostorView {
 }
 
 /// One impostor instance: its object-to-world transform (a rotation, a uniform scale and a
-/// translation; the card and the depth it writes assume no shear).
+/// translation; the card and the depth it writes assume no shear) and its screen-door alpha.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImpostorInstance {
     /// Object to world.
     pub model: glam::Mat4,
+    /// The complementary screen-door pattern's alpha (`lodkit::screen_door`): 1 draws every
+    /// pixel; in a transition from a mesh level at `-(1 - t)` the impostor takes `t` (or the
+    /// other way round), and the two cover disjoint pixels whose union is the object's.
+    pub alpha: f32,
+}
+
+impl ImpostorInstance {
+    /// An instance at `model`, drawn whole (alpha 1).
+    pub fn new(model: glam::Mat4) -> Self {
+        Self { model, alpha: 1.0 }
+    }
 }
 
 /// Rust mirror of `ImpostorView` in `passes/impostor.wgsl`.
@@ -120,9 +131,9 @@ impl ImpostorPass {
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
                     buffers: &[Some(wgpu::VertexBufferLayout {
-                        array_stride: 64,
+                        array_stride: 80,
                         step_mode: wgpu::VertexStepMode::Instance,
-                        attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4, 2 => Float32x4, 3 => Float32x4],
+                        attributes: &wgpu::vertex_attr_array![0 => Float32x4, 1 => Float32x4, 2 => Float32x4, 3 => Float32x4, 4 => Float32x4],
                     })],
                 },
                 primitive: Default::default(),
@@ -172,7 +183,15 @@ impl ImpostorPass {
             wgpu::BufferUsages::UNIFORM,
             "impostor view",
         )?;
-        let models: Vec<[f32; 16]> = instances.iter().map(|i| i.model.to_cols_array()).collect();
+        let models: Vec<[f32; 20]> = instances
+            .iter()
+            .map(|i| {
+                let mut words = [0.0; 20];
+                words[..16].copy_from_slice(&i.model.to_cols_array());
+                words[16] = i.alpha;
+                words
+            })
+            .collect();
         let buffer = buffer_with_data(
             gpu,
             bytemuck::cast_slice(&models),
