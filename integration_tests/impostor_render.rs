@@ -204,6 +204,31 @@ fn impostor_stays_within_the_pixel_bound_between_frames() {
             "t = {t}: the impostor keeps {share} of its pixels"
         );
     }
+    // Reversed Z (an infinite reversed projection, tested `Greater` against a depth cleared to
+    // 0): the same pixels as the standard projection, whose clip x and y it shares.
+    let reversed = ImpostorPass::new(
+        gpu,
+        &ImpostorPassDescriptor {
+            color_format: wgpu::TextureFormat::Rgba8Unorm,
+            depth: lodkit::combine::DepthConvention::Reversed,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let center = Vec3::from(textures.layout.center);
+    let up = if view.y.abs() > 0.95 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    let infinite = glam::camera::rh::proj::directx::perspective_infinite_reverse(
+        FOV.to_radians(),
+        1.0,
+        near * 0.05,
+    ) * glam::camera::rh::view::look_at_mat4(eye, center, up);
+    let got = screen_door_coverage(gpu, &reversed, &textures, infinite, eye, 1.0);
+    let differ = (0..whole.len()).filter(|&i| got[i] != whole[i]).count();
+    assert_eq!(differ, 0, "reversed Z covers other pixels");
 }
 
 /// Bad input is an error naming the field and the part, before any GPU work; nothing panics.

@@ -2,6 +2,7 @@
 //! (`passes/impostor.wgsl`).
 
 use super::ImpostorTextures;
+use crate::combine::DepthConvention;
 use crate::gpu::resources::{buffer_with_data, uniform_entry};
 use crate::gpu::{GpuContext, GpuError};
 
@@ -10,16 +11,21 @@ use crate::gpu::{GpuContext, GpuError};
 pub struct ImpostorPassDescriptor {
     /// Format of the colour target it draws into.
     pub color_format: wgpu::TextureFormat,
-    /// Format of the depth target (depth-tested and written, `Less`).
+    /// Format of the depth target (depth-tested and written).
     pub depth_format: wgpu::TextureFormat,
+    /// The engine's depth convention: `Standard` tests `Less` (cleared to 1), `Reversed`
+    /// (Bevy's, with an infinite reversed projection) `Greater` (cleared to 0). The depth the
+    /// fragment writes comes from the view's projection either way.
+    pub depth: DepthConvention,
 }
 
 impl Default for ImpostorPassDescriptor {
-    /// `Rgba8UnormSrgb` colour, `Depth32Float` depth.
+    /// `Rgba8UnormSrgb` colour, `Depth32Float` depth, standard depth.
     fn default() -> Self {
         Self {
             color_format: wgpu::TextureFormat::Rgba8UnormSrgb,
             depth_format: wgpu::TextureFormat::Depth32Float,
+            depth: DepthConvention::Standard,
         }
     }
 }
@@ -139,7 +145,10 @@ impl ImpostorPass {
                 primitive: Default::default(),
                 depth_stencil: Some(crate::gpu::resources::depth_write_state(
                     descriptor.depth_format,
-                    wgpu::CompareFunction::Less,
+                    match descriptor.depth {
+                        DepthConvention::Standard => wgpu::CompareFunction::Less,
+                        DepthConvention::Reversed => wgpu::CompareFunction::Greater,
+                    },
                 )),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
@@ -272,11 +281,15 @@ impl ImpostorPass {
             {
                 let color_view = color.create_view(&Default::default());
                 let depth_view = depth.create_view(&Default::default());
+                let far = match self.descriptor.depth {
+                    DepthConvention::Standard => 1.0,
+                    DepthConvention::Reversed => 0.0,
+                };
                 let mut pass = begin_targets_pass(
                     &mut encoder,
                     &[(&color_view, wgpu::Color::TRANSPARENT)],
                     &depth_view,
-                    1.0,
+                    far,
                     None,
                     "impostors",
                 );
