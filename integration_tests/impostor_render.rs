@@ -204,8 +204,9 @@ fn impostor_stays_within_the_pixel_bound_between_frames() {
             "t = {t}: the impostor keeps {share} of its pixels"
         );
     }
-    // Reversed Z (an infinite reversed projection, tested `Greater` against a depth cleared to
-    // 0): the same pixels as the standard projection, whose clip x and y it shares.
+    // Depth, standard and reversed (an infinite reversed projection, tested `Greater` against
+    // a depth cleared to 0): the near tree drawn first, a second one behind it and to the side;
+    // wherever the near one covers a pixel it shows there, byte for byte as drawn alone.
     let reversed = ImpostorPass::new(
         gpu,
         &ImpostorPassDescriptor {
@@ -226,9 +227,48 @@ fn impostor_stays_within_the_pixel_bound_between_frames() {
         1.0,
         near * 0.05,
     ) * glam::camera::rh::view::look_at_mat4(eye, center, up);
-    let got = screen_door_coverage(gpu, &reversed, &textures, infinite, eye, 1.0);
-    let differ = (0..whole.len()).filter(|&i| got[i] != whole[i]).count();
-    assert_eq!(differ, 0, "reversed Z covers other pixels");
+    let radius = textures.layout.radius;
+    let side = view.cross(up).normalize();
+    let behind = Mat4::from_translation((side * 0.6 - view * 3.0) * radius);
+    let alone = [ImpostorInstance::new(Mat4::IDENTITY)];
+    let both = [alone[0], ImpostorInstance::new(behind)];
+    let standard_clip = clip;
+    for (who, depth_pass, clip) in [("standard", &pass, clip), ("reversed", &reversed, infinite)] {
+        let view = ImpostorView {
+            view_proj: clip,
+            eye,
+            light: Vec3::new(0.3, 0.8, 0.5).normalize(),
+            ambient: 0.4,
+        };
+        let one = depth_pass
+            .render(gpu, &textures, &view, &alone, (SIZE, SIZE))
+            .unwrap();
+        let two = depth_pass
+            .render(gpu, &textures, &view, &both, (SIZE, SIZE))
+            .unwrap();
+        let shown = |image: &[u8]| image.chunks(4).filter(|p| p[3] > 127).count();
+        assert!(
+            shown(&two) > shown(&one),
+            "{who}: the tree behind shows nowhere"
+        );
+        let hidden = (0..one.len() / 4)
+            .filter(|&i| one[4 * i + 3] > 127 && one[4 * i..4 * i + 4] != two[4 * i..4 * i + 4])
+            .count();
+        assert_eq!(hidden, 0, "{who}: the tree behind drew over the near one");
+        if who == "reversed" {
+            let standard_view = ImpostorView {
+                view_proj: standard_clip,
+                ..view
+            };
+            let standard = pass
+                .render(gpu, &textures, &standard_view, &alone, (SIZE, SIZE))
+                .unwrap();
+            let differ = (0..one.len() / 4)
+                .filter(|&i| (one[4 * i + 3] > 127) != (standard[4 * i + 3] > 127))
+                .count();
+            assert_eq!(differ, 0, "reversed Z covers other pixels than standard Z");
+        }
+    }
 }
 
 /// Bad input is an error naming the field and the part, before any GPU work; nothing panics.

@@ -12,7 +12,8 @@
 //   fs_main   location 0: colour (base colour x Lambert from `view.light`); @builtin(frag_depth)
 // Bindings: group 0: 0 `view: ImpostorView` (uniform), 1 `color_atlas`, 2 `normal_atlas`
 //   (filterable, with mips), 3 `atlas_sampler` (linear, mipmapped, clamp to edge).
-// Shader defs: none.
+// Shader defs: LODKIT_SCREEN_DOOR_BLUE_NOISE (bool, default off; lodkit::screen_door's) — the
+//   16x16 blue-noise pattern instead of the 4x4 Bayer one, to match the mesh levels'.
 #import lodkit::impostor::{ImpostorSample, impostor_sample, impostor_keep}
 #import lodkit::screen_door::screen_door_keep
 

@@ -157,26 +157,30 @@ pub fn mip_chain(image: ImpostorImage, frames: u32, frame_size: u32) -> Vec<Impo
     levels
 }
 
-/// Scales the alpha of every frame of every level after the first so that as large a share of
-/// its texels passes the alpha test (>= 0.5) as of the frame's texels at level 0: a box filter
-/// alone averages thin covered features (leaves, twigs, fences) below the test and they vanish
-/// at a distance (Castaño's coverage-preserving alpha mipmaps). `chain` is a [`mip_chain`] of
+/// Scales up the alpha of every frame of every level after the first, where it falls short, so
+/// that at least as large a share of its texels passes the alpha test (>= 0.5) as of the
+/// frame's texels at level 0: a box filter alone averages thin covered features (leaves,
+/// twigs, fences) below the test and they vanish at a distance (after Castaño's
+/// coverage-preserving alpha mipmaps, which also scale down). `chain` is a [`mip_chain`] of
 /// `frames x frames` frames; one that is not (sizes that do not halve down from a multiple of
-/// `frames`) is left as it is. Alpha stays within [0, 1].
+/// `frames`) is left as it is. A scaled alpha is clamped to 1.
 pub fn preserve_coverage(chain: &mut [ImpostorImage], frames: u32) {
     let Some(first) = chain.first() else {
         return;
     };
+    if chain.len() < 2 || first.size == 0 || frames == 0 || first.size < frames {
+        return;
+    }
     let frames = frames as usize;
     let whole = |i: &ImpostorImage| {
-        frames > 0
+        i.size as usize >= frames
             && (i.size as usize).is_multiple_of(frames)
             && i.texels.len() == (i.size as usize).pow(2)
     };
     let halving = chain
         .iter()
         .enumerate()
-        .all(|(k, i)| whole(i) && i.size == first.size >> k);
+        .all(|(k, i)| whole(i) && Some(i.size) == first.size.checked_shr(k as u32));
     if !halving {
         return;
     }

@@ -127,3 +127,52 @@ fn coverage_preserving_mips_keep_thin_features() {
     assert_eq!(counts, [8, 4, 2, 1]);
     assert!(chain.iter().flat_map(|i| &i.texels).all(|t| t[3] <= 1.0));
 }
+
+#[test]
+fn coverage_preserving_mips_work_frame_by_frame() {
+    // 2 x 2 frames of 4 texels: frame (1, 0) holds a one-texel line at alpha 0.9, frame (0, 1)
+    // is solid, the others empty.
+    let mut image = ImpostorImage::filled(8, [0.0; 4]);
+    for y in 0..4 {
+        image.texels[y * 8 + 5] = [1.0, 0.0, 0.0, 0.9];
+    }
+    for y in 4..8 {
+        for x in 0..4 {
+            image.texels[y * 8 + x] = [0.0, 1.0, 0.0, 1.0];
+        }
+    }
+    let mut chain = mip_chain(image, 2, 4);
+    let before = chain.clone();
+    preserve_coverage(&mut chain, 2);
+    // Level 1 (4 x 4, 2 x 2 texels a frame): the line's frame gets its column back (2 of 4),
+    // the solid and the empty frames are left exactly as they were.
+    let level = &chain[1];
+    let passing = |x0: u32, y0: u32| {
+        (0..2)
+            .flat_map(|y| (0..2).map(move |x| (x0 + x, y0 + y)))
+            .filter(|&(x, y)| level.texel(x, y)[3] >= 0.5)
+            .count()
+    };
+    assert_eq!(passing(2, 0), 2, "{:?}", level.texels);
+    for (x0, y0) in [(0, 0), (0, 2), (2, 2)] {
+        for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let (x, y) = (x0 + x, y0 + y);
+            assert_eq!(
+                level.texel(x, y),
+                before[1].texel(x, y),
+                "frame at ({x0}, {y0})"
+            );
+        }
+    }
+    // Nothing to do for a chain of one level, or a chain that is not one.
+    let mut one = vec![ImpostorImage::filled(8, [0.3; 4])];
+    preserve_coverage(&mut one, 2);
+    assert_eq!(one[0].texels[0], [0.3; 4]);
+    let mut odd = vec![
+        ImpostorImage::filled(8, [0.3; 4]),
+        ImpostorImage::filled(3, [0.3; 4]),
+    ];
+    preserve_coverage(&mut odd, 2);
+    assert_eq!(odd[1].texels[0], [0.3; 4]);
+    preserve_coverage(&mut odd, u32::MAX);
+}

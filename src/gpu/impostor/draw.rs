@@ -5,6 +5,7 @@ use super::ImpostorTextures;
 use crate::combine::DepthConvention;
 use crate::gpu::resources::{buffer_with_data, uniform_entry};
 use crate::gpu::{GpuContext, GpuError};
+use crate::screen_door::DitherPattern;
 
 /// How to build an [`ImpostorPass`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -17,15 +18,19 @@ pub struct ImpostorPassDescriptor {
     /// (Bevy's, with an infinite reversed projection) `Greater` (cleared to 0). The depth the
     /// fragment writes comes from the view's projection either way.
     pub depth: DepthConvention,
+    /// The screen-door pattern of transitions: the one the mesh levels it meets are drawn with
+    /// (the two must match to be complementary).
+    pub dither: DitherPattern,
 }
 
 impl Default for ImpostorPassDescriptor {
-    /// `Rgba8UnormSrgb` colour, `Depth32Float` depth, standard depth.
+    /// `Rgba8UnormSrgb` colour, `Depth32Float` depth, standard depth, the 4x4 Bayer pattern.
     fn default() -> Self {
         Self {
             color_format: wgpu::TextureFormat::Rgba8UnormSrgb,
             depth_format: wgpu::TextureFormat::Depth32Float,
             depth: DepthConvention::Standard,
+            dither: DitherPattern::Bayer4x4,
         }
     }
 }
@@ -49,9 +54,10 @@ pub struct ImpostorView {
 pub struct ImpostorInstance {
     /// Object to world.
     pub model: glam::Mat4,
-    /// The complementary screen-door pattern's alpha (`lodkit::screen_door`): 1 draws every
-    /// pixel; in a transition from a mesh level at `-(1 - t)` the impostor takes `t` (or the
-    /// other way round), and the two cover disjoint pixels whose union is the object's.
+    /// The complementary screen-door pattern's alpha (`lodkit::screen_door`), in [-1, 1]: 1
+    /// draws every pixel; in a transition from a mesh level at `-(1 - t)` the impostor takes
+    /// `t` (or the other way round), and the two cover disjoint pixels whose union is the
+    /// object's. Values outside are clamped, a NaN taken as 1.
     pub alpha: f32,
 }
 
@@ -101,7 +107,11 @@ impl ImpostorPass {
             descriptor.color_format,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         )?;
-        let module = gpu.pass_module("impostor", &[])?;
+        let defs: &[&str] = match descriptor.dither {
+            DitherPattern::Bayer4x4 => &[],
+            DitherPattern::BlueNoise16x16 => &["LODKIT_SCREEN_DOOR_BLUE_NOISE"],
+        };
+        let module = gpu.pass_module("impostor", defs)?;
         gpu.guarded(CALL, || {
             let device = &gpu.device;
             let texture = |binding| {
@@ -197,7 +207,11 @@ impl ImpostorPass {
             .map(|i| {
                 let mut words = [0.0; 20];
                 words[..16].copy_from_slice(&i.model.to_cols_array());
-                words[16] = i.alpha;
+                words[16] = if i.alpha.is_nan() {
+                    1.0
+                } else {
+                    i.alpha.clamp(-1.0, 1.0)
+                };
                 words
             })
             .collect();
