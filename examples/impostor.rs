@@ -17,7 +17,7 @@ use lodkit::gpu::impostor::{
     ImpostorBakeDescriptor, ImpostorBaker, ImpostorInstance, ImpostorPass, ImpostorPassDescriptor,
     ImpostorTextures, ImpostorView,
 };
-use lodkit::impostor::impostor_switch_distance;
+use lodkit::impostor::{impostor_switch_distance, srgba8};
 use lodkit::lod_chain::PixelErrorCamera;
 use lodkit_scenes::tree::LeafyTree;
 
@@ -40,7 +40,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let atlas = baker.bake(&gpu, &ImpostorBakeDescriptor::default())?;
     let baked = start.elapsed();
     let size = atlas.layout.atlas_size();
-    image::RgbaImage::from_raw(size, size, atlas.color[0].to_rgba8())
+    image::RgbaImage::from_raw(size, size, atlas.color[0].to_srgba8())
         .ok_or("atlas size")?
         .save(format!("{out}/impostor_atlas.png"))?;
 
@@ -104,17 +104,8 @@ fn main() -> Result<(), Box<dyn Error>> {
                 let (sx, sy) = (SIZE * 3 / 8 + x / 4, SIZE * 3 / 8 + y / 4);
                 let i = (sy * SIZE + sx) as usize;
                 let t = reference[i];
-                let srgb = |c: f32| {
-                    let c = c.clamp(0.0, 1.0);
-                    let s = if c <= 0.003_130_8 {
-                        12.92 * c
-                    } else {
-                        1.055 * c.powf(1.0 / 2.4) - 0.055
-                    };
-                    (s * 255.0).round() as u8
-                };
                 let mesh_px = if t[3] > 0.5 {
-                    [srgb(t[0]), srgb(t[1]), srgb(t[2]), 255]
+                    srgba8([t[0], t[1], t[2], 1.0])
                 } else {
                     [255; 4]
                 };

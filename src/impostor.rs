@@ -13,7 +13,9 @@ mod atlas;
 mod bound;
 mod sample;
 
-pub use atlas::{ImpostorAtlas, ImpostorImage, dilate_frames, mip_chain, preserve_coverage};
+pub use atlas::{
+    ImpostorAtlas, ImpostorImage, dilate_frames, mip_chain, preserve_coverage, srgba8,
+};
 #[cfg(feature = "lod_chain")]
 pub use bound::impostor_switch_distance;
 pub use bound::{impostor_angle, impostor_error};

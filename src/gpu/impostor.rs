@@ -14,7 +14,7 @@ pub use draw::{
 use glam::Vec3;
 
 use crate::gpu::{GpuContext, GpuError};
-use crate::impostor::{ImpostorAtlas, ImpostorLayout, ImpostorShape};
+use crate::impostor::{ImpostorAtlas, ImpostorImage, ImpostorLayout, ImpostorShape};
 
 /// The mesh an impostor is baked from: an indexed triangle list (object space).
 #[derive(Clone, Copy, Debug, Default)]
@@ -319,33 +319,7 @@ impl ImpostorTextures {
                     &data,
                 )
             };
-            let srgb = |c: f32| {
-                let c = c.clamp(0.0, 1.0);
-                let s = if c <= 0.003_130_8 {
-                    12.92 * c
-                } else {
-                    1.055 * c.powf(1.0 / 2.4) - 0.055
-                };
-                (s * 255.0).round() as u8
-            };
-            let color = atlas
-                .color
-                .iter()
-                .map(|image| {
-                    image
-                        .texels
-                        .iter()
-                        .flat_map(|t| {
-                            [
-                                srgb(t[0]),
-                                srgb(t[1]),
-                                srgb(t[2]),
-                                (t[3].clamp(0.0, 1.0) * 255.0).round() as u8,
-                            ]
-                        })
-                        .collect()
-                })
-                .collect();
+            let color = atlas.color.iter().map(ImpostorImage::to_srgba8).collect();
             let normal_depth = atlas
                 .normal_depth
                 .iter()

@@ -27,6 +27,12 @@ impl ImpostorImage {
         self.texels[(y * self.size + x) as usize]
     }
 
+    /// The texels as sRGB RGBA8: colour through the sRGB transfer function, alpha linear
+    /// (what an `Rgba8UnormSrgb` texture or a PNG of the colour atlas holds).
+    pub fn to_srgba8(&self) -> Vec<u8> {
+        self.texels.iter().flat_map(|t| srgba8(*t)).collect()
+    }
+
     /// The texels as RGBA8 (unorm, rounded, clamped to [0, 1]).
     pub fn to_rgba8(&self) -> Vec<u8> {
         self.texels
@@ -34,6 +40,26 @@ impl ImpostorImage {
             .flat_map(|t| t.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8))
             .collect()
     }
+}
+
+/// A linear RGBA texel as sRGB RGBA8: colour through the sRGB transfer function, alpha linear,
+/// each clamped to [0, 1] and rounded.
+pub fn srgba8(texel: [f32; 4]) -> [u8; 4] {
+    let byte = |c: f32| (c.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let encode = |c: f32| {
+        let c = c.clamp(0.0, 1.0);
+        byte(if c <= 0.003_130_8 {
+            12.92 * c
+        } else {
+            1.055 * c.powf(1.0 / 2.4) - 0.055
+        })
+    };
+    [
+        encode(texel[0]),
+        encode(texel[1]),
+        encode(texel[2]),
+        byte(texel[3]),
+    ]
 }
 
 /// A baked impostor: its layout and two atlases, each with its mip chain (level 0 first, down to

@@ -220,23 +220,7 @@ pub fn bake(
 /// linear), level 0 each.
 pub fn pngs(atlas: &ImpostorAtlas) -> Result<(Vec<u8>, Vec<u8>), String> {
     let size = atlas.layout.atlas_size();
-    let srgb = |c: f32| {
-        let c = c.clamp(0.0, 1.0);
-        let s = if c <= 0.003_130_8 {
-            12.92 * c
-        } else {
-            1.055 * c.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0).round() as u8
-    };
-    let color: Vec<u8> = atlas.color[0]
-        .texels
-        .iter()
-        .flat_map(|t| {
-            let a = (t[3].clamp(0.0, 1.0) * 255.0).round() as u8;
-            [srgb(t[0]), srgb(t[1]), srgb(t[2]), a]
-        })
-        .collect();
+    let color = atlas.color[0].to_srgba8();
     let normal_depth: Vec<u16> = atlas.normal_depth[0]
         .texels
         .iter()

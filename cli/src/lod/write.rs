@@ -151,13 +151,15 @@ impl Output {
     }
 
     fn view(&mut self, bytes: &[u8], target: json::buffer::Target) -> Index<json::buffer::View> {
-        self.strided_view(bytes, target, None)
+        self.strided_view(bytes, Some(target), None)
     }
 
+    /// `bytes` appended to the buffer (4-aligned) as a view, with a target (none for an image)
+    /// and a stride.
     fn strided_view(
         &mut self,
         bytes: &[u8],
-        target: json::buffer::Target,
+        target: Option<json::buffer::Target>,
         stride: Option<usize>,
     ) -> Index<json::buffer::View> {
         pad4(&mut self.bin);
@@ -169,7 +171,7 @@ impl Output {
             byte_offset: Some(offset.into()),
             byte_stride: stride.map(json::buffer::Stride),
             name: None,
-            target: Some(Checked::Valid(target)),
+            target: target.map(Checked::Valid),
             extensions: None,
             extras: Default::default(),
         })
@@ -259,7 +261,7 @@ impl Output {
             bytes.resize(bytes.len() + padded - size, 0);
         }
         let stride = (padded != size).then_some(padded);
-        let view = self.strided_view(&bytes, json::buffer::Target::ArrayBuffer, stride);
+        let view = self.strided_view(&bytes, Some(json::buffer::Target::ArrayBuffer), stride);
         self.root.push(json::Accessor {
             buffer_view: Some(view),
             byte_offset: None,

@@ -23,19 +23,7 @@ impl Output {
         png: &[u8],
         name: String,
     ) -> (Index<json::Image>, Index<json::Texture>) {
-        super::pad4(&mut self.bin);
-        let offset = self.bin.len();
-        self.bin.extend_from_slice(png);
-        let view = self.root.push(json::buffer::View {
-            buffer: Index::new(0),
-            byte_length: png.len().into(),
-            byte_offset: Some(offset.into()),
-            byte_stride: None,
-            name: None,
-            target: None,
-            extensions: None,
-            extras: Default::default(),
-        });
+        let view = self.strided_view(png, None, None);
         let image = self.root.push(json::Image {
             buffer_view: Some(view),
             mime_type: Some(json::image::MimeType("image/png".into())),
