@@ -26,8 +26,8 @@
 //! rectangles, draws the same picture with more of the combine's fragments:
 //! `fragments_<run>_combine`). `--without-prepass-only` skips the app with a prepass.
 //! `--msaa` gives every camera Bevy's default `Msaa::Sample4`: the frame-sequential runs then take
-//! the plugin's fallback, lodkit's complementary screen-door dither (in the app with a prepass,
-//! a switch at once).
+//! the plugin's fallback, lodkit's complementary screen-door dither (in the app with a prepass
+//! too: the levels' prepass drops the same pixels).
 //! Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
 //!
 //! The scene is `scene.rs` (what a Bevy app writes to use the plugin is there, in

@@ -19,7 +19,11 @@ use crate::headless::{
 pub const WIDTH: u32 = 320;
 /// The height `lodkit lod` made the committed file's switch distances for.
 pub const HEIGHT: u32 = 180;
-pub const BACKGROUND: Color = Color::srgb_u8(20, 23, 31);
+/// The clear colour: a key colour no object of a real asset comes near, so that "shows the
+/// background" (within `frames::BACKGROUND_TOLERANCE`) means a hole. A dark grey one was within
+/// the tolerance of the dark rubber of Bevy's FlightHelmet: a pixel whose shade moved by one
+/// level counted as a hole, or as an object where no level is.
+pub const BACKGROUND: Color = Color::srgb_u8(255, 0, 255);
 /// Updates at the first pose before a run is recorded (materials and view resources ready).
 const WARMUP_UPDATES: usize = 3;
 

@@ -7,8 +7,11 @@
 //! It serves a camera with MSAA (the combine reads the main pass per pixel, and a multisampled
 //! one has no single id per pixel), groups with a blending material (whose alpha cannot carry
 //! the combine's id word) and groups with a masked material other than a `StandardMaterial`
-//! (whose alpha test the older-level depth pass cannot repeat). With a prepass the prepass would write both levels' depth whole and
-//! the main pass could then show neither at a pixel: such a camera switches at once instead.
+//! (whose alpha test the older-level depth pass cannot repeat). On a camera with a prepass, the
+//! prepass must drop the same pixels as the main pass, or it would write both levels' depth
+//! whole and the main pass could then show neither at a pixel: `FrameSequentialExtension`'s
+//! prepass does (and a blending material is not in the prepass); a level in a material of the
+//! app's own type, whose prepass is its own, switches at once instead.
 
 use lodkit::select::LodSelection;
 
@@ -21,15 +24,16 @@ pub(super) enum Fallback {
     None,
     /// Both levels are drawn through the screen-door dither.
     Dither,
-    /// The level switches at once (no combine, and a prepass rules the dither out).
+    /// The level switches at once (no combine, and a prepass that would draw a dithered level
+    /// whole rules the dither out).
     Switch,
 }
 
 impl Fallback {
-    /// The fallback of a group: `multisampled` camera, a level that `blends`, a camera with a
-    /// `prepass`.
-    pub(super) fn of(multisampled: bool, blends: bool, prepass: bool) -> Self {
-        match (multisampled || blends, prepass) {
+    /// The fallback of a group: `multisampled` camera, a level that `blends`, a camera whose
+    /// prepass draws one of the group's levels whole (`prepass_draws_whole`).
+    pub(super) fn of(multisampled: bool, blends: bool, prepass_draws_whole: bool) -> Self {
+        match (multisampled || blends, prepass_draws_whole) {
             (false, _) => Self::None,
             (true, false) => Self::Dither,
             (true, true) => Self::Switch,
@@ -111,7 +115,7 @@ mod tests {
     }
 
     #[test]
-    fn the_fallback_is_the_dither_unless_a_prepass_rules_it_out() {
+    fn the_fallback_is_the_dither_unless_a_prepass_draws_a_level_whole() {
         assert_eq!(Fallback::of(false, false, true), Fallback::None);
         assert_eq!(Fallback::of(true, false, false), Fallback::Dither);
         assert_eq!(Fallback::of(false, true, false), Fallback::Dither);

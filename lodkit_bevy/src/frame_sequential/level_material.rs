@@ -120,6 +120,11 @@ pub(super) struct Looks {
     /// in its alpha), or it is an alpha mask whose test lodkit cannot repeat (a material type
     /// other than `StandardMaterial`), so the combine could not know its coverage.
     pub(super) blends: bool,
+    /// Whether a prepass keeps the same pixels of it as the main pass when the dither drops
+    /// some: `StandardMaterial`'s prepass drops them too (`FrameSequentialExtension`), a blending
+    /// material is not in the prepass; the prepass of a custom opaque or masked material is its
+    /// own, which draws the level whole.
+    pub(super) prepass_dithers: bool,
     /// The faces it culls.
     pub(super) cull_mode: Option<Face>,
     /// A masked `StandardMaterial`'s alpha test, which the older-level depth pass repeats.
@@ -191,11 +196,13 @@ fn looks_of<B: Material>(material: &B) -> Looks {
     match (material as &dyn Any).downcast_ref::<StandardMaterial>() {
         Some(standard) => Looks {
             blends: blends(mode),
+            prepass_dithers: true,
             cull_mode: standard.cull_mode,
             alpha_test: AlphaTest::of(standard),
         },
         None => Looks {
             blends: blends(mode) || matches!(mode, AlphaMode::Mask(_)),
+            prepass_dithers: blends(mode),
             cull_mode: Some(Face::Back),
             alpha_test: None,
         },

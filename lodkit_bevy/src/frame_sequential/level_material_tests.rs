@@ -185,6 +185,8 @@ fn a_custom_material_is_derived_followed_and_drawn() {
         looks(&app),
         Looks {
             blends: false,
+            // Its prepass is its own, which draws a dithered level whole.
+            prepass_dithers: false,
             cull_mode: Some(Face::Back),
             alpha_test: None,
         }
@@ -197,6 +199,10 @@ fn a_custom_material_is_derived_followed_and_drawn() {
     app.update();
     app.update();
     assert!(looks(&app).blends, "a change of alpha mode is followed");
+    assert!(
+        looks(&app).prepass_dithers,
+        "a blending material has no prepass"
+    );
     app.world_mut()
         .resource_mut::<Assets<Plain>>()
         .get_mut(&plain)

@@ -9,15 +9,19 @@ use bevy::pbr::{
 use bevy::prelude::*;
 use bevy::reflect::TypePath;
 use bevy::render::render_resource::{
-    AsBindGroup, Extent3d, RenderPipelineDescriptor, SpecializedMeshPipelineError,
+    AsBindGroup, Extent3d, FragmentState, RenderPipelineDescriptor, SpecializedMeshPipelineError,
     TextureDimension, TextureFormat,
 };
+use bevy::shader::ShaderDefVal;
 use bevy::shader::ShaderRef;
 use lodkit::visibility::{VisibilityPattern, visibility_texture};
 
 /// The main-pass shader of [`FrameSequentialExtension`].
 pub(super) const LOD_MATERIAL_SHADER: Handle<Shader> =
     uuid_handle!("0b8f3e7a-5c1d-4e92-a6b4-7d2c9e1f3a58");
+/// The prepass shader of [`FrameSequentialExtension`].
+pub(super) const LOD_PREPASS_SHADER: Handle<Shader> =
+    uuid_handle!("7c2e9a14-3b6d-4f58-8e01-d5a3c7b9f246");
 /// The visibility texture every [`FrameSequentialExtension`] binds (64x64 void-and-cluster
 /// blue noise from `lodkit::visibility::visibility_texture`).
 pub const VISIBILITY_TEXTURE: Handle<Image> = uuid_handle!("5d7a2c41-8e36-4b0f-9c15-e2a4b6d8f013");
@@ -32,7 +36,10 @@ pub type FrameSequentialMaterial = ExtendedMaterial<StandardMaterial, FrameSeque
 /// The extension that makes a [`StandardMaterial`] a level of a frame-sequential LOD group: the
 /// shading is Bevy's, unchanged; the main pass also writes the fragment's LOD-buffer id word and
 /// display-time flags (from lodkit's visibility pattern) in alpha, which the combine pass reads.
-/// Opaque materials only.
+/// Where the group blends with the screen-door dither instead (a camera with MSAA), its prepass
+/// (StandardMaterial's, with the dither's discard first) keeps the same pixels of each level as
+/// the main pass, so a camera with MSAA and a prepass gets the dither too; on such a camera the
+/// prepass of an opaque level gets a fragment stage (a depth-only prepass of Bevy's has none).
 ///
 /// ```
 /// use bevy::prelude::*;
@@ -70,14 +77,41 @@ impl MaterialExtension for FrameSequentialExtension {
         LOD_MATERIAL_SHADER.into()
     }
 
+    fn prepass_fragment_shader() -> ShaderRef {
+        LOD_PREPASS_SHADER.into()
+    }
+
     fn specialize(
         _: &MaterialExtensionPipeline,
         descriptor: &mut RenderPipelineDescriptor,
         _: &MeshVertexBufferLayoutRef,
-        _: MaterialExtensionKey<Self>,
+        key: MaterialExtensionKey<Self>,
     ) -> Result<(), SpecializedMeshPipelineError> {
         define_level(descriptor);
+        if key.mesh_key.msaa_samples() > 1 {
+            dither_in_prepass(descriptor);
+        }
         Ok(())
+    }
+}
+
+/// The shader def Bevy's prepass pipelines (the camera's prepass and shadow maps) define.
+const PREPASS_PIPELINE_SHADER_DEF: &str = "PREPASS_PIPELINE";
+
+/// Gives a prepass pipeline without a fragment stage (an opaque level, depth prepass only)
+/// [`LOD_PREPASS_SHADER`]'s, which drops the pixels the dither drops. Bevy runs that shader
+/// where it runs a fragment stage already (normals, motion vectors, alpha masks): the
+/// extension's prepass shader.
+fn dither_in_prepass(descriptor: &mut RenderPipelineDescriptor) {
+    let prepass = descriptor.vertex.shader_defs.iter().any(
+        |def| matches!(def, ShaderDefVal::Bool(name, true) if name == PREPASS_PIPELINE_SHADER_DEF),
+    );
+    if prepass && descriptor.fragment.is_none() {
+        descriptor.fragment = Some(FragmentState {
+            shader: LOD_PREPASS_SHADER,
+            shader_defs: descriptor.vertex.shader_defs.clone(),
+            ..default()
+        });
     }
 }
 

@@ -27,7 +27,8 @@ use super::drawer::{
     DrawerQuery, FrameSequentialLevels, Scheduler, drawn, show, spawn_drawer, spawn_levels,
 };
 use super::level_material::{
-    ApplyDrawerMaterials, DeriveMaterials, DerivedMaterials, DrawerMaterial, add_level_material,
+    ApplyDrawerMaterials, DeriveMaterials, DerivedMaterials, DrawerMaterial, Looks,
+    add_level_material,
 };
 use super::rects::{Bounds, group_hull, group_rect, level_bounds, merge_rows, to_lodkit};
 use super::silhouette::{OutlineView, Surfaces, forget_changed_meshes, outline};
@@ -240,22 +241,21 @@ fn update(
     };
     let prepass = has_motion || has_depth || has_normal || has_deferred;
     // The combine reads and copies the main pass per pixel: a multisampled camera gets no
-    // combine; its groups are drawn through the screen-door dither, or switch at once where a
-    // prepass rules the dither out (`dither::Fallback`).
+    // combine; its groups are drawn through the screen-door dither, in the prepass too, or
+    // switch at once where a level's prepass cannot drop the dither's pixels
+    // (`dither::Fallback`).
     let multisampled = msaa.is_some_and(|m| *m != Msaa::Off);
     if multisampled {
-        if prepass {
-            warn_once!(
-                "FrameSequentialLod on a camera with MSAA and a prepass: the combine needs \
-                 Msaa::Off and the screen-door dither no prepass, so its LOD groups switch \
-                 levels at once"
-            );
-        } else {
-            warn_once!(
-                "FrameSequentialLod on a camera with MSAA: its LOD groups blend with lodkit's \
-                 complementary screen-door dither (Msaa::Off for the frame-sequential combine)"
-            );
-        }
+        warn_once!(
+            "FrameSequentialLod on a camera with MSAA: its LOD groups blend with lodkit's \
+             complementary screen-door dither (Msaa::Off for the frame-sequential combine){}",
+            if prepass {
+                "; with the camera's prepass, levels in a material of the app's own type whose \
+                 prepass is its own switch at once"
+            } else {
+                ""
+            }
+        );
         commands
             .entity(camera_entity)
             .remove::<FrameSequentialView>();
@@ -319,13 +319,17 @@ fn update(
         // Only a group in transition (or starting one) needs to know: a settled group draws its
         // level whole either way.
         let transitioning = selection.next.is_some() || state.transition.is_some();
-        let blending = transitioning
-            && levels.0.iter().any(|l| {
-                derived
-                    .looks(&l.material, &materials)
-                    .is_some_and(|m| m.blends)
-            });
-        let fallback = Fallback::of(multisampled, blending, prepass);
+        let looks = |test: fn(&Looks) -> bool| {
+            transitioning
+                && levels.0.iter().any(|l| {
+                    derived
+                        .looks(&l.material, &materials)
+                        .is_some_and(|m| test(&m))
+                })
+        };
+        let blending = looks(|m| m.blends);
+        let prepass_draws_whole = prepass && looks(|m| !m.prepass_dithers);
+        let fallback = Fallback::of(multisampled, blending, prepass_draws_whole);
         if blending {
             warn_once!(
                 "a LOD group has a blending material (AlphaMode::Blend, ...), whose alpha cannot \
@@ -334,7 +338,8 @@ fn update(
                 if fallback == Fallback::Dither {
                     "it blends with the screen-door dither"
                 } else {
-                    "with a prepass on the camera it switches levels at once"
+                    "with a prepass on the camera that draws its levels whole, it switches \
+                     levels at once"
                 }
             );
         }
