@@ -1,8 +1,10 @@
 //! Host time of one recording: lodkit's `CombinePass::record` (known coverage: the frame's
-//! `CombineData` uploaded with it) and `UpsamplePass::record`, each against a plain wgpu pass an
-//! engine writes by hand around lodkit's pass shader, with the same bindings and the same uploads
-//! (its parameters with `queue.write_buffer`, the combine's data with `queue.write_texture`, its
-//! bind group made once), drawing the same full-screen triangle into the same target. Only the recording is timed: the
+//! `CombineData` uploaded with it), `UpsamplePass::record` and `GpuLodSelector::record`, each
+//! against a plain wgpu pass an engine writes by hand around lodkit's pass shader, with the same
+//! bindings and the same uploads (its parameters with `queue.write_buffer`, the combine's data
+//! with `queue.write_texture`, its bind group made once), drawing the same full-screen triangle
+//! into the same target (the selection: resetting the same counts and dispatching the same
+//! workgroups over the same instances). Only the recording is timed: the
 //! encoder is made before, submitted after and waited for (so that a software GPU's drawing does
 //! not share the cores with the next recording), outside the clock.
 //!
@@ -30,9 +32,14 @@ use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor, UpsampleSettings,
 };
 use lodkit::gpu::resources::{
-    begin_color_pass, fullscreen_pipeline_with, one_group_layout, texture_2d, texture_entry,
-    uniform_buffer, uniform_entry,
+    begin_color_pass, buffer_with_data, fullscreen_pipeline_with, one_group_layout, texture_2d,
+    texture_entry, uniform_buffer, uniform_entry,
 };
+use lodkit::gpu::select::{
+    GpuLodGroup, GpuLodInstance, GpuLodSelector, GpuLodSelectorDescriptor, GpuSelectCamera,
+    GpuSelectChunk, GpuSelectFrame,
+};
+use lodkit::select::{LodCamera, LodGroup, LodSettings, LodState, distance_kind, frustum_planes};
 
 const W: u32 = 320;
 const H: u32 = 180;
@@ -321,6 +328,170 @@ fn upsample(c: &mut Criterion, gpu: &GpuContext) -> String {
     )
 }
 
+/// Instances the selection selects (one chunk: one dispatch).
+const SELECT_INSTANCES: usize = 10_000;
+/// Its workgroup size (`passes/select.wgsl`).
+const SELECT_WORKGROUP: u32 = 64;
+/// Bytes of one slot's indirect draw arguments.
+const DRAW_BYTES: usize = 20;
+/// Bytes of one list entry.
+const ENTRY_BYTES: usize = 16;
+
+fn select(c: &mut Criterion, gpu: &GpuContext) -> String {
+    let groups = [
+        LodGroup::from_distances(&[0.0, 10.0, 30.0]).expect("a group"),
+        LodGroup::from_distances(&[0.0, 5.0, 15.0, 40.0]).expect("a group"),
+    ];
+    let slots: u32 = groups.iter().map(|g| g.levels().len() as u32).sum();
+    let side = (SELECT_INSTANCES as f32).sqrt().ceil() as usize;
+    let instances: Vec<GpuLodInstance> = (0..SELECT_INSTANCES)
+        .map(|i| {
+            let at = glam::Vec3::new((i % side) as f32 * 2.0, 0.5, -((i / side) as f32) * 2.0);
+            GpuLodInstance::new(at, 0.6, 1.0, (i % 2) as u32)
+        })
+        .collect();
+    let mut selector = GpuLodSelector::new(
+        gpu,
+        &GpuLodSelectorDescriptor {
+            groups: &groups,
+            settings: LodSettings::default(),
+            meshes: &[],
+        },
+    )
+    .expect("the selector");
+    selector
+        .set_instances(gpu, &instances)
+        .expect("the instances");
+    let view = selector.add_view(gpu).expect("a view");
+    let proj = glam::camera::rh::proj::directx::perspective(1.0, 1.6, 0.1, 2000.0);
+    let eye = glam::Vec3::new(0.0, 3.0, 5.0);
+    let look = glam::camera::rh::view::look_at_mat4(eye, eye - glam::Vec3::Z, glam::Vec3::Y);
+    let frame = GpuSelectFrame {
+        camera: LodCamera::new(eye, proj),
+        view_proj: Some(proj * look),
+        dt: 1.0 / 60.0,
+        frame: 0,
+        frame_sequential: false,
+    };
+    // The plain pass: lodkit's select shader in a compute pipeline of the engine's, its eight
+    // buffers (camera, groups, instances, slot starts, states, counts, lists, chunk) filled by
+    // the engine with lodkit's math (`select_data`, `distance_kind`, `select_mode`,
+    // `frustum_planes`) and bound once, the counts reset from a template by a copy, as lodkit's
+    // recording does. Its data is lodkit's, so the GPU does the same work on both sides: on a
+    // software GPU the work a recording follows (same cores, same caches) changes its host time.
+    let device = &gpu.device;
+    let module = gpu.pass_module("select", &[]).expect("the pass module");
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("plain select"),
+        layout: None,
+        module: &module,
+        entry_point: None,
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let settings = LodSettings::default();
+    let mut table = Vec::new();
+    let mut firsts = Vec::new();
+    let mut entries = 0u32;
+    for (g, group) in groups.iter().enumerate() {
+        let data = group
+            .select_data(settings.hysteresis)
+            .expect("at most 8 levels");
+        table.push(GpuLodGroup {
+            levels: data.levels,
+            level_count: data.level_count,
+            max_distance: data.max_distance,
+            fade_from: data.fade_from,
+            hysteresis: data.hysteresis,
+            first_slot: firsts.len() as u32,
+            pad: [0; 3],
+        });
+        let members = instances.iter().filter(|i| i.group == g as u32).count() as u32;
+        for _ in 0..data.level_count {
+            firsts.push(entries);
+            entries += members;
+        }
+    }
+    let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+    let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+    let filled = |bytes: &[u8], usage: wgpu::BufferUsages, label: &str| {
+        buffer_with_data(gpu, bytes, usage, label).expect("a buffer")
+    };
+    let states = vec![[LodState::NEW.packed(), 0u32]; SELECT_INSTANCES];
+    let counts = vec![0u8; slots as usize * DRAW_BYTES];
+    let chunk = GpuSelectChunk {
+        first_instance: 0,
+        count: SELECT_INSTANCES as u32,
+        draw_base: 0,
+        pad: 0,
+    };
+    let bound = [
+        filled(&[0; size_of::<GpuSelectCamera>()], uniform, "plain camera"),
+        filled(bytemuck::cast_slice(&table), storage, "plain groups"),
+        filled(bytemuck::cast_slice(&instances), storage, "plain instances"),
+        filled(bytemuck::cast_slice(&firsts), storage, "plain slot starts"),
+        filled(bytemuck::cast_slice(&states), storage, "plain states"),
+        filled(
+            &counts,
+            storage | wgpu::BufferUsages::INDIRECT,
+            "plain counts",
+        ),
+        filled(
+            &vec![0u8; entries as usize * ENTRY_BYTES],
+            storage,
+            "plain lists",
+        ),
+        filled(bytemuck::bytes_of(&chunk), uniform, "plain chunk"),
+    ];
+    let template = filled(&counts, wgpu::BufferUsages::COPY_SRC, "plain template");
+    let group_entries: Vec<wgpu::BindGroupEntry> = bound
+        .iter()
+        .enumerate()
+        .map(|(k, b)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("plain select"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &group_entries,
+    });
+    let (distance_kind, factor) = distance_kind(&frame.camera, &settings);
+    let (mode, step) = settings.select_mode(frame.dt);
+    let camera_bytes = GpuSelectCamera {
+        planes: frustum_planes(&(proj * look)).map(|p| p.to_array()),
+        position: eye.to_array(),
+        factor,
+        distance_kind,
+        mode,
+        step,
+        frame: frame.frame,
+        instance_count: SELECT_INSTANCES as u32,
+        group_count: groups.len() as u32,
+        frame_sequential: 0,
+        cull: 1,
+    };
+    let workgroups = (SELECT_INSTANCES as u32).div_ceil(SELECT_WORKGROUP);
+    compare(
+        c,
+        gpu,
+        "select",
+        &mut |encoder| {
+            black_box(selector.record(gpu, encoder, view, &frame)).expect("a recording");
+        },
+        &mut |encoder| {
+            gpu.queue
+                .write_buffer(&bound[0], 0, bytemuck::bytes_of(&camera_bytes));
+            encoder.copy_buffer_to_buffer(&template, 0, &bound[5], 0, template.size());
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(workgroups, 1, 1);
+        },
+    )
+}
+
 fn main() {
     let gpu = match GpuContext::new_headless(&Default::default()) {
         Ok(gpu) => gpu,
@@ -334,7 +505,11 @@ fn main() {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(2))
         .configure_from_args();
-    let rows = [combine(&mut c, &gpu), upsample(&mut c, &gpu)];
+    let rows = [
+        combine(&mut c, &gpu),
+        upsample(&mut c, &gpu),
+        select(&mut c, &gpu),
+    ];
     c.final_summary();
     println!(
         "\nhost time per recording, median of {TABLE_RECORDINGS} each, {}",
