@@ -35,9 +35,6 @@ const SIZE: (u32, u32) = (640, 360);
 const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// View depth of the cleared background (world units).
 const FAR: f32 = 60.0;
-/// Range sigmas of eq. 1: depth in world units, foreshortened normal distance.
-const SIGMA_Z: f32 = 0.25;
-const SIGMA_N: f32 = 0.4;
 /// Synthetic shading work per fragment: expensive, smooth shading is what framebuffer LOD saves.
 const SHADING_WORK: u32 = 48;
 
@@ -130,10 +127,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         prepass_pass.render(&gpu, &prepass, &scene)?;
         shading.render(&gpu, &low, &GBufferFrame { r, ..scene })?;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        let sigmas = RangeSigmas {
-            depth: SIGMA_Z,
-            normal: SIGMA_N,
-        };
+        let sigmas = RangeSigmas::default();
         let upsampled = UpsampleFrame {
             low: &low,
             full_geometry: prepass.geometry(),

@@ -24,7 +24,7 @@
 //   LODKIT_UPSAMPLE_PACKED (bool) — L is one packed rgba32uint texture (lodkit::gbuffer).
 #import lodkit::fullscreen::{FullscreenVertex, fullscreen_vertex}
 #import lodkit::gbuffer::{gbuffer_depth, gbuffer_normal}
-#import lodkit::bilateral::{bilateral_upsample_at, bilateral_upsample_packed_at}
+#import lodkit::bilateral::{bilateral_relative_sigma, bilateral_upsample_at, bilateral_upsample_packed_at}
 
 /// Per-frame parameters.
 struct UpsampleParams {
@@ -33,6 +33,7 @@ struct UpsampleParams {
     low_viewport: vec2<f32>,
     /// Size of the full-resolution target.
     full_size: vec2<f32>,
+    /// Depth sigma as a fraction of the pixel's view depth (bilateral_relative_sigma).
     sigma_z: f32,
     sigma_n: f32,
     _pad0: f32,
@@ -72,6 +73,8 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
 fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(v.position.xy);
     let full = textureLoad(full_geometry, pixel, 0);
+    let depth = gbuffer_depth(full);
+    let sigma_z = bilateral_relative_sigma(params.sigma_z, depth);
     var color: vec4<f32>;
 #ifdef LODKIT_UPSAMPLE_PACKED
     color = bilateral_upsample_packed_at(
@@ -79,9 +82,9 @@ fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
         params.low_viewport,
         params.full_size,
         v.position.xy,
-        gbuffer_depth(full),
+        depth,
         gbuffer_normal(full),
-        params.sigma_z,
+        sigma_z,
         params.sigma_n,
     );
 #else
@@ -91,9 +94,9 @@ fn fs_main(v: FullscreenVertex) -> @location(0) vec4<f32> {
         params.low_viewport,
         params.full_size,
         v.position.xy,
-        gbuffer_depth(full),
+        depth,
         gbuffer_normal(full),
-        params.sigma_z,
+        sigma_z,
         params.sigma_n,
     );
 #endif

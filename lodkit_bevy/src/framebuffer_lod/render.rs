@@ -21,6 +21,7 @@ use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
 use bevy::render::sync_component::SyncComponent;
 use bevy::render::view::{ExtractedView, ViewTarget, ViewUniformOffset, ViewUniforms};
 use bevy::render::{GpuResourceAppExt, Render, RenderApp, RenderSystems};
+use lodkit::bilateral::gpu_sigma;
 
 use super::effect::{EffectBinding, FRAMEBUFFER_LOD_EFFECT_BIND_GROUP_INDEX};
 use super::layout::{FramebufferLodUniform, common_entries, effect_view_layout};
@@ -79,7 +80,9 @@ impl ExtractComponent<RenderApp> for FramebufferLod {
         // The controller keeps the factor in [1, MAX_FACTOR] (clamp_factor), the one place r is
         // clamped.
         let factor = state.factor;
-        let (depth_sigma, normal_sigma) = settings.upsample.sigmas();
+        // A shader is given no infinity: +inf (no range term) as the finite sigma that does the same.
+        let sigmas = settings.upsample.sigmas();
+        let (depth_sigma, normal_sigma) = (gpu_sigma(sigmas.depth), gpu_sigma(sigmas.normal));
         Some((
             ExtractedFramebufferLod {
                 composite: settings.composite,

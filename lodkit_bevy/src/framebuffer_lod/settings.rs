@@ -8,6 +8,7 @@ use bevy::camera::Hdr;
 use bevy::core_pipeline::prepass::{DepthPrepass, NormalPrepass};
 use bevy::prelude::*;
 use bevy::render::render_resource::TextureFormat;
+use lodkit::bilateral::RangeSigmas;
 use lodkit::framebuffer_lod::RlsController;
 
 /// Format of the low-resolution color and geometry targets (lodkit::gbuffer's geometry layout).
@@ -66,12 +67,15 @@ pub enum FramebufferLodComposite {
 pub enum FramebufferLodUpsample {
     /// lodkit's geometry-aware upsample (eq. 1): a 2x2 tent times Gaussians on the depth and
     /// normal differences between the pixel and each low-resolution sample.
+    /// The fields are those of lodkit's `RangeSigmas` (`lodkit::bilateral`), which lodkit's own
+    /// upsample pass takes: one set of names, units and defaults.
     Bilateral {
-        /// Depth sigma as a fraction of the pixel's view depth (default 0.05: samples 5 % nearer
-        /// or farther weigh e^-1/2). Relative, so distant slanted surfaces stay smooth.
-        depth_sigma: f32,
+        /// Depth sigma as a fraction of the pixel's view depth
+        /// (`lodkit::bilateral::bilateral_relative_sigma`; default 0.05: samples 5 % nearer or
+        /// farther weigh e^-1/2). Relative, so distant slanted surfaces stay smooth.
+        depth: f32,
         /// Sigma on the foreshortened normal distance (lodkit::normal_distance; default 0.5).
-        normal_sigma: f32,
+        normal: f32,
     },
     /// Plain bilinear upsampling (the same pass with sigmas that turn the range terms off,
     /// `lodkit::bilateral::BILATERAL_SIGMA_OFF`): what a renderer does
@@ -80,27 +84,19 @@ pub enum FramebufferLodUpsample {
 }
 
 impl Default for FramebufferLodUpsample {
+    /// lodkit's defaults (`RangeSigmas::default()`).
     fn default() -> Self {
-        Self::Bilateral {
-            depth_sigma: 0.05,
-            normal_sigma: 0.5,
-        }
+        let RangeSigmas { depth, normal } = RangeSigmas::default();
+        Self::Bilateral { depth, normal }
     }
 }
 
 impl FramebufferLodUpsample {
-    /// The (depth, normal) sigmas the upsample pass uses; `BILATERAL_SIGMA_OFF` for bilinear (a
-    /// finite value: a shader must not be given an infinity).
-    pub fn sigmas(&self) -> (f32, f32) {
+    /// The sigmas the upsample pass uses ([`RangeSigmas::OFF`] for bilinear).
+    pub fn sigmas(&self) -> RangeSigmas {
         match *self {
-            Self::Bilateral {
-                depth_sigma,
-                normal_sigma,
-            } => (depth_sigma, normal_sigma),
-            Self::Bilinear => (
-                lodkit::bilateral::BILATERAL_SIGMA_OFF,
-                lodkit::bilateral::BILATERAL_SIGMA_OFF,
-            ),
+            Self::Bilateral { depth, normal } => RangeSigmas { depth, normal },
+            Self::Bilinear => RangeSigmas::OFF,
         }
     }
 }

@@ -8,6 +8,9 @@
 //   LODKIT_BILATERAL_MIN_WEIGHT: float   fallback threshold on the sum of weights (1e-4)
 //   LODKIT_BILATERAL_SIGMA_OFF: float   a sigma that turns its range term off (1e30; a shader
 //       must not be given +inf)
+//   LODKIT_BILATERAL_MIN_VIEW_DEPTH: float   the least view depth a relative sigma is taken of
+//       (1e-6)
+//   lodkit_bilateral_relative_sigma(relative, view_depth) -> float
 //   lodkit_bilateral_range(difference, sigma) -> float
 //   lodkit_bilateral_tent(f) -> vec4
 //   lodkit_bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> float
@@ -40,6 +43,16 @@ const float LODKIT_BILATERAL_MIN_WEIGHT = 1e-4;
 
 /// A sigma that turns its range term off (finite: a shader must not be given +inf).
 const float LODKIT_BILATERAL_SIGMA_OFF = 1e30;
+
+/// The least view depth a relative sigma is taken of (a pixel with no geometry gets a small
+/// sigma, not a zero one).
+const float LODKIT_BILATERAL_MIN_VIEW_DEPTH = 1e-6;
+
+/// A depth sigma given as a fraction of the pixel's view depth, in the depth's units;
+/// LODKIT_BILATERAL_SIGMA_OFF stays off.
+float lodkit_bilateral_relative_sigma(float relative, float view_depth) {
+    return relative >= LODKIT_BILATERAL_SIGMA_OFF ? relative : relative * max(view_depth, LODKIT_BILATERAL_MIN_VIEW_DEPTH);
+}
 
 /// Gaussian range filter exp(-difference^2 / (2 sigma^2)); 1 when sigma is LODKIT_BILATERAL_SIGMA_OFF.
 float lodkit_bilateral_range(float difference, float sigma) {

@@ -15,6 +15,9 @@
 // Exports:
 //   BILATERAL_MIN_WEIGHT: f32   fallback threshold on the sum of weights (1e-4)
 //   BILATERAL_SIGMA_OFF: f32   a sigma that turns its range term off (1e30, finite)
+//   BILATERAL_MIN_VIEW_DEPTH: f32   the least view depth a relative sigma is taken of (1e-6)
+//   bilateral_relative_sigma(relative, view_depth) -> f32   a depth sigma given as a fraction of
+//       the pixel's view depth, in the depth's units (BILATERAL_SIGMA_OFF stays off)
 //   bilateral_range(difference, sigma) -> f32   exp(-d^2 / (2 sigma^2)); 1 for BILATERAL_SIGMA_OFF
 //   bilateral_tent(f) -> vec4<f32>   bilinear weights of the 2x2 samples at fraction f
 //   bilateral_weight(tent, depth_diff, normal_dist, sigma_z, sigma_n) -> f32   one term of eq. 1
@@ -53,6 +56,17 @@ const BILATERAL_MIN_WEIGHT: f32 = 1e-4;
 /// A sigma that turns its range term off: every difference over it squares to 0 (or a denormal,
 /// which is as good), so the weight is 1. Finite, unlike +inf, which no shader must be given.
 const BILATERAL_SIGMA_OFF: f32 = 1e30;
+
+/// The least view depth a relative sigma is taken of: a pixel with no geometry (depth 0) gets a
+/// small sigma, which keeps it from mixing with geometry, not a zero one, which would divide by 0.
+const BILATERAL_MIN_VIEW_DEPTH: f32 = 1e-6;
+
+/// A depth sigma given as a fraction of the pixel's view depth (`relative` 0.05: a sample 5 %
+/// nearer or farther weighs e^-1/2), in the depth's units, for the sigma_z of eq. 1: the same
+/// fraction serves a near wall and a distant slanted floor. BILATERAL_SIGMA_OFF stays off.
+fn bilateral_relative_sigma(relative: f32, view_depth: f32) -> f32 {
+    return select(relative * max(view_depth, BILATERAL_MIN_VIEW_DEPTH), relative, relative >= BILATERAL_SIGMA_OFF);
+}
 
 /// Gaussian range filter exp(-difference^2 / (2 sigma^2)); 1 when sigma is BILATERAL_SIGMA_OFF.
 fn bilateral_range(difference: f32, sigma: f32) -> f32 {

@@ -18,7 +18,8 @@ pub struct UpsampleParams {
     pub low_viewport: [f32; 2],
     /// Size of the full-resolution target.
     pub full_size: [f32; 2],
-    /// Depth range sigma (world units; `BILATERAL_SIGMA_OFF`: no depth term).
+    /// Depth range sigma, a fraction of the pixel's view depth (`bilateral_relative_sigma`;
+    /// `BILATERAL_SIGMA_OFF`: no depth term).
     pub sigma_z: f32,
     /// Normal range sigma (`BILATERAL_SIGMA_OFF`: no normal term).
     pub sigma_n: f32,
@@ -72,35 +73,7 @@ impl Default for UpsamplePassDescriptor {
     }
 }
 
-/// The range filters' sigmas of eq. 1.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RangeSigmas {
-    /// On the depth difference, in world units (the view depth L stores). > 0; +inf: no
-    /// depth term.
-    pub depth: f32,
-    /// On the foreshortened normal distance (`lodkit::normal_distance`). > 0; +inf: no normal
-    /// term.
-    pub normal: f32,
-}
-
-impl RangeSigmas {
-    /// No range term: a plain bilinear upsample through the same pass.
-    pub const OFF: Self = Self {
-        depth: f32::INFINITY,
-        normal: f32::INFINITY,
-    };
-}
-
-impl Default for RangeSigmas {
-    /// 0.25 world units of depth, 0.4 of normal distance: the demo's edge scene, where a
-    /// depth step of 1 and a crease of 30 degrees weigh under 1e-3.
-    fn default() -> Self {
-        Self {
-            depth: 0.25,
-            normal: 0.4,
-        }
-    }
-}
+pub use crate::bilateral::RangeSigmas;
 
 /// The parameters of one recording.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -28,7 +28,6 @@ pub const RESIZE_FACTORS: [f32; 4] = [1.5, 2.0, 3.0, 4.0];
 pub const SHADING_WORK: u32 = 64;
 
 use crate::demo::fixtures::edge_frame::sigmas as demo_sigmas;
-pub use crate::demo::fixtures::edge_frame::{SIGMA_N, SIGMA_Z};
 
 /// Quality and speed of one resize factor.
 #[derive(Clone, Debug, Serialize)]

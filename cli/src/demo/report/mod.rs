@@ -19,7 +19,7 @@ use crate::demo::error::DemoError;
 use crate::demo::fixtures::technique::Technique;
 use crate::demo::measures::DemoReport;
 use crate::demo::measures::controllers::{CONTROLLER_SEEDS, TARGET_MS};
-use crate::demo::measures::upsample_quality::{METHODS, ROUTES, SHADING_WORK, SIGMA_N, SIGMA_Z};
+use crate::demo::measures::upsample_quality::{METHODS, ROUTES, SHADING_WORK};
 use crate::demo::report::plots::{Chart, Series, line_chart};
 use crate::demo::report::table::{Table, esc, img, pct, reads, times};
 
@@ -381,9 +381,13 @@ pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
     q.push_str(POP_TEXT);
     q.push_str(&transition_tables(report, false));
     q.push_str("\n## Framebuffer LOD\n\n");
+    let lodkit::bilateral::RangeSigmas {
+        depth: depth_sigma,
+        normal: normal_sigma,
+    } = lodkit::bilateral::RangeSigmas::default();
     let _ = writeln!(
         q,
-        "Edge scene with synthetic shading work (a smooth sky term summed over {SHADING_WORK} directions per fragment, the expensive low-frequency shading framebuffer LOD is for), full-resolution frame as reference; bilateral sigma_z = {SIGMA_Z}, sigma_n = {SIGMA_N}; fine-grained resizing sends only the lighting through the low-res buffer, and its upsample pass multiplies by the full-resolution albedo (the image measured is the one the timed frame produces); \"packed L\" reads lodkit::gbuffer's packed texel (HDR color as halves, depth, normal: 4 low-res loads per pixel instead of 8).\n"
+        "Edge scene with synthetic shading work (a smooth sky term summed over {SHADING_WORK} directions per fragment, the expensive low-frequency shading framebuffer LOD is for), full-resolution frame as reference; bilateral sigmas (`RangeSigmas`, the defaults): depth {depth_sigma} of the view depth, normal {normal_sigma}; fine-grained resizing sends only the lighting through the low-res buffer, and its upsample pass multiplies by the full-resolution albedo (the image measured is the one the timed frame produces); \"packed L\" reads lodkit::gbuffer's packed texel (HDR color as halves, depth, normal: 4 low-res loads per pixel instead of 8).\n"
     );
     q.push_str(&upsample_table(report).markdown());
     // The controllers on the real frame are the headline; the simulation stands beside them.
