@@ -17,7 +17,7 @@ pub use atlas::{
     ImpostorAtlas, ImpostorImage, dilate_frames, mip_chain, preserve_coverage, srgba8,
 };
 #[cfg(feature = "lod_chain")]
-pub use bound::impostor_switch_distance;
+pub use bound::{ImpostorPlacement, impostor_placement, impostor_switch_distance};
 pub use bound::{impostor_angle, impostor_error};
 pub use sample::{ImpostorSample, impostor_sample, impostor_sample_frame, impostor_sample_level};
 

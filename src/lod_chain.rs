@@ -193,6 +193,20 @@ pub enum LodChainError {
     /// A bounding radius that is negative or not finite.
     #[error("radius {0} must be finite and >= 0")]
     BadRadius(f32),
+    /// An impostor at the end of the chain would never be shown: its picture is within the
+    /// pixel error only from `from`, or the chain's last mesh level is shown up to `from`, and
+    /// the object is hidden beyond `hidden` (view-normalized distances).
+    #[error(
+        "the impostor would never be shown: {why} from {from} (view-normalized), and the object is hidden beyond {hidden}"
+    )]
+    ImpostorNeverShown {
+        /// What holds it off: its own error, or the last mesh level.
+        why: &'static str,
+        /// Where it could be shown from.
+        from: f32,
+        /// The hide distance.
+        hidden: f32,
+    },
     /// The group the distances make is invalid.
     #[error(transparent)]
     Lod(#[from] LodError),
@@ -334,6 +348,37 @@ impl LodChain {
     /// A hysteresis to select with ([`suggested_hysteresis`]).
     pub fn suggested_hysteresis(&self, camera: &PixelErrorCamera) -> Result<f32, LodChainError> {
         suggested_hysteresis(&self.errors(), self.sphere.radius, camera)
+    }
+
+    /// The chain ending in the impostor of `layout` (baked from this mesh): the mesh levels that
+    /// switch in before the impostor is within `camera.pixel_error`, then the impostor, as one
+    /// group hidden where [`Self::lod_group`] is ([`impostor_placement`](crate::impostor::impostor_placement)
+    /// says which levels give way). The impostor is level [`ImpostorPlacement::mesh_levels`](crate::impostor::ImpostorPlacement)
+    /// of the group.
+    pub fn impostor_group(
+        &self,
+        layout: &crate::impostor::ImpostorLayout,
+        camera: &PixelErrorCamera,
+    ) -> Result<(LodGroup, crate::impostor::ImpostorPlacement), LodChainError> {
+        let distances = self.switch_distances(camera)?;
+        let hidden = self.max_distance(camera)?;
+        let own = crate::impostor::impostor_switch_distance(layout, camera)?;
+        let placement = crate::impostor::impostor_placement(&distances, hidden, own)?;
+        let levels = distances[..placement.mesh_levels]
+            .iter()
+            .copied()
+            .chain(std::iter::once(placement.distance))
+            .enumerate()
+            .map(|(i, distance)| crate::select::LodLevel {
+                distance,
+                mesh: if i < placement.mesh_levels {
+                    format!("lod{i}")
+                } else {
+                    "impostor".to_owned()
+                },
+            });
+        let group = LodGroup::new(levels)?.with_max_distance(hidden)?;
+        Ok((group, placement))
     }
 
     /// The max distance [`Self::lod_group`] sets ([`hide_distance`]).

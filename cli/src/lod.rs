@@ -425,9 +425,10 @@ fn plan(
     })
 }
 
-/// Appends the impostor of `atlas` to `report`'s levels: its error (`impostor_error`), from the
-/// distance where its picture stays within the pixel error (never before the last mesh level);
-/// an error when that is beyond the hide distance (the impostor would never be shown).
+/// Appends the impostor of `atlas` to `report`'s levels where `lodkit::impostor::
+/// impostor_placement` puts it: its error (`impostor_error`), from the distance where its
+/// picture stays within the pixel error, the mesh levels that would switch in beyond that left
+/// out (with a warning); an error when it would never be shown.
 fn add_impostor_row(
     report: &mut MeshReport,
     atlas: &lodkit::impostor::ImpostorAtlas,
@@ -436,41 +437,28 @@ fn add_impostor_row(
 ) -> Result<(), String> {
     let own = lodkit::impostor::impostor_switch_distance(&atlas.layout, camera)
         .map_err(|e| format!("impostor: {e}"))?;
-    // Mesh levels that would switch in only where the impostor is already within the pixel
-    // error give way to it: it is cheaper there and as close to the mesh.
-    let keep = report
-        .levels
-        .iter()
-        .position(|l| l.level > 0 && l.switch_distance >= own)
-        .unwrap_or(report.levels.len());
-    if keep < report.levels.len() {
+    let distances: Vec<f32> = report.levels.iter().map(|l| l.switch_distance).collect();
+    let placement = lodkit::impostor::impostor_placement(&distances, report.max_distance, own)
+        .map_err(|e| match e {
+            lodkit::lod_chain::LodChainError::ImpostorNeverShown { from, .. } if from == own => {
+                format!("impostor left out: {e}; more frames (--impostor-frames) bring it nearer")
+            }
+            e => format!("impostor left out: {e}"),
+        })?;
+    if placement.mesh_levels < report.levels.len() {
         report.warnings.push(format!(
             "levels {}..={} left out: the impostor is within the pixel error from {own:.3} (view-normalized), nearer than they switch in",
-            keep,
+            placement.mesh_levels,
             report.levels.len() - 1
         ));
-        report.levels.truncate(keep);
-    }
-    let last = report.levels.last().map_or(0.0, |l| l.switch_distance);
-    let distance = own.max(last);
-    if last >= report.max_distance {
-        return Err(format!(
-            "impostor left out: the last level is shown up to where the mesh is hidden ({:.3}, view-normalized)",
-            report.max_distance
-        ));
-    }
-    if own >= report.max_distance {
-        return Err(format!(
-            "impostor left out: its picture is within the pixel error only from {own:.3} (view-normalized), where the mesh is already hidden ({:.3}); more frames (--impostor-frames) bring it nearer",
-            report.max_distance
-        ));
+        report.levels.truncate(placement.mesh_levels);
     }
     report.levels.push(LevelRow {
         level: report.levels.len(),
         triangles: 2,
         error: lodkit::impostor::impostor_error(&atlas.layout),
         error_capped: false,
-        switch_distance: distance,
+        switch_distance: placement.distance,
         screen_coverage: 0.0,
         seconds,
         impostor: true,

@@ -108,3 +108,61 @@ pub fn impostor_switch_distance(
         crate::lod_chain::switch_distances(&[0.0, impostor_error(layout)], layout.radius, camera)?;
     Ok(d[1])
 }
+
+/// Where an impostor ends a chain of mesh levels ([`impostor_placement`]).
+#[cfg(feature = "lod_chain")]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImpostorPlacement {
+    /// The mesh levels kept before it (LOD0 always): the impostor is level `mesh_levels`.
+    pub mesh_levels: usize,
+    /// Its switch distance (view-normalized): its own ([`impostor_switch_distance`]); every
+    /// kept mesh level switches in nearer.
+    pub distance: f32,
+}
+
+/// Where an impostor whose picture is within the pixel error from `impostor` (its
+/// [`impostor_switch_distance`]) ends a chain whose mesh levels switch at `distances` (LOD0's
+/// first, 0) and which is hidden beyond `hidden`. Mesh levels that would switch in only where
+/// the impostor is already within the pixel error give way to it: it is cheaper there and as
+/// close to the mesh. [`LodChainError::ImpostorNeverShown`](crate::lod_chain::LodChainError)
+/// where it would switch in only where the object is hidden.
+///
+/// ```
+/// # use lodkit::impostor::impostor_placement;
+/// // Levels at 0, 2, 5 and 9; the impostor is within the error from 4: levels 2 and 3 give way.
+/// let p = impostor_placement(&[0.0, 2.0, 5.0, 9.0], 40.0, 4.0).unwrap();
+/// assert_eq!((p.mesh_levels, p.distance), (2, 4.0));
+/// // Within the error from 1, before level 1 switches in: LOD0, then the impostor.
+/// let p = impostor_placement(&[0.0, 2.0, 5.0], 40.0, 1.0).unwrap();
+/// assert_eq!((p.mesh_levels, p.distance), (1, 1.0));
+/// assert!(impostor_placement(&[0.0, 2.0], 40.0, 50.0).is_err());
+/// ```
+#[cfg(feature = "lod_chain")]
+pub fn impostor_placement(
+    distances: &[f32],
+    hidden: f32,
+    impostor: f32,
+) -> Result<ImpostorPlacement, crate::lod_chain::LodChainError> {
+    let mesh_levels = distances
+        .iter()
+        .skip(1)
+        .position(|&d| d >= impostor)
+        .map_or(distances.len(), |k| k + 1)
+        .max(1);
+    let last = distances
+        .get(mesh_levels.saturating_sub(1))
+        .copied()
+        .unwrap_or(0.0);
+    let never =
+        |why, from| Err(crate::lod_chain::LodChainError::ImpostorNeverShown { why, from, hidden });
+    if impostor >= hidden {
+        return never("its picture is within the pixel error only", impostor);
+    }
+    if last >= hidden {
+        return never("the last mesh level is shown", last);
+    }
+    Ok(ImpostorPlacement {
+        mesh_levels,
+        distance: impostor.max(last),
+    })
+}

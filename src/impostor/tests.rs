@@ -176,3 +176,72 @@ fn coverage_preserving_mips_work_frame_by_frame() {
     assert_eq!(odd[1].texels[0], [0.3; 4]);
     preserve_coverage(&mut odd, u32::MAX);
 }
+
+/// Mesh levels that switch in at or beyond the impostor's distance give way to it; LOD0 stays;
+/// an impostor the object is hidden before, or after a last level that is, is refused.
+#[cfg(feature = "lod_chain")]
+#[test]
+fn the_impostor_ends_the_chain_where_it_is_within_the_error() {
+    use crate::lod_chain::LodChainError;
+    let place = |distances: &[f32], own| {
+        impostor_placement(distances, 40.0, own).map(|p| (p.mesh_levels, p.distance))
+    };
+    assert_eq!(place(&[0.0, 2.0, 5.0, 9.0], 6.0).unwrap(), (3, 6.0));
+    // A level switching in exactly where the impostor is within the error gives way.
+    assert_eq!(place(&[0.0, 2.0, 5.0, 9.0], 5.0).unwrap(), (2, 5.0));
+    assert_eq!(place(&[0.0, 2.0], 0.5).unwrap(), (1, 0.5));
+    assert_eq!(place(&[0.0], 3.0).unwrap(), (1, 3.0));
+    assert_eq!(place(&[0.0, 2.0, 5.0], 30.0).unwrap(), (3, 30.0));
+    for (distances, own) in [(&[0.0, 2.0][..], 40.0), (&[0.0, 2.0, 41.0][..], 45.0)] {
+        let e = place(distances, own).unwrap_err();
+        assert!(
+            matches!(e, LodChainError::ImpostorNeverShown { hidden: 40.0, .. }),
+            "{e}"
+        );
+    }
+}
+
+/// `LodChain::impostor_group`: the chain's own switch distances up to the impostor's, the
+/// impostor last, hidden where the mesh chain is.
+#[cfg(feature = "lod_chain")]
+#[test]
+fn a_chain_ends_in_its_impostor() {
+    use crate::lod_chain::{LodChain, LodChainDescriptor, MeshData, PixelErrorCamera, uv_sphere};
+    let (positions, indices) = uv_sphere(32, 64);
+    let mesh = MeshData {
+        positions: &positions,
+        indices: &indices,
+        ..Default::default()
+    };
+    let chain = LodChain::build(&mesh, &LodChainDescriptor::default()).unwrap();
+    let camera = PixelErrorCamera::default();
+    let sphere = chain.bounding_sphere();
+    // Fine enough that the chain's last level gives way to it.
+    let layout = ImpostorLayout {
+        frames: 64,
+        frame_size: 512,
+        shape: ImpostorShape::Full,
+        center: sphere.center,
+        radius: sphere.radius,
+    };
+    let (group, placement) = chain.impostor_group(&layout, &camera).unwrap();
+    assert!(
+        placement.mesh_levels < chain.levels().len(),
+        "{placement:?}"
+    );
+    let own = impostor_switch_distance(&layout, &camera).unwrap();
+    let mesh: Vec<f32> = chain
+        .switch_distances(&camera)
+        .unwrap()
+        .into_iter()
+        .enumerate()
+        .filter(|&(i, d)| i == 0 || d < own)
+        .map(|(_, d)| d)
+        .collect();
+    let got: Vec<f32> = group.levels().iter().map(|l| l.distance).collect();
+    assert_eq!(got[..got.len() - 1], mesh[..], "{got:?}");
+    assert_eq!(got.last(), Some(&own));
+    assert_eq!(placement.mesh_levels, mesh.len());
+    assert_eq!(group.levels().last().unwrap().mesh, "impostor");
+    assert_eq!(group.max_distance(), chain.max_distance(&camera).ok());
+}
