@@ -1,6 +1,7 @@
 //! Alpha-mask levels (the alpha_mask example run on the GPU, its report read here): a ball with
 //! holes and a bunch of leaf cards, `StandardMaterial`s with `AlphaMode::Mask`, through
-//! frame-sequential LOD's combine (`Msaa::Off`) and its screen-door dither (Bevy's default MSAA).
+//! frame-sequential LOD's combine (`Msaa::Off`) and its screen-door dither (Bevy's default MSAA),
+//! without and with Bevy's depth and motion-vector prepass.
 
 mod support;
 
@@ -9,7 +10,7 @@ mod support;
 /// pass's alpha test the combine drew the older level over its holes: 7,975 ghost pixel-frames
 /// and flicker 5.4 on lavapipe), each pixel changed one way only (flicker 1 within 10 %), and a
 /// pop at most a quarter of switching at once (measured on lavapipe: 0.126 combine, 0.086
-/// dither, against 0.643: 0.20x and 0.13x). The hard switch's pop is there for the metric to
+/// dither without and with the prepass, against 0.643: 0.20x and 0.13x). The hard switch's pop is there for the metric to
 /// see one (at least 0.4). No wgpu validation error is logged.
 #[test]
 fn alpha_mask_levels_transition_with_their_exact_coverage() {
@@ -18,7 +19,7 @@ fn alpha_mask_levels_transition_with_their_exact_coverage() {
     };
     let hard = r["hard_switch"]["pop"].as_f64().unwrap();
     assert!(hard >= 0.4, "the hard switch pops: {r}");
-    for name in ["frame_sequential", "dither"] {
+    for name in ["frame_sequential", "dither", "dither_prepass"] {
         let run = &r[name];
         assert_eq!(run["see_through"], 0, "{name}: {run}");
         assert_eq!(run["ghosts"], 0, "{name}: {run}");

@@ -2,8 +2,9 @@
 //! camera that holds still while the bias ramps (as a quality setting or a frame-time budget
 //! would move it), so every change in the picture is LOD's. The ramp is rendered with each level
 //! alone (the references), with lodkit's frame-sequential combine (`Msaa::Off`), its screen-door
-//! dither (Bevy's default `Msaa::Sample4`) and switching at once; each run is measured against
-//! the references (`measure::Figures`).
+//! dither (Bevy's default `Msaa::Sample4`, without and with Bevy's depth and motion-vector
+//! prepass) and switching at once; each run is measured against the references
+//! (`measure::Figures`).
 
 use std::path::Path;
 
@@ -39,6 +40,9 @@ pub enum Technique {
     FrameSequential,
     /// lodkit's screen-door dither, Bevy's default MSAA.
     Dither,
+    /// The same on a camera with Bevy's depth and motion-vector prepass (motion blur, depth of
+    /// field): the levels' prepass must drop the pixels the dither drops.
+    DitherPrepass,
     /// lodkit switching at once.
     Hard,
 }
@@ -88,6 +92,10 @@ pub fn run<M: Material>(
         }
         Technique::Dither => {
             camera.insert(lod);
+        }
+        Technique::DitherPrepass => {
+            use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass};
+            camera.insert((lod, DepthPrepass, MotionVectorPrepass));
         }
         Technique::Hard => {
             lod.settings = LodSettings {
@@ -159,7 +167,8 @@ pub fn run<M: Material>(
     })
 }
 
-/// Renders the references, then the combine, the dither and the hard switch; prints a line per
+/// Renders the references, then the combine, the dither (without and with a prepass) and the
+/// hard switch; prints a line per
 /// run, writes `out/strip_<run>.png` (8 frames) and returns the report (JSON per run). Errors:
 /// (exit code, message).
 pub fn measure_all<M: Material>(
@@ -191,6 +200,7 @@ pub fn measure_all<M: Material>(
     for (name, technique, references) in [
         ("frame_sequential", Technique::FrameSequential, &plain),
         ("dither", Technique::Dither, &msaa),
+        ("dither_prepass", Technique::DitherPrepass, &msaa),
         ("hard_switch", Technique::Hard, &plain),
     ] {
         let lodkit = go(technique)?;

@@ -14,6 +14,7 @@ use bevy::pbr::{ExtendedMaterial, MaterialExtension, MaterialPlugin};
 use bevy::platform::collections::{HashMap, HashSet};
 use bevy::prelude::*;
 use bevy::render::render_resource::{AsBindGroup, Face};
+use bevy::shader::ShaderRef;
 
 use super::levels::{LevelMaterial, LodLevels};
 use super::material::{FrameSequentialBindings, FrameSequentialMaterial};
@@ -121,9 +122,10 @@ pub(super) struct Looks {
     /// other than `StandardMaterial`), so the combine could not know its coverage.
     pub(super) blends: bool,
     /// Whether a prepass keeps the same pixels of it as the main pass when the dither drops
-    /// some: `StandardMaterial`'s prepass drops them too (`FrameSequentialExtension`), a blending
-    /// material is not in the prepass; the prepass of a custom opaque or masked material is its
-    /// own, which draws the level whole.
+    /// some: `StandardMaterial`'s prepass drops them too (`FrameSequentialExtension`), and so
+    /// does Bevy's default prepass of a material of the app's own type with no prepass shader
+    /// of its own (`FrameSequentialBindings`); a blending material is not in the prepass. A
+    /// material's own prepass shader draws the level whole.
     pub(super) prepass_dithers: bool,
     /// The faces it culls.
     pub(super) cull_mode: Option<Face>,
@@ -202,7 +204,9 @@ fn looks_of<B: Material>(material: &B) -> Looks {
         },
         None => Looks {
             blends: blends(mode) || matches!(mode, AlphaMode::Mask(_)),
-            prepass_dithers: blends(mode),
+            prepass_dithers: blends(mode)
+                || (matches!(B::prepass_vertex_shader(), ShaderRef::Default)
+                    && matches!(B::prepass_fragment_shader(), ShaderRef::Default)),
             cull_mode: Some(Face::Back),
             alpha_test: None,
         },

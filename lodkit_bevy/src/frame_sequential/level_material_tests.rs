@@ -185,8 +185,8 @@ fn a_custom_material_is_derived_followed_and_drawn() {
         looks(&app),
         Looks {
             blends: false,
-            // Its prepass is its own, which draws a dithered level whole.
-            prepass_dithers: false,
+            // No prepass shader of its own: Bevy's default, which lodkit's replaces.
+            prepass_dithers: true,
             cull_mode: Some(Face::Back),
             alpha_test: None,
         }
@@ -257,6 +257,31 @@ fn a_material_without_its_plugin_is_named() {
     });
     let name = derived.unregistered(&LevelMaterial::custom(plain));
     assert!(name.is_some_and(|n| n.ends_with("Plain")), "{name:?}");
+}
+
+/// A material with a prepass shader of its own (its shader is not compiled here).
+#[derive(Asset, TypePath, AsBindGroup, Clone, Debug)]
+struct OwnPrepass {}
+
+impl Material for OwnPrepass {
+    fn prepass_fragment_shader() -> bevy::shader::ShaderRef {
+        "own_prepass.wesl".into()
+    }
+}
+
+/// A material whose prepass is its own draws a dithered level whole there (its groups switch at
+/// once on a camera with MSAA and a prepass); one without a prepass shader, or one that blends
+/// (not in the prepass), does not.
+#[test]
+fn a_prepass_of_the_materials_own_is_told_apart() {
+    assert!(!looks_of(&OwnPrepass {}).prepass_dithers);
+    let plain = |alpha_mode| Plain {
+        color: LinearRgba::RED,
+        alpha_mode,
+    };
+    assert!(looks_of(&plain(AlphaMode::Opaque)).prepass_dithers);
+    assert!(looks_of(&plain(AlphaMode::Mask(0.5))).prepass_dithers);
+    assert!(looks_of(&StandardMaterial::default()).prepass_dithers);
 }
 
 #[test]

@@ -22,6 +22,9 @@ pub(super) const LOD_MATERIAL_SHADER: Handle<Shader> =
 /// The prepass shader of [`FrameSequentialExtension`].
 pub(super) const LOD_PREPASS_SHADER: Handle<Shader> =
     uuid_handle!("7c2e9a14-3b6d-4f58-8e01-d5a3c7b9f246");
+/// The prepass shader [`FrameSequentialBindings`] puts in place of Bevy's default one.
+pub(super) const LOD_DEFAULT_PREPASS_SHADER: Handle<Shader> =
+    uuid_handle!("3e8b1f02-6a4c-4d97-b5e3-9c0f2a7d4b61");
 /// The visibility texture every [`FrameSequentialExtension`] binds (64x64 void-and-cluster
 /// blue noise from `lodkit::visibility::visibility_texture`).
 pub const VISIBILITY_TEXTURE: Handle<Image> = uuid_handle!("5d7a2c41-8e36-4b0f-9c15-e2a4b6d8f013");
@@ -103,15 +106,52 @@ const PREPASS_PIPELINE_SHADER_DEF: &str = "PREPASS_PIPELINE";
 /// where it runs a fragment stage already (normals, motion vectors, alpha masks): the
 /// extension's prepass shader.
 fn dither_in_prepass(descriptor: &mut RenderPipelineDescriptor) {
-    let prepass = descriptor.vertex.shader_defs.iter().any(
-        |def| matches!(def, ShaderDefVal::Bool(name, true) if name == PREPASS_PIPELINE_SHADER_DEF),
-    );
-    if prepass && descriptor.fragment.is_none() {
+    if is_prepass(descriptor) && descriptor.fragment.is_none() {
         descriptor.fragment = Some(FragmentState {
             shader: LOD_PREPASS_SHADER,
             shader_defs: descriptor.vertex.shader_defs.clone(),
             ..default()
         });
+    }
+}
+
+/// Whether `descriptor` is a prepass pipeline's (the camera's prepass or a shadow map's).
+fn is_prepass(descriptor: &RenderPipelineDescriptor) -> bool {
+    descriptor.vertex.shader_defs.iter().any(
+        |def| matches!(def, ShaderDefVal::Bool(name, true) if name == PREPASS_PIPELINE_SHADER_DEF),
+    )
+}
+
+/// Where Bevy 0.20.1 keeps its default prepass shader (the vertex and fragment stages of a
+/// material with no prepass shader of its own).
+const DEFAULT_PREPASS_SHADER_PATH: &str = "bevy_pbr/prepass/prepass.wesl";
+
+/// Gives a prepass pipeline that runs Bevy's default prepass shader (a material of the app's
+/// own with no prepass shader of its own) [`LOD_DEFAULT_PREPASS_SHADER`]'s fragment stage,
+/// which drops the pixels the dither drops: in place of the default's, or where a depth-only
+/// prepass runs none. A material with a prepass shader of its own keeps it (its groups switch
+/// at once on a camera with MSAA and a prepass).
+fn dither_in_default_prepass(descriptor: &mut RenderPipelineDescriptor) {
+    let bevys = |shader: &Handle<Shader>| {
+        shader
+            .path()
+            .is_some_and(|p| p.path().ends_with(DEFAULT_PREPASS_SHADER_PATH))
+    };
+    if !is_prepass(descriptor) || !bevys(&descriptor.vertex.shader) {
+        return;
+    }
+    match descriptor.fragment.as_mut() {
+        None => {
+            descriptor.fragment = Some(FragmentState {
+                shader: LOD_DEFAULT_PREPASS_SHADER,
+                shader_defs: descriptor.vertex.shader_defs.clone(),
+                ..default()
+            });
+        }
+        Some(fragment) if bevys(&fragment.shader) => {
+            fragment.shader = LOD_DEFAULT_PREPASS_SHADER;
+        }
+        Some(_) => {}
     }
 }
 
@@ -131,7 +171,9 @@ fn define_level(descriptor: &mut RenderPipelineDescriptor) {
 /// [`FrameSequentialMaterialPlugin`](super::FrameSequentialMaterialPlugin)): the bindings that
 /// `lodkit_bevy::frame_sequential_level::lod_level_color` reads (the same as
 /// [`FrameSequentialExtension`]'s, at 100 and 101) and the shader def [`LEVEL_SHADER_DEF`] that
-/// turns it on. The material's own shaders are used, unchanged.
+/// turns it on. The material's own shaders are used, unchanged; where the material has no
+/// prepass shader of its own, on a camera with MSAA, its prepass drops the pixels the
+/// screen-door dither drops (Bevy's default prepass with the dither's discard first).
 #[derive(Asset, AsBindGroup, TypePath, Clone, Debug)]
 pub struct FrameSequentialBindings {
     /// The visibility texture (as [`FrameSequentialExtension::visibility`]).
@@ -160,9 +202,12 @@ impl MaterialExtension for FrameSequentialBindings {
         _: &MaterialExtensionPipeline,
         descriptor: &mut RenderPipelineDescriptor,
         _: &MeshVertexBufferLayoutRef,
-        _: MaterialExtensionKey<Self>,
+        key: MaterialExtensionKey<Self>,
     ) -> Result<(), SpecializedMeshPipelineError> {
         define_level(descriptor);
+        if key.mesh_key.msaa_samples() > 1 {
+            dither_in_default_prepass(descriptor);
+        }
         Ok(())
     }
 }

@@ -97,8 +97,7 @@
 //! screen-door dither (both levels each frame on disjoint pixels: no pop, no see-through; in the
 //! example pop 0.043 / 0.034 against Bevy's crossfade's 0.044 / 0.035), as do groups with a
 //! blending material; with MSAA and a prepass the levels' prepass drops the same pixels (a group
-//! with a level in a material of the app's own type, whose prepass is its own, switches at
-//! once); a group in transition casts the shadow of the
+//! with a level whose material has a prepass shader of its own switches at once); a group in transition casts the shadow of the
 //! level drawn that frame (use `NotShadowCaster` on levels if that flickers in your scene);
 //! at most [`MAX_TAG_ID`] groups in transition at once (more switch at once, with a warning);
 //! the combine reads no storage buffer, but the plugin has not been run on WebGL2.
@@ -189,6 +188,16 @@ impl Plugin for FrameSequentialLodPlugin {
             )
             .expect("UUID handles never fail to insert");
         app.world_mut()
+            .resource_mut::<Assets<Shader>>()
+            .insert(
+                &material::LOD_DEFAULT_PREPASS_SHADER,
+                Shader::from_wesl(
+                    include_str!("lod_default_prepass.wesl"),
+                    "embedded://lodkit_bevy/frame_sequential/lod_default_prepass.wesl",
+                ),
+            )
+            .expect("UUID handles never fail to insert");
+        app.world_mut()
             .resource_mut::<Assets<Image>>()
             .insert(&VISIBILITY_TEXTURE, material::visibility_image())
             .expect("UUID handles never fail to insert");
@@ -227,7 +236,8 @@ impl Plugin for FrameSequentialLodPlugin {
 /// The combine needs `Msaa::Off`: with another `Msaa` (Bevy's default is `Sample4`) the plugin
 /// logs one warning, runs no combine, and draws each group in transition through lodkit's
 /// complementary screen-door dither instead, in the prepass too where the camera has one
-/// (groups with a level in a material of the app's own type then switch levels at once).
+/// (groups with a level whose material has a prepass shader of its own then switch levels at
+/// once).
 #[derive(Component, Clone, Debug, Reflect)]
 #[reflect(Component, Default, Clone)]
 #[require(Hdr)]

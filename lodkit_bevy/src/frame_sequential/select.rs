@@ -250,8 +250,8 @@ fn update(
             "FrameSequentialLod on a camera with MSAA: its LOD groups blend with lodkit's \
              complementary screen-door dither (Msaa::Off for the frame-sequential combine){}",
             if prepass {
-                "; with the camera's prepass, levels in a material of the app's own type whose \
-                 prepass is its own switch at once"
+                "; with the camera's prepass, levels whose material has a prepass shader of \
+                 its own switch at once"
             } else {
                 ""
             }
