@@ -21,6 +21,11 @@
 //! without coverages switches where its sphere's projected radius halves: level `i` from
 //! `d = 2^i R` (a size rule, not a pixel-error bound: give the file coverages, as `lodkit lod`
 //! does, for that).
+//!
+//! An impostor level (`lodkit lod --impostor`: a card node whose extras hold `lodkit_impostor`,
+//! the last of the node's levels) is left out with a warning: lodkit_bevy draws no impostor
+//! yet, and the card alone would show the object's front from every side (edge-on from 90°).
+//! The last mesh level is shown in its place, up to where the node is hidden.
 
 use bevy::asset::LoadContext;
 use bevy::gltf::extensions::{
@@ -96,7 +101,15 @@ pub(crate) fn build(app: &mut App) {
 struct MsftLod {
     /// Per node: its mesh's index and each primitive's material index.
     nodes: Vec<Option<(usize, Vec<Option<usize>>)>>,
+    /// Per node: whether it is an impostor's card (`lodkit lod --impostor`: its extras hold
+    /// `lodkit_impostor`).
+    impostors: Vec<bool>,
+    /// Whether this load warned of an impostor level left out (once per file).
+    impostor_warned: bool,
 }
+
+/// The key `lodkit lod --impostor` writes into an impostor level node's extras.
+const IMPOSTOR_EXTRAS_KEY: &str = "lodkit_impostor";
 
 impl GltfExtensionHandler for MsftLod {
     fn dyn_clone(&self) -> Box<dyn ErasedGltfExtensionHandler> {
@@ -109,12 +122,22 @@ impl GltfExtensionHandler for MsftLod {
         gltf: &gltf::Gltf,
         _settings: &bevy::gltf::GltfLoaderSettings,
     ) {
+        self.impostor_warned = false;
         self.nodes = gltf
             .nodes()
             .map(|node| {
                 node.mesh().map(|mesh| {
                     let materials = mesh.primitives().map(|p| p.material().index()).collect();
                     (mesh.index(), materials)
+                })
+            })
+            .collect();
+        self.impostors = gltf
+            .nodes()
+            .map(|node| {
+                node.extras().as_ref().is_some_and(|extras| {
+                    gltf::json::deserialize::from_str::<gltf::json::Value>(extras.get())
+                        .is_ok_and(|v| v.get(IMPOSTOR_EXTRAS_KEY).is_some())
                 })
             })
             .collect();
@@ -148,7 +171,7 @@ impl GltfExtensionHandler for MsftLod {
 impl MsftLod {
     /// The [`GltfLod`] of `node`, whose `MSFT_lod` extension is `lod`.
     fn levels(
-        &self,
+        &mut self,
         load_context: &mut LoadContext<'_>,
         node: &gltf::Node,
         lod: &gltf::json::Value,
@@ -159,11 +182,19 @@ impl MsftLod {
             .and_then(|ids| ids.as_array())
             .ok_or("no \"ids\" array")?;
         let mut level_nodes = Vec::new();
-        for id in ids {
+        let mut impostor = None;
+        for (k, id) in ids.iter().enumerate() {
             let id = id
                 .as_u64()
                 .and_then(|i| usize::try_from(i).ok())
                 .ok_or_else(|| format!("id {id} is not a node index"))?;
+            if self.impostors.get(id).copied().unwrap_or(false) {
+                if k + 1 < ids.len() {
+                    return Err(format!("impostor level node {id} is not the last level"));
+                }
+                impostor = Some(id);
+                continue;
+            }
             match self.nodes.get(id) {
                 Some(Some(info)) => level_nodes.push(info.clone()),
                 Some(None) => return Err(format!("level node {id} has no mesh")),
@@ -196,8 +227,23 @@ impl MsftLod {
         if !(radius.is_finite() && radius > 0.0) {
             return Err(format!("the mesh's box has no size (radius {radius})"));
         }
-        let coverage = screen_coverage(node)?;
-        let (distances, max_distance) = switch_distances(radius, coverage.as_deref(), ids.len())?;
+        let mut coverage = screen_coverage(node)?;
+        if let Some(id) = impostor {
+            // Its card would show the object's front from every side: the last mesh level is
+            // shown instead, up to where the node is hidden (its coverage, the impostor's
+            // switch, goes).
+            without_last_level(coverage.as_mut(), ids.len());
+            if !std::mem::replace(&mut self.impostor_warned, true) {
+                warn!(
+                    "{}: impostor levels (`lodkit lod --impostor`; the first: node {id}) left \
+                     out: lodkit_bevy draws no impostor yet; each node's last mesh level is \
+                     shown up to where the node is hidden",
+                    load_context.path()
+                );
+            }
+        }
+        let (distances, max_distance) =
+            switch_distances(radius, coverage.as_deref(), level_nodes.len())?;
         let primitives = mesh
             .primitives()
             .map(|p| {
@@ -234,6 +280,18 @@ impl MsftLod {
             distances,
             max_distance,
         })
+    }
+}
+
+/// Takes the last of `coarser` levels' coverage out of `coverage` (one per level from the
+/// finest, below which the next takes over, and where present the hide coverage last): the
+/// level before it is then shown up to the hide coverage.
+fn without_last_level(coverage: Option<&mut Vec<f32>>, coarser: usize) {
+    if let Some(c) = coverage
+        && coarser > 0
+        && c.len() >= coarser
+    {
+        c.remove(coarser - 1);
     }
 }
 
@@ -345,6 +403,27 @@ fn spawn_gltf_groups(
 #[cfg(test)]
 mod tests {
     use crate::gltf_lod::*;
+
+    /// An impostor level left out: the last mesh level takes its place up to the hide coverage;
+    /// without a hide coverage, up to any distance.
+    #[test]
+    fn a_left_out_last_level_gives_its_range_to_the_level_before() {
+        let mut with_hide = vec![0.5, 0.1, 0.02, 0.004, 0.001];
+        without_last_level(Some(&mut with_hide), 4);
+        assert_eq!(with_hide, [0.5, 0.1, 0.02, 0.001]);
+        let (d, max) = switch_distances(1.0, Some(&with_hide), 3).unwrap();
+        assert_eq!(d.len(), 4);
+        let hide = (std::f32::consts::PI / (4.0 * GLTF_COVERAGE_ASPECT * 0.001)).sqrt();
+        assert!((max.unwrap() - hide).abs() <= 1e-5 * hide);
+        let mut without_hide = vec![0.5, 0.1, 0.02, 0.004];
+        without_last_level(Some(&mut without_hide), 4);
+        assert_eq!(without_hide, [0.5, 0.1, 0.02]);
+        assert_eq!(
+            switch_distances(1.0, Some(&without_hide), 3).unwrap().1,
+            None
+        );
+        without_last_level(None, 4);
+    }
 
     #[test]
     fn coverages_give_the_distances_lodkit_lod_wrote_them_from() {
