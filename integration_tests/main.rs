@@ -6,6 +6,7 @@
 #[macro_use]
 mod support;
 mod alpha_tested;
+mod bilateral_sigma;
 mod combine_coverage;
 mod combine_ray;
 mod composition;

@@ -13,6 +13,11 @@ mod atlas;
 mod bound;
 mod sample;
 
+/// The key of a glTF node's `extras` under which `lodkit lod --impostor` writes an impostor
+/// level's layout (docs/impostors.md), and by which a loader knows the node for an impostor's
+/// card.
+pub const IMPOSTOR_GLTF_EXTRAS_KEY: &str = "lodkit_impostor";
+
 pub use atlas::{
     ImpostorAtlas, ImpostorImage, dilate_frames, mip_chain, preserve_coverage, srgba8,
 };

@@ -194,15 +194,13 @@ pub enum LodChainError {
     #[error("radius {0} must be finite and >= 0")]
     BadRadius(f32),
     /// An impostor at the end of the chain would never be shown: its picture is within the
-    /// pixel error only from `from`, or the chain's last mesh level is shown up to `from`, and
-    /// the object is hidden beyond `hidden` (view-normalized distances).
+    /// pixel error only from `from`, and the object is hidden beyond `hidden` (view-normalized
+    /// distances).
     #[error(
-        "the impostor would never be shown: {why} from {from} (view-normalized), and the object is hidden beyond {hidden}"
+        "the impostor would never be shown: its picture is within the pixel error only from {from:.3} (view-normalized), and the object is hidden beyond {hidden:.3}"
     )]
     ImpostorNeverShown {
-        /// What holds it off: its own error, or the last mesh level.
-        why: &'static str,
-        /// Where it could be shown from.
+        /// Where its picture is within the pixel error from.
         from: f32,
         /// The hide distance.
         hidden: f32,

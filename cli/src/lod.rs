@@ -439,11 +439,8 @@ fn add_impostor_row(
         .map_err(|e| format!("impostor: {e}"))?;
     let distances: Vec<f32> = report.levels.iter().map(|l| l.switch_distance).collect();
     let placement = lodkit::impostor::impostor_placement(&distances, report.max_distance, own)
-        .map_err(|e| match e {
-            lodkit::lod_chain::LodChainError::ImpostorNeverShown { from, .. } if from == own => {
-                format!("impostor left out: {e}; more frames (--impostor-frames) bring it nearer")
-            }
-            e => format!("impostor left out: {e}"),
+        .map_err(|e| {
+            format!("impostor left out: {e}; more frames (--impostor-frames) bring it nearer")
         })?;
     if placement.mesh_levels < report.levels.len() {
         report.warnings.push(format!(

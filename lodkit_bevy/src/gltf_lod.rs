@@ -108,9 +108,6 @@ struct MsftLod {
     impostor_warned: bool,
 }
 
-/// The key `lodkit lod --impostor` writes into an impostor level node's extras.
-const IMPOSTOR_EXTRAS_KEY: &str = "lodkit_impostor";
-
 impl GltfExtensionHandler for MsftLod {
     fn dyn_clone(&self) -> Box<dyn ErasedGltfExtensionHandler> {
         Box::new(self.clone())
@@ -137,7 +134,7 @@ impl GltfExtensionHandler for MsftLod {
             .map(|node| {
                 node.extras().as_ref().is_some_and(|extras| {
                     gltf::json::deserialize::from_str::<gltf::json::Value>(extras.get())
-                        .is_ok_and(|v| v.get(IMPOSTOR_EXTRAS_KEY).is_some())
+                        .is_ok_and(|v| v.get(lodkit::impostor::IMPOSTOR_GLTF_EXTRAS_KEY).is_some())
                 })
             })
             .collect();
@@ -232,7 +229,7 @@ impl MsftLod {
             // Its card would show the object's front from every side: the last mesh level is
             // shown instead, up to where the node is hidden (its coverage, the impostor's
             // switch, goes).
-            without_last_level(coverage.as_mut(), ids.len());
+            without_last_level(coverage.as_mut(), ids.len())?;
             if !std::mem::replace(&mut self.impostor_warned, true) {
                 warn!(
                     "{}: impostor levels (`lodkit lod --impostor`; the first: node {id}) left \
@@ -285,14 +282,22 @@ impl MsftLod {
 
 /// Takes the last of `coarser` levels' coverage out of `coverage` (one per level from the
 /// finest, below which the next takes over, and where present the hide coverage last): the
-/// level before it is then shown up to the hide coverage.
-fn without_last_level(coverage: Option<&mut Vec<f32>>, coarser: usize) {
+/// level before it is then shown up to the hide coverage. Too few coverages is an error that
+/// counts every level.
+fn without_last_level(coverage: Option<&mut Vec<f32>>, coarser: usize) -> Result<(), String> {
     if let Some(c) = coverage
         && coarser > 0
-        && c.len() >= coarser
     {
+        if c.len() < coarser {
+            return Err(format!(
+                "MSFT_screencoverage has {} values for {} levels",
+                c.len(),
+                coarser + 1
+            ));
+        }
         c.remove(coarser - 1);
     }
+    Ok(())
 }
 
 /// The node's `MSFT_screencoverage` (its extras), None where it has none.
@@ -409,20 +414,23 @@ mod tests {
     #[test]
     fn a_left_out_last_level_gives_its_range_to_the_level_before() {
         let mut with_hide = vec![0.5, 0.1, 0.02, 0.004, 0.001];
-        without_last_level(Some(&mut with_hide), 4);
+        without_last_level(Some(&mut with_hide), 4).unwrap();
         assert_eq!(with_hide, [0.5, 0.1, 0.02, 0.001]);
         let (d, max) = switch_distances(1.0, Some(&with_hide), 3).unwrap();
         assert_eq!(d.len(), 4);
         let hide = (std::f32::consts::PI / (4.0 * GLTF_COVERAGE_ASPECT * 0.001)).sqrt();
         assert!((max.unwrap() - hide).abs() <= 1e-5 * hide);
         let mut without_hide = vec![0.5, 0.1, 0.02, 0.004];
-        without_last_level(Some(&mut without_hide), 4);
+        without_last_level(Some(&mut without_hide), 4).unwrap();
         assert_eq!(without_hide, [0.5, 0.1, 0.02]);
         assert_eq!(
             switch_distances(1.0, Some(&without_hide), 3).unwrap().1,
             None
         );
-        without_last_level(None, 4);
+        without_last_level(None, 4).unwrap();
+        let mut short = vec![0.5, 0.1];
+        let e = without_last_level(Some(&mut short), 4).unwrap_err();
+        assert!(e.contains("2 values for 5 levels"), "{e}");
     }
 
     #[test]

@@ -8,7 +8,7 @@ mod support;
 /// Every route takes every ball through both levels with no background shown and nothing drawn
 /// where no level is, change each pixel one way only (flicker 1 against the fine level, within
 /// 10 %), and pop at most a quarter of switching at once (measured on lavapipe: 0.054, 0.052
-/// and, with the prepass, 0.052 against 0.345, 0.16x and 0.15x; `Stripes` has no prepass shader
+/// and, with the prepass, 0.052 against 0.345: 0.16x, 0.15x and 0.15x; `Stripes` has no prepass shader
 /// of its own, and without the dither's discard in Bevy's default prepass, a throwaway edit,
 /// the prepass run showed the background in 79,882 pixel-frames, pop 0.20); the combine ran (frames with a group in transition). The
 /// hard switch's pop is there for the metric to see one (a third of the picture's change in one

@@ -143,26 +143,20 @@ pub fn impostor_placement(
     hidden: f32,
     impostor: f32,
 ) -> Result<ImpostorPlacement, crate::lod_chain::LodChainError> {
+    if impostor >= hidden {
+        return Err(crate::lod_chain::LodChainError::ImpostorNeverShown {
+            from: impostor,
+            hidden,
+        });
+    }
+    // LOD0 (the first) stays whatever its distance; a chain without levels is the impostor.
     let mesh_levels = distances
         .iter()
         .skip(1)
         .position(|&d| d >= impostor)
-        .map_or(distances.len(), |k| k + 1)
-        .max(1);
-    let last = distances
-        .get(mesh_levels.saturating_sub(1))
-        .copied()
-        .unwrap_or(0.0);
-    let never =
-        |why, from| Err(crate::lod_chain::LodChainError::ImpostorNeverShown { why, from, hidden });
-    if impostor >= hidden {
-        return never("its picture is within the pixel error only", impostor);
-    }
-    if last >= hidden {
-        return never("the last mesh level is shown", last);
-    }
+        .map_or(distances.len(), |k| k + 1);
     Ok(ImpostorPlacement {
         mesh_levels,
-        distance: impostor.max(last),
+        distance: impostor,
     })
 }

@@ -177,8 +177,8 @@ fn coverage_preserving_mips_work_frame_by_frame() {
     preserve_coverage(&mut odd, u32::MAX);
 }
 
-/// Mesh levels that switch in at or beyond the impostor's distance give way to it; LOD0 stays;
-/// an impostor the object is hidden before, or after a last level that is, is refused.
+/// Mesh levels that switch in at or beyond the impostor's distance give way to it; LOD0 stays
+/// (whatever its distance); an impostor the object is hidden before is refused.
 #[cfg(feature = "lod_chain")]
 #[test]
 fn the_impostor_ends_the_chain_where_it_is_within_the_error() {
@@ -192,10 +192,16 @@ fn the_impostor_ends_the_chain_where_it_is_within_the_error() {
     assert_eq!(place(&[0.0, 2.0], 0.5).unwrap(), (1, 0.5));
     assert_eq!(place(&[0.0], 3.0).unwrap(), (1, 3.0));
     assert_eq!(place(&[0.0, 2.0, 5.0], 30.0).unwrap(), (3, 30.0));
+    assert_eq!(place(&[3.0, 5.0], 1.0).unwrap(), (1, 1.0));
+    assert_eq!(place(&[], 1.0).unwrap(), (0, 1.0));
     for (distances, own) in [(&[0.0, 2.0][..], 40.0), (&[0.0, 2.0, 41.0][..], 45.0)] {
         let e = place(distances, own).unwrap_err();
-        assert!(
-            matches!(e, LodChainError::ImpostorNeverShown { hidden: 40.0, .. }),
+        assert_eq!(
+            e,
+            LodChainError::ImpostorNeverShown {
+                from: own,
+                hidden: 40.0
+            },
             "{e}"
         );
     }

@@ -168,9 +168,8 @@ pub fn run<M: Material>(
 }
 
 /// Renders the references, then the combine, the dither (without and with a prepass) and the
-/// hard switch; prints a line per
-/// run, writes `out/strip_<run>.png` (8 frames) and returns the report (JSON per run). Errors:
-/// (exit code, message).
+/// hard switch; prints a line per run, writes `out/strip_<run>.png` (8 frames) and returns the
+/// report (JSON per run). Errors: (exit code, message).
 pub fn measure_all<M: Material>(
     app: &mut App,
     stage: &Stage,

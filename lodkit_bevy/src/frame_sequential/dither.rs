@@ -10,9 +10,11 @@
 //! (whose alpha test the older-level depth pass cannot repeat). On a camera with a prepass, the
 //! prepass must drop the same pixels as the main pass, or it would write both levels' depth
 //! whole and the main pass could then show neither at a pixel: `FrameSequentialExtension`'s
-//! prepass does, and so does Bevy's default prepass of a material of the app's own type as
-//! `FrameSequentialBindings` gives it (a blending material is not in the prepass); a level whose
-//! material has a prepass shader of its own switches at once instead.
+//! prepass does on a multisampled camera, and so does Bevy's default prepass of a material of
+//! the app's own type as `FrameSequentialBindings` gives it (a blending material is not in the
+//! prepass); a level whose material has a prepass shader of its own switches at once instead,
+//! and so does a group with a blending level on a camera with a prepass but no MSAA (its other
+//! levels' prepass is Bevy's there).
 
 use lodkit::select::LodSelection;
 

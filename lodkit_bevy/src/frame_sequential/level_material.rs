@@ -121,8 +121,8 @@ pub(super) struct Looks {
     /// in its alpha), or it is an alpha mask whose test lodkit cannot repeat (a material type
     /// other than `StandardMaterial`), so the combine could not know its coverage.
     pub(super) blends: bool,
-    /// Whether a prepass keeps the same pixels of it as the main pass when the dither drops
-    /// some: `StandardMaterial`'s prepass drops them too (`FrameSequentialExtension`), and so
+    /// Whether a multisampled camera's prepass keeps the same pixels of it as the main pass when
+    /// the dither drops some: `StandardMaterial`'s prepass drops them too (`FrameSequentialExtension`), and so
     /// does Bevy's default prepass of a material of the app's own type with no prepass shader
     /// of its own (`FrameSequentialBindings`); a blending material is not in the prepass. A
     /// material's own prepass shader draws the level whole.

@@ -261,11 +261,17 @@ fn a_material_without_its_plugin_is_named() {
 
 /// A material with a prepass shader of its own (its shader is not compiled here).
 #[derive(Asset, TypePath, AsBindGroup, Clone, Debug)]
-struct OwnPrepass {}
+struct OwnPrepass {
+    alpha_mode: AlphaMode,
+}
 
 impl Material for OwnPrepass {
     fn prepass_fragment_shader() -> bevy::shader::ShaderRef {
         "own_prepass.wesl".into()
+    }
+
+    fn alpha_mode(&self) -> AlphaMode {
+        self.alpha_mode
     }
 }
 
@@ -274,12 +280,17 @@ impl Material for OwnPrepass {
 /// (not in the prepass), does not.
 #[test]
 fn a_prepass_of_the_materials_own_is_told_apart() {
-    assert!(!looks_of(&OwnPrepass {}).prepass_dithers);
+    let own = |alpha_mode| OwnPrepass { alpha_mode };
+    assert!(!looks_of(&own(AlphaMode::Opaque)).prepass_dithers);
+    assert!(!looks_of(&own(AlphaMode::Mask(0.5))).prepass_dithers);
+    // A blending material is not in the prepass, whatever its prepass shader.
+    assert!(looks_of(&own(AlphaMode::Blend)).prepass_dithers);
     let plain = |alpha_mode| Plain {
         color: LinearRgba::RED,
         alpha_mode,
     };
     assert!(looks_of(&plain(AlphaMode::Opaque)).prepass_dithers);
+    assert!(looks_of(&plain(AlphaMode::Blend)).prepass_dithers);
     assert!(looks_of(&plain(AlphaMode::Mask(0.5))).prepass_dithers);
     assert!(looks_of(&StandardMaterial::default()).prepass_dithers);
 }

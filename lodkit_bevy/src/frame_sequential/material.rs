@@ -43,6 +43,7 @@ pub type FrameSequentialMaterial = ExtendedMaterial<StandardMaterial, FrameSeque
 /// (StandardMaterial's, with the dither's discard first) keeps the same pixels of each level as
 /// the main pass, so a camera with MSAA and a prepass gets the dither too; on such a camera the
 /// prepass of an opaque level gets a fragment stage (a depth-only prepass of Bevy's has none).
+/// Shadow maps and prepasses without MSAA are Bevy's.
 ///
 /// ```
 /// use bevy::prelude::*;
@@ -80,10 +81,6 @@ impl MaterialExtension for FrameSequentialExtension {
         LOD_MATERIAL_SHADER.into()
     }
 
-    fn prepass_fragment_shader() -> ShaderRef {
-        LOD_PREPASS_SHADER.into()
-    }
-
     fn specialize(
         _: &MaterialExtensionPipeline,
         descriptor: &mut RenderPipelineDescriptor,
@@ -92,7 +89,7 @@ impl MaterialExtension for FrameSequentialExtension {
     ) -> Result<(), SpecializedMeshPipelineError> {
         define_level(descriptor);
         if key.mesh_key.msaa_samples() > 1 {
-            dither_in_prepass(descriptor);
+            dither_in_prepass(descriptor, STANDARD_PREPASS_SHADER_PATH, LOD_PREPASS_SHADER);
         }
         Ok(())
     }
@@ -100,20 +97,6 @@ impl MaterialExtension for FrameSequentialExtension {
 
 /// The shader def Bevy's prepass pipelines (the camera's prepass and shadow maps) define.
 const PREPASS_PIPELINE_SHADER_DEF: &str = "PREPASS_PIPELINE";
-
-/// Gives a prepass pipeline without a fragment stage (an opaque level, depth prepass only)
-/// [`LOD_PREPASS_SHADER`]'s, which drops the pixels the dither drops. Bevy runs that shader
-/// where it runs a fragment stage already (normals, motion vectors, alpha masks): the
-/// extension's prepass shader.
-fn dither_in_prepass(descriptor: &mut RenderPipelineDescriptor) {
-    if is_prepass(descriptor) && descriptor.fragment.is_none() {
-        descriptor.fragment = Some(FragmentState {
-            shader: LOD_PREPASS_SHADER,
-            shader_defs: descriptor.vertex.shader_defs.clone(),
-            ..default()
-        });
-    }
-}
 
 /// Whether `descriptor` is a prepass pipeline's (the camera's prepass or a shadow map's).
 fn is_prepass(descriptor: &RenderPipelineDescriptor) -> bool {
@@ -125,32 +108,33 @@ fn is_prepass(descriptor: &RenderPipelineDescriptor) -> bool {
 /// Where Bevy 0.20.1 keeps its default prepass shader (the vertex and fragment stages of a
 /// material with no prepass shader of its own).
 const DEFAULT_PREPASS_SHADER_PATH: &str = "bevy_pbr/prepass/prepass.wesl";
+/// Where Bevy 0.20.1 keeps `StandardMaterial`'s prepass fragment shader.
+const STANDARD_PREPASS_SHADER_PATH: &str = "bevy_pbr/render/pbr_prepass.wesl";
 
-/// Gives a prepass pipeline that runs Bevy's default prepass shader (a material of the app's
-/// own with no prepass shader of its own) [`LOD_DEFAULT_PREPASS_SHADER`]'s fragment stage,
-/// which drops the pixels the dither drops: in place of the default's, or where a depth-only
-/// prepass runs none. A material with a prepass shader of its own keeps it (its groups switch
-/// at once on a camera with MSAA and a prepass).
-fn dither_in_default_prepass(descriptor: &mut RenderPipelineDescriptor) {
-    let bevys = |shader: &Handle<Shader>| {
-        shader
-            .path()
-            .is_some_and(|p| p.path().ends_with(DEFAULT_PREPASS_SHADER_PATH))
+/// On a camera prepass pipeline (not a shadow map's: those have one sample, and the callers
+/// come here only for a multisampled one) that runs Bevy's default prepass vertex shader, puts
+/// `ours` where Bevy's fragment shader at `bevys` would run, or where a depth-only prepass runs
+/// no fragment stage: `ours` drops the pixels the screen-door dither drops, so the prepass keeps
+/// the same pixels of each level as the main pass. A material with a prepass shader of its own
+/// keeps it (its groups switch at once on a camera with MSAA and a prepass). Without MSAA no
+/// prepass changes: the combine runs there, and no level pays for a fragment stage or a
+/// material binding in its depth-only prepass or its shadows.
+fn dither_in_prepass(descriptor: &mut RenderPipelineDescriptor, bevys: &str, ours: Handle<Shader>) {
+    let at = |shader: &Handle<Shader>, path: &str| {
+        shader.path().is_some_and(|p| p.path().ends_with(path))
     };
-    if !is_prepass(descriptor) || !bevys(&descriptor.vertex.shader) {
+    if !is_prepass(descriptor) || !at(&descriptor.vertex.shader, DEFAULT_PREPASS_SHADER_PATH) {
         return;
     }
     match descriptor.fragment.as_mut() {
         None => {
             descriptor.fragment = Some(FragmentState {
-                shader: LOD_DEFAULT_PREPASS_SHADER,
+                shader: ours,
                 shader_defs: descriptor.vertex.shader_defs.clone(),
                 ..default()
             });
         }
-        Some(fragment) if bevys(&fragment.shader) => {
-            fragment.shader = LOD_DEFAULT_PREPASS_SHADER;
-        }
+        Some(fragment) if at(&fragment.shader, bevys) => fragment.shader = ours,
         Some(_) => {}
     }
 }
@@ -206,7 +190,11 @@ impl MaterialExtension for FrameSequentialBindings {
     ) -> Result<(), SpecializedMeshPipelineError> {
         define_level(descriptor);
         if key.mesh_key.msaa_samples() > 1 {
-            dither_in_default_prepass(descriptor);
+            dither_in_prepass(
+                descriptor,
+                DEFAULT_PREPASS_SHADER_PATH,
+                LOD_DEFAULT_PREPASS_SHADER,
+            );
         }
         Ok(())
     }

@@ -328,7 +328,10 @@ fn update(
                 })
         };
         let blending = looks(|m| m.blends);
-        let prepass_draws_whole = prepass && looks(|m| !m.prepass_dithers);
+        // The levels' prepass drops the dither's pixels only on a multisampled camera (where
+        // the dither is the rule; without MSAA it serves blending levels alone, and the
+        // prepass of the group's other levels is Bevy's).
+        let prepass_draws_whole = prepass && (!multisampled || looks(|m| !m.prepass_dithers));
         let fallback = Fallback::of(multisampled, blending, prepass_draws_whole);
         if blending {
             warn_once!(

@@ -139,18 +139,23 @@ fn a_multisampled_camera_blends_with_the_dither() {
     assert_eq!(views.iter(&world).count(), 0, "the render world got a view");
 }
 
+/// Gives the world's camera Bevy's depth prepass.
+fn give_camera_a_depth_prepass(world: &mut World) {
+    let camera = world
+        .query_filtered::<Entity, With<FrameSequentialLod>>()
+        .single(world)
+        .unwrap();
+    world
+        .entity_mut(camera)
+        .insert(bevy::core_pipeline::prepass::DepthPrepass);
+}
+
 /// With MSAA and a prepass, levels in `StandardMaterial`s (whose prepass drops the dither's
 /// pixels too) blend with the dither as without a prepass: both levels drawn in the band.
 #[test]
 fn a_multisampled_camera_with_a_prepass_blends_with_the_dither() {
     let (mut world, group) = world_with_group(Msaa::Sample4);
-    let camera = world
-        .query_filtered::<Entity, With<FrameSequentialLod>>()
-        .single(&world)
-        .unwrap();
-    world
-        .entity_mut(camera)
-        .insert(bevy::core_pipeline::prepass::DepthPrepass);
+    give_camera_a_depth_prepass(&mut world);
     assert_eq!(frame(&mut world, group, 1.0), (false, 0, None), "idle");
     for z in [3.9, 4.05, 4.2] {
         assert_eq!(frame(&mut world, group, z), (false, 0, None), "in the band");
@@ -159,6 +164,36 @@ fn a_multisampled_camera_with_a_prepass_blends_with_the_dither() {
             .dither_entity
             .unwrap_or_else(|| panic!("the second drawer at {z}"));
         assert_ne!(world.get::<Visibility>(second), Some(&Visibility::Hidden));
+    }
+    frame(&mut world, group, 9.0);
+    assert_eq!(world.get::<FrameSequentialLevels>(group).unwrap().drawn, 1);
+}
+
+/// Without MSAA a group with a blending level takes the dither, but on a camera with a prepass
+/// its other levels' prepass is Bevy's (it would write their depth whole): it switches at once.
+#[test]
+fn a_blending_level_on_a_camera_with_a_prepass_and_no_msaa_switches_at_once() {
+    let (mut world, group) = world_with_group(Msaa::Off);
+    give_camera_a_depth_prepass(&mut world);
+    let blending =
+        world
+            .resource_mut::<Assets<FrameSequentialMaterial>>()
+            .add(FrameSequentialMaterial {
+                base: StandardMaterial {
+                    alpha_mode: AlphaMode::Blend,
+                    ..default()
+                },
+                extension: default(),
+            });
+    world.get_mut::<LodLevels>(group).unwrap().0[1] = LodLevel::new(Handle::default(), blending);
+    world
+        .run_system_once(super::super::drawer::spawn_levels)
+        .unwrap();
+    assert_eq!(frame(&mut world, group, 1.0), (false, 0, None), "idle");
+    for z in [3.9, 4.05, 4.2] {
+        frame(&mut world, group, z);
+        let levels = world.get::<FrameSequentialLevels>(group).unwrap();
+        assert_eq!(levels.dither_entity, None, "one level at {z}");
     }
     frame(&mut world, group, 9.0);
     assert_eq!(world.get::<FrameSequentialLevels>(group).unwrap().drawn, 1);

@@ -139,7 +139,7 @@ impl Output {
         });
         let shape = if hemi { "hemi" } else { "full" };
         let extras = json::Value::from(serde_json_map([(
-            "lodkit_impostor",
+            lodkit::impostor::IMPOSTOR_GLTF_EXTRAS_KEY,
             json::Value::from(serde_json_map([
                 ("frames", json::Value::from(layout.frames)),
                 ("frame_size", json::Value::from(layout.frame_size)),
