@@ -32,8 +32,8 @@ use lodkit::gpu::framebuffer_lod::{
     LowResBuffer, UpsampleFrame, UpsamplePass, UpsamplePassDescriptor, UpsampleSettings,
 };
 use lodkit::gpu::resources::{
-    begin_color_pass, buffer_with_data, fullscreen_pipeline_with, one_group_layout, texture_2d,
-    texture_entry, uniform_buffer, uniform_entry,
+    begin_color_pass, buffer_with_data, buffers_bind_group, fullscreen_pipeline_with,
+    one_group_layout, texture_2d, texture_entry, uniform_buffer, uniform_entry,
 };
 use lodkit::gpu::select::{
     GpuLodGroup, GpuLodInstance, GpuLodSelector, GpuLodSelectorDescriptor, GpuSelectCamera,
@@ -397,15 +397,7 @@ fn select(c: &mut Criterion, gpu: &GpuContext) -> String {
         let data = group
             .select_data(settings.hysteresis)
             .expect("at most 8 levels");
-        table.push(GpuLodGroup {
-            levels: data.levels,
-            level_count: data.level_count,
-            max_distance: data.max_distance,
-            fade_from: data.fade_from,
-            hysteresis: data.hysteresis,
-            first_slot: firsts.len() as u32,
-            pad: [0; 3],
-        });
+        table.push(GpuLodGroup::new(&data, firsts.len() as u32));
         let members = instances.iter().filter(|i| i.group == g as u32).count() as u32;
         for _ in 0..data.level_count {
             firsts.push(entries);
@@ -444,19 +436,12 @@ fn select(c: &mut Criterion, gpu: &GpuContext) -> String {
         filled(bytemuck::bytes_of(&chunk), uniform, "plain chunk"),
     ];
     let template = filled(&counts, wgpu::BufferUsages::COPY_SRC, "plain template");
-    let group_entries: Vec<wgpu::BindGroupEntry> = bound
-        .iter()
-        .enumerate()
-        .map(|(k, b)| wgpu::BindGroupEntry {
-            binding: k as u32,
-            resource: b.as_entire_binding(),
-        })
-        .collect();
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("plain select"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &group_entries,
-    });
+    let group = buffers_bind_group(
+        device,
+        &pipeline.get_bind_group_layout(0),
+        &bound.each_ref(),
+        "plain select",
+    );
     let (distance_kind, factor) = distance_kind(&frame.camera, &settings);
     let (mode, step) = settings.select_mode(frame.dt);
     let camera_bytes = GpuSelectCamera {

@@ -118,6 +118,28 @@ pub fn buffer_with_data(
     })
 }
 
+/// A bind group of `layout` binding each of `buffers` whole, at bindings 0, 1, ... in order.
+pub fn buffers_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+    label: &str,
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(k, b)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
 /// A uniform buffer of `size` bytes that can be written.
 pub fn uniform_buffer(
     gpu: &GpuContext,

@@ -205,15 +205,7 @@ impl GpuLodSelector {
                     expected: format!("at most its {} levels", group.levels().len()),
                 });
             }
-            groups.push(GpuLodGroup {
-                levels: data.levels,
-                level_count: data.level_count,
-                max_distance: data.max_distance,
-                fade_from: data.fade_from,
-                hysteresis: data.hysteresis,
-                first_slot: slot_meshes.len() as u32,
-                pad: [0; 3],
-            });
+            groups.push(GpuLodGroup::new(&data, slot_meshes.len() as u32));
             for level in 0..group.levels().len() {
                 slot_meshes.push(meshes.get(level).copied().unwrap_or_default());
             }

@@ -4,7 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
-use crate::select::{LodCamera, LodGroup, LodSettings, SELECT_MAX_LEVELS};
+use crate::select::{LodCamera, LodGroup, LodSettings, SELECT_MAX_LEVELS, SelectGroupData};
 
 /// Rust mirror of `SelectInstance` in `passes/select.wgsl` (32 bytes).
 #[repr(C)]
@@ -53,6 +53,22 @@ pub struct GpuLodGroup {
     pub first_slot: u32,
     /// Padding.
     pub pad: [u32; 3],
+}
+
+impl GpuLodGroup {
+    /// The group `data` says (`LodGroup::select_data`), its levels' lists starting at the
+    /// (group, level) slot `first_slot`.
+    pub fn new(data: &SelectGroupData, first_slot: u32) -> Self {
+        Self {
+            levels: data.levels,
+            level_count: data.level_count,
+            max_distance: data.max_distance,
+            fade_from: data.fade_from,
+            hysteresis: data.hysteresis,
+            first_slot,
+            pad: [0; 3],
+        }
+    }
 }
 
 /// Rust mirror of `SelectCamera` in `passes/select.wgsl` (144 bytes).

@@ -56,19 +56,12 @@ impl GpuLodSelector {
                 &chunk.info,
             ];
             let bind_group = gpu.guarded(call, || {
-                let entries: Vec<wgpu::BindGroupEntry> = buffers
-                    .iter()
-                    .enumerate()
-                    .map(|(k, b)| wgpu::BindGroupEntry {
-                        binding: k as u32,
-                        resource: b.as_entire_binding(),
-                    })
-                    .collect();
-                Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("lodkit select"),
-                    layout: &self.pipeline.get_bind_group_layout(0),
-                    entries: &entries,
-                }))
+                Ok(crate::gpu::resources::buffers_bind_group(
+                    &gpu.device,
+                    &self.pipeline.get_bind_group_layout(0),
+                    &buffers,
+                    "lodkit select",
+                ))
             })?;
             chunks.push(ViewChunk {
                 states,
