@@ -27,8 +27,7 @@ use super::drawer::{
     DrawerQuery, FrameSequentialLevels, Scheduler, drawn, show, spawn_drawer, spawn_levels,
 };
 use super::level_material::{
-    ApplyDrawerMaterials, DeriveMaterials, DerivedMaterials, DrawerMaterial, Looks,
-    add_level_material,
+    ApplyDrawerMaterials, DeriveMaterials, DerivedMaterials, DrawerMaterial, add_level_material,
 };
 use super::rects::{Bounds, group_hull, group_rect, level_bounds, merge_rows, to_lodkit};
 use super::silhouette::{OutlineView, Surfaces, forget_changed_meshes, outline};
@@ -319,19 +318,22 @@ fn update(
         // Only a group in transition (or starting one) needs to know: a settled group draws its
         // level whole either way.
         let transitioning = selection.next.is_some() || state.transition.is_some();
-        let looks = |test: fn(&Looks) -> bool| {
-            transitioning
-                && levels.0.iter().any(|l| {
-                    derived
-                        .looks(&l.material, &materials)
-                        .is_some_and(|m| test(&m))
-                })
-        };
-        let blending = looks(|m| m.blends);
+        // Whether a level blends, and whether a level's prepass would draw it whole.
+        let (mut blending, mut whole) = (false, false);
+        if transitioning {
+            for looks in levels
+                .0
+                .iter()
+                .filter_map(|l| derived.looks(&l.material, &materials))
+            {
+                blending |= looks.blends;
+                whole |= !looks.prepass_dithers;
+            }
+        }
         // The levels' prepass drops the dither's pixels only on a multisampled camera (where
         // the dither is the rule; without MSAA it serves blending levels alone, and the
         // prepass of the group's other levels is Bevy's).
-        let prepass_draws_whole = prepass && (!multisampled || looks(|m| !m.prepass_dithers));
+        let prepass_draws_whole = prepass && (!multisampled || whole);
         let fallback = Fallback::of(multisampled, blending, prepass_draws_whole);
         if blending {
             warn_once!(
