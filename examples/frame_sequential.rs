@@ -12,10 +12,10 @@
 //! 3. `CombinePass::record` (with `CombineRegions::Only`) merges that buffer with last frame's,
 //!    reprojected through the camera motion (`new_to_old_matrix`), into the frame's target, only
 //!    inside the screen rectangles of the instances in transition (the rest of the frame is a
-//!    copy), told where the level last frame drew covers the screen: its silhouette under this
-//!    frame's camera (`CombineCoverage::Known` with the data `CoverageLevels::data` lays out
-//!    from each level's `lodkit::silhouette::Surface`, registered once, and the scheduler's
-//!    `older(key)`: lodkit's default route).
+//!    copy), told where the level last frame drew covers the screen now and how deep: lodkit's
+//!    default route, the older-level depth pass (each t-instance's `older(key)` level drawn
+//!    again, whole and depth only, into `LodBuffers::level_depth`; `CombineCoverage::Known` with
+//!    the data `CombineData::depth_pass` lays out from the scheduler's `older(key)`).
 //!
 //! `cargo run --example frame_sequential -- [--out DIR]`
 //! Writes DIR/frame_sequential.png (default DIR: lodkit-out): frames of the camera pulling back
@@ -25,7 +25,7 @@ use std::error::Error;
 
 use glam::{Mat4, Vec3, Vec4};
 use lodkit::combine::screen_rect;
-use lodkit::combine_coverage::{CoverageFrame, CoverageLevels, OlderLevel};
+use lodkit::combine_coverage::{CombineData, DepthPassFrame, OlderDepth};
 use lodkit::frame_sequential::{Drive, TransitionScheduler};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{
@@ -89,14 +89,6 @@ fn main() -> Result<(), Box<dyn Error>> {
             Vec4::new(0.15, 0.3, 0.9, 1.0),
         ),
     ];
-    // Each level's surface, registered once (both are closed meshes): the combine is told
-    // where the level the older buffer holds covers the screen by its silhouette.
-    let mut coverage = CoverageLevels::new();
-    let levels = meshes
-        .iter()
-        .map(|m| Ok(coverage.register(m.surface()?)))
-        .collect::<Result<Vec<_>, Box<dyn Error>>>()?;
-
     // Five instances in a row going away from the camera; level 1 beyond a view-normalized
     // distance of 2.5. Selection switches hard: the scheduler spreads each switch over 0.3 s.
     let group = LodGroup::from_distances(&[0.0, 2.5])?;
@@ -119,6 +111,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     // Triangles drawn over the frames with an instance in transition, against a hard switch
     // at each transition's midpoint (the outgoing LOD before progress 0.5, the incoming after).
     let (mut drawn, mut hard, mut per_frame) = (0u64, 0u64, Vec::new());
+    // Triangles of the older-level depth pass (depth only, no shading).
+    let mut depth_pass = 0u64;
     for frame in 0..FRAMES {
         let dt = 1.0 / 60.0;
         if frame > 0 {
@@ -207,27 +201,35 @@ fn main() -> Result<(), Box<dyn Error>> {
             .filter(|(key, _)| scheduler.in_transition(**key))
             .filter_map(|(_, &p)| screen_rect(unit_box, model(p), &views, SIZE, 2))
             .collect();
-        // Where the level the older buffer holds covers the screen now: its silhouette under
-        // this frame's camera (nothing moves by itself, so each instance's matrix is the
-        // camera's), shown at this frame's threshold for it (the pattern is on the screen):
-        // exactly complementary to the level drawn now.
+        // Where the level the older buffer holds covers the screen now and how deep: the
+        // t-instances' older levels drawn again, whole and depth only, with this frame's camera
+        // (the older-level depth pass), each shown at this frame's threshold for it (the
+        // pattern is on the screen): exactly complementary to the level drawn now.
+        let mut older_items = Vec::new();
         let mut older = Vec::new();
         for (key, &p) in keys.iter().zip(&positions) {
             if let Some(o) = scheduler.older(*key)? {
-                older.push(OlderLevel {
-                    id: o.id,
-                    level: levels[usize::from(o.lod.min(1))],
-                    world_from_local: model(p),
-                    new_to_old: None,
-                    older_tau: Some(o.tau),
-                    displace: None,
-                });
+                let (mesh, color) = &lods[usize::from(o.lod.min(1))];
+                let mut item =
+                    LodDrawItem::from_draw(mesh, model(p), *color, &scheduler.draw(*key)?);
+                item.id = o.id;
+                older_items.push(item);
+                older.push(OlderDepth::from(o));
             }
         }
-        let data = coverage.data(&CoverageFrame {
-            clip_from_world: proj * view,
-            eye,
-            size: SIZE,
+        if !older_items.is_empty() {
+            let (triangles, _) = renderer.render_level_depth(
+                &gpu,
+                &buffers,
+                &LodBufferFrame {
+                    view: lod_view,
+                    items: &older_items,
+                    ..Default::default()
+                },
+            )?;
+            depth_pass += triangles;
+        }
+        let data = CombineData::depth_pass(&DepthPassFrame {
             new_to_old,
             objects: &older,
             ..Default::default()
@@ -241,7 +243,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             regions: CombineRegions::Only(&regions),
             coverage: CombineCoverage::Known {
                 data: &data,
-                level_depth: None,
+                level_depth: Some(buffers.level_depth()),
                 pattern: Some(renderer.visibility_view()),
             },
         };
@@ -260,7 +262,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (lo, hi) = (per_frame.iter().min(), per_frame.iter().max());
     println!(
         "frames with a transition: {} triangles each ({} per sphere, {} per box); \
-         {drawn} in all, against {hard} for a hard switch at each transition's midpoint",
+         {drawn} in all, against {hard} for a hard switch at each transition's midpoint; \
+         {depth_pass} more drawn depth only in the older-level depth pass",
         match (lo, hi) {
             (Some(lo), Some(hi)) => format!("{lo} to {hi}"),
             _ => "no frame".to_owned(),

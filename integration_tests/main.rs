@@ -8,6 +8,7 @@ mod support;
 mod alpha_tested;
 mod bilateral_sigma;
 mod combine_coverage;
+mod combine_level_depth;
 mod combine_ray;
 mod composition;
 mod cost;

@@ -14,9 +14,9 @@ use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
 use crate::combine::older::{NOT_FOUND, depth_at, found, id_at, index_of, size_of};
 use crate::combine::{
-    COMBINE_BLOCK_REACH, COMBINE_COVER_REACH, COMBINE_SNAP, CombineRead, DepthConvention, LodImage,
-    combine_cover_texel, combine_displayed_word, combine_other_texel, combine_own_color,
-    combine_ray_offset, combine_read_own, combine_texel, combine_texels, combine_uv, depth_closer,
+    COMBINE_COVER_REACH, COMBINE_SNAP, CombineRead, DepthConvention, LodImage,
+    combine_displayed_word, combine_ray_offset, combine_read_own, combine_texel, combine_texels,
+    combine_uv, depth_closer,
 };
 use crate::lod_buffer::lod_buffer_id;
 use crate::reproject::{
@@ -25,12 +25,14 @@ use crate::reproject::{
 use crate::silhouette::{SILHOUETTE_ON, silhouette_covers, silhouette_texel};
 
 mod data;
+mod depth_pass;
 mod levels;
 mod ray;
 pub use data::{
     COMBINE_DATA_WIDTH, COMBINE_MAX_HEIGHT, COMBINE_MAX_ID, CombineData, CombineDataDescriptor,
     CombineDataError, CombineObjectData, CoverageRoute,
 };
+pub use depth_pass::{DepthPassFrame, OlderDepth, combine_read_level_depth};
 pub use levels::{
     CoverageError, CoverageFrame, CoverageLevel, CoverageLevels, LevelShape, MissingSilhouette,
     OlderLevel,
@@ -173,78 +175,6 @@ pub fn combine_read_estimated(
         }
     }
     found(older, read)
-}
-
-/// The older read with the older-level depth pass (`level`: its depth at the pixel, far where
-/// none): for a pixel showing `id` (0: none), its newer `depth`, the reprojection `old` of that
-/// depth and the object `motion`. Where a level is drawn, its owner is the pixel's own
-/// t-instance, or the t-instance the older buffer holds where that level's depth reprojects when
-/// it lies in front; read where its own surface was. Where none is, what lies behind the
-/// pixel's own older level.
-///
-/// Its parameters mirror the shader function's, one for one (hence more than seven).
-#[allow(clippy::too_many_arguments)]
-pub fn combine_read_level_depth(
-    older: &LodImage,
-    data: &[[u32; 4]],
-    level: f32,
-    id: u32,
-    uv: Vec2,
-    depth: f32,
-    old: Vec3,
-    motion: Vec2,
-    convention: DepthConvention,
-) -> CombineRead {
-    let size = size_of(older);
-    let covered = depth_closer(level, combine_far_depth(convention), convention);
-    let known = |g: u32| g != 0 && combine_object(data, g).flags & COMBINE_KNOWN != 0;
-    let mut owner = id;
-    if covered && (id == 0 || depth_closer(level, depth, convention)) {
-        let read_at = reproject(uv, level, &combine_new_to_old(data, id)).truncate() + motion;
-        let read = combine_texel(read_at, size);
-        if known(id_at(older, read)) {
-            owner = id_at(older, read);
-        } else if id == 0 {
-            let t = combine_other_texel(older, 0, read, read_at);
-            owner = if known(id_at(older, t)) {
-                id_at(older, t)
-            } else {
-                0
-            };
-        }
-    }
-    if owner == 0 {
-        return NOT_FOUND;
-    }
-    if covered {
-        let m = combine_new_to_old(data, owner);
-        let base = reproject_base(uv, &m);
-        let read_at = reproject_from_base(base, level, &m).truncate() + motion;
-        let read = combine_texel(read_at, size);
-        let mut texel = read;
-        if id_at(older, read) != owner {
-            texel = combine_cover_texel(
-                older,
-                owner,
-                read,
-                base,
-                level,
-                &m,
-                motion,
-                COMBINE_BLOCK_REACH,
-            );
-        }
-        let mut r = found(older, texel);
-        if id_at(older, texel) == owner {
-            r.color = combine_own_color(older, owner, read_at, r.color);
-        }
-        return r;
-    }
-    let read_at = old.truncate() + motion;
-    found(
-        older,
-        combine_other_texel(older, owner, combine_texel(read_at, size), read_at),
-    )
 }
 
 /// How far in front of a level's point, as a share of the point's view distance, an older object

@@ -24,9 +24,13 @@ fn the_combine_rectangles_hold_every_pixel_of_the_swaying_tree() {
         o.sway = 1.0;
     }
     let renderer = SceneRenderer::new(gpu, &scene, (320, 180), 24).unwrap();
-    for (coverage, moving) in [Coverage::Estimated, Coverage::Silhouettes]
-        .into_iter()
-        .flat_map(|c| [(c, false), (c, true)])
+    for (coverage, moving) in [
+        Coverage::Estimated,
+        Coverage::Silhouettes,
+        Coverage::DepthPass,
+    ]
+    .into_iter()
+    .flat_map(|c| [(c, false), (c, true)])
     {
         let technique = Technique::FrameSequential(
             VisibilityPattern::BlueNoise,

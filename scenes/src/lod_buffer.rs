@@ -11,8 +11,8 @@ use lodkit::gpu::checks::{check_color_format, same_color_format};
 use lodkit::gpu::counters::FragmentCounter;
 use lodkit::gpu::frame_sequential::{LOD_DEPTH_FORMAT, LodBuffers};
 use lodkit::gpu::resources::{
-    DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, r32float_texture,
-    texture_entry, uniform_buffer,
+    DrawUniforms, camera_draw_layouts, depth_write_state, mesh_pipeline, mesh_pipeline_entry,
+    r32float_texture, texture_entry, uniform_buffer,
 };
 use lodkit::gpu::{GpuContext, GpuError};
 use lodkit::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
@@ -170,6 +170,8 @@ pub struct LodBufferRenderer {
     pipeline: wgpu::RenderPipeline,
     /// The same for LOD buffers without the object motion target.
     still_pipeline: wgpu::RenderPipeline,
+    /// The older-level depth pass (`fs_level_depth`, depth only).
+    level_depth_pipeline: wgpu::RenderPipeline,
     camera: wgpu::Buffer,
     camera_layout: wgpu::BindGroupLayout,
     vis_view: wgpu::TextureView,
@@ -248,6 +250,14 @@ impl LodBufferRenderer {
                 )
             };
             let (with_motion, still) = (pipeline(&targets)?, pipeline(&targets[..2])?);
+            let level_depth_pipeline = mesh_pipeline_entry(
+                gpu,
+                (&module, "fs_level_depth"),
+                &layout,
+                &[],
+                depth_state.clone(),
+                "older-level depth pass",
+            )?;
             let size = std::mem::size_of::<LodCameraUniform>();
             let camera = uniform_buffer(gpu, size, "lod camera")?;
             let draws = DrawUniforms::new(
@@ -264,6 +274,7 @@ impl LodBufferRenderer {
             Ok(Self {
                 pipeline: with_motion,
                 still_pipeline: still,
+                level_depth_pipeline,
                 camera,
                 camera_layout: view_layout,
                 vis_view,
@@ -324,6 +335,31 @@ impl LodBufferRenderer {
         buffers: &LodBuffers,
         frame: &LodBufferFrame,
     ) -> Result<(u64, u64), GpuError> {
+        self.draw(gpu, buffers, frame, false)
+    }
+
+    /// Draws `frame.items` whole (no visibility pattern; their alpha test kept), depth only,
+    /// into `buffers.level_depth()`: the older-level depth pass, lodkit's default route to the
+    /// older levels' coverage. Give it each t-instance's older level (`TransitionScheduler::older`)
+    /// with this frame's transform and sway. `frame.index` and `frame.clear` are not read.
+    /// Returns the triangles drawn and the fragment count as [`render`](Self::render) does.
+    pub fn render_level_depth(
+        &self,
+        gpu: &GpuContext,
+        buffers: &LodBuffers,
+        frame: &LodBufferFrame,
+    ) -> Result<(u64, u64), GpuError> {
+        self.draw(gpu, buffers, frame, true)
+    }
+
+    /// [`render`](Self::render), or with `level_depth` the older-level depth pass.
+    fn draw(
+        &self,
+        gpu: &GpuContext,
+        buffers: &LodBuffers,
+        frame: &LodBufferFrame,
+        level_depth: bool,
+    ) -> Result<(u64, u64), GpuError> {
         let LodBufferFrame {
             index,
             view,
@@ -371,19 +407,23 @@ impl LodBufferRenderer {
                     DepthConvention::Standard => 1.0,
                     DepthConvention::Reversed => 0.0,
                 };
-                let mut pass = buffers.begin_pass(&mut encoder, index, clear, far, occlusion);
+                let mut pass = match level_depth {
+                    true => buffers.begin_level_depth_pass(&mut encoder, far, occlusion),
+                    false => buffers.begin_pass(&mut encoder, index, clear, far, occlusion),
+                };
                 if let Some(c) = counter {
                     c.begin(&mut pass);
                 }
-                pass.set_pipeline(match buffers.motion() {
-                    Some(_) => &self.pipeline,
-                    None => &self.still_pipeline,
+                pass.set_pipeline(match (level_depth, buffers.motion()) {
+                    (true, _) => &self.level_depth_pipeline,
+                    (false, Some(_)) => &self.pipeline,
+                    (false, None) => &self.still_pipeline,
                 });
                 pass.set_bind_group(0, &self.camera_group, &[]);
                 for (i, item) in items
                     .iter()
                     .enumerate()
-                    .filter(|(_, item)| item.shows_anything())
+                    .filter(|(_, item)| level_depth || item.shows_anything())
                 {
                     pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                     item.mesh.draw(&mut pass);

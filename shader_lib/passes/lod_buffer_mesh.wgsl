@@ -20,6 +20,8 @@
 //   vs_main   @location(0) position, @location(1) normal (object space)
 //   fs_main   LodBufferMotionOutput (location 0 color, location 1 r32uint id word, location 2
 //             rg16float object motion; the depth attachment keeps the depth)
+//   fs_level_depth  the older-level depth pass: the alpha test alone, no color target (the level
+//             drawn whole, depth only, into LodBuffers::level_depth)
 //   sway_offset(p, sway) -> vec3<f32>   helper: the wind sway of the vertex stage
 // An alpha-tested LOD (a billboard impostor) discards what its mask does not cover
 // (lodkit::alpha_mask) before anything is written.
@@ -71,6 +73,8 @@ struct LodDraw {
 @group(1) @binding(0) var<uniform> draw: LodDraw;
 
 struct VertexOut {
+    /// The older-level depth pass (fs_level_depth) runs this same vertex stage, so that it
+    /// covers the pixels the LOD pass (fs_main) covers with the same level.
     @builtin(position) position: vec4<f32>,
     @location(0) normal: vec3<f32>,
     @location(1) object_pos: vec3<f32>,
@@ -116,4 +120,13 @@ fn fs_main(in: VertexOut) -> LodBufferMotionOutput {
     let color = vec4<f32>(draw.color.rgb * (0.35 + 0.65 * lambert), 1.0);
     let motion = lod_buffer_motion(in.then_clip, in.now_clip);
     return lod_buffer_output_motion(color, draw.instance_id, flags, motion);
+}
+
+/// The older-level depth pass: the level whole (no visibility pattern), its alpha test, depth
+/// only.
+@fragment
+fn fs_level_depth(in: VertexOut) {
+    if (!alpha_mask_keep(alpha_mask, in.object_pos, draw.alpha_rect)) {
+        discard;
+    }
 }

@@ -34,6 +34,7 @@ pub struct LodBuffers {
     colors: [wgpu::Texture; 2],
     ids: [wgpu::Texture; 2],
     depths: [wgpu::Texture; 2],
+    level_depth: wgpu::Texture,
     motion: Option<wgpu::Texture>,
 }
 
@@ -67,6 +68,7 @@ impl TextureSet for LodBuffers {
             .iter()
             .chain(&self.ids)
             .chain(&self.depths)
+            .chain([&self.level_depth])
             .chain(&self.motion)
             .collect()
     }
@@ -97,6 +99,7 @@ impl LodBuffers {
                 texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 0")?,
                 texture(LOD_DEPTH_FORMAT, usage, "lod buffer depth 1")?,
             ],
+            level_depth: texture(LOD_DEPTH_FORMAT, usage, "older-level depth pass")?,
             motion: match motion {
                 true => Some(texture(MOTION_FORMAT, usage, "lod buffer object motion")?),
                 false => None,
@@ -107,7 +110,8 @@ impl LodBuffers {
     /// Allocates both buffers at `width` x `height` (a zero side is taken as 1) with color format
     /// `color_format`, a floating-point color format the device can render to, sample and copy,
     /// and the object motion target: 8 bytes per pixel per buffer with an RGBA8 color, 4 more for
-    /// the motion, beyond the two depth attachments.
+    /// the motion, beyond the two depth attachments and the older-level depth pass's
+    /// ([`level_depth`](Self::level_depth)).
     pub fn new(
         gpu: &GpuContext,
         width: u32,
@@ -120,7 +124,7 @@ impl LodBuffers {
     /// [`new`](Self::new) without the object motion target, for scenes where nothing moves by
     /// itself (the camera's motion is the combine's reprojection) or engines that pass motion
     /// vectors of their own to `combine_at_moved`: 8 bytes per pixel per buffer with an RGBA8
-    /// color beyond its depth attachment, nothing else. The reference LOD pass writes no motion
+    /// color beyond its depth attachment, and the older-level depth pass's target. The reference LOD pass writes no motion
     /// into them and the combine pass reads none (a t-instance that moves by itself is read
     /// where it is now).
     pub fn without_motion(
@@ -166,6 +170,17 @@ impl LodBuffers {
         &self.depths[index % 2]
     }
 
+    /// The older-level depth pass's target (`LOD_DEPTH_FORMAT`, the buffers' size): lodkit's
+    /// default route to the older levels' coverage. Each frame of a transition, draw every
+    /// t-instance's older level (`TransitionScheduler::older`) whole, with this frame's camera,
+    /// transform and vertex animation and its alpha test, depth only, into
+    /// [`begin_level_depth_pass`](Self::begin_level_depth_pass) (an engine's depth prepass
+    /// pipeline does it), and pass it as `CombineCoverage::Known::level_depth` with
+    /// [`CombineData::depth_pass`](crate::combine_coverage::CombineData::depth_pass).
+    pub fn level_depth(&self) -> &wgpu::Texture {
+        &self.level_depth
+    }
+
     /// The object motion target (`MOTION_FORMAT`): written by the frame rendered last, read by
     /// its combine; `None` for buffers built [`without_motion`](Self::without_motion).
     pub fn motion(&self) -> Option<&wgpu::Texture> {
@@ -202,6 +217,30 @@ impl LodBuffers {
             far_depth,
             occlusion_query_set,
             "lod buffer",
+        )
+    }
+
+    /// Begins the older-level depth pass: a depth-only render pass into
+    /// [`level_depth`](Self::level_depth), cleared to `far_depth` (1 for standard Z, 0 for
+    /// reversed), with no color target. Draw with the depth test of the LOD pass, the same
+    /// vertex stage (its clip positions are what the combine compares with the LOD pass's
+    /// coverage; where a driver may compute them otherwise in two pipelines, the position's
+    /// `@invariant`, on the targets that take it: not GLSL ES 3.0 or MSL before 2.1) and no
+    /// visibility pattern.
+    pub fn begin_level_depth_pass<'e>(
+        &self,
+        encoder: &'e mut wgpu::CommandEncoder,
+        far_depth: f32,
+        occlusion_query_set: Option<&wgpu::QuerySet>,
+    ) -> wgpu::RenderPass<'e> {
+        let depth = self.level_depth.create_view(&Default::default());
+        begin_targets_pass(
+            encoder,
+            &[],
+            &depth,
+            far_depth,
+            occlusion_query_set,
+            "older-level depth pass",
         )
     }
 }

@@ -311,6 +311,19 @@ pub fn mesh_pipeline(
     depth: wgpu::DepthStencilState,
     label: &str,
 ) -> Result<wgpu::RenderPipeline, GpuError> {
+    mesh_pipeline_entry(gpu, (module, "fs_main"), layout, targets, depth, label)
+}
+
+/// [`mesh_pipeline`] with the fragment stage `entry` of the module (another pass over the same
+/// vertex stage: a depth-only one has no `targets`).
+pub fn mesh_pipeline_entry(
+    gpu: &GpuContext,
+    (module, entry): (&wgpu::ShaderModule, &str),
+    layout: &wgpu::PipelineLayout,
+    targets: &[Option<wgpu::ColorTargetState>],
+    depth: wgpu::DepthStencilState,
+    label: &str,
+) -> Result<wgpu::RenderPipeline, GpuError> {
     gpu.guarded("resources::mesh_pipeline", || {
         Ok(gpu
             .device
@@ -331,7 +344,7 @@ pub fn mesh_pipeline(
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module,
-                    entry_point: Some("fs_main"),
+                    entry_point: Some(entry),
                     compilation_options: Default::default(),
                     targets,
                 }),

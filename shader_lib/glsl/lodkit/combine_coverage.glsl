@@ -264,20 +264,22 @@ lodkit_CombineRead lodkit_combine_read_estimated(vec2 uv, float depth, vec4 base
 #define LODKIT_COMBINE_IS_KNOWN_(g) ((g) != 0u && (lodkit_combine_object(g).flags & LODKIT_COMBINE_KNOWN) != 0u)
 
 /// The read with the older-level depth pass (`level` at the pixel) for a pixel showing `id`:
-/// the level drawn there read where its surface was, else what lies behind `id`'s own level.
+/// the level drawn there (the t-instance the older buffer holds where its depth reprojects, else
+/// `id`'s) read where its surface was, else what lies behind `id`'s own level.
 lodkit_CombineRead lodkit_combine_read_level_depth(float level, uint id, vec2 uv, float depth, vec3 old, vec2 motion) {
     uvec2 size = lodkit_combine_fetch_size();
-    bool covered = lodkit_depth_closer(level, lodkit_combine_far_depth());
+    // A pixel showing no t-instance shows a level only in front of what it shows.
+    bool covered = lodkit_depth_closer(level, id == 0u ? depth : lodkit_combine_far_depth());
     uint owner = id;
-    if (covered && (id == 0u || lodkit_depth_closer(level, depth))) {
+    if (covered) {
         vec2 at = lodkit_reproject(uv, level, lodkit_combine_new_to_old(id)).xy + motion;
         uvec2 read = lodkit_combine_texel(at, size);
         uint g = lodkit_lod_buffer_id(lodkit_combine_fetch_word(read));
         if (LODKIT_COMBINE_IS_KNOWN_(g)) {
             owner = g;
-        } else if (id == 0u) {
+        } else {
             uint o = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_other_texel(0u, read, at)));
-            owner = LODKIT_COMBINE_IS_KNOWN_(o) ? o : 0u;
+            owner = LODKIT_COMBINE_IS_KNOWN_(o) ? o : id;
         }
     }
     if (owner == 0u) {
@@ -286,15 +288,27 @@ lodkit_CombineRead lodkit_combine_read_level_depth(float level, uint id, vec2 uv
     if (covered) {
         mat4 m = lodkit_combine_new_to_old(owner);
         vec4 base = lodkit_reproject_base(uv, m);
-        vec2 at = lodkit_reproject_from_base(base, level, m).xy + motion;
+        vec2 first = lodkit_reproject_from_base(base, level, m).xy;
+        vec2 at = first + motion;
         uvec2 texel = lodkit_combine_texel(at, size);
         if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) != owner) {
             texel = lodkit_combine_cover_texel(owner, texel, base, level, m, motion, LODKIT_COMBINE_BLOCK_REACH);
         }
-        vec4 color = lodkit_combine_fetch_color(texel);
-        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) == owner) {
-            color = lodkit_combine_own_color(owner, at, color);
+        // The pixel's object motion is its newer level's: where the older level's points moved
+        // otherwise (a sway), the level is found where the camera alone puts it.
+        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) != owner) {
+            texel = lodkit_combine_texel(first, size);
+            at = first;
+            if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) != owner) {
+                texel = lodkit_combine_cover_texel(owner, texel, base, level, m, vec2(0.0), LODKIT_COMBINE_BLOCK_REACH);
+            }
         }
+        // No texel of the level near where it was (hidden last frame, or drawn there as an
+        // n-instance on its transition's first frame): the newer color, not what the read holds.
+        if (lodkit_lod_buffer_id(lodkit_combine_fetch_word(texel)) != owner) {
+            return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
+        }
+        vec4 color = lodkit_combine_own_color(owner, at, lodkit_combine_fetch_color(texel));
         return lodkit_CombineRead(texel, color, true);
     }
     vec2 at = old.xy + motion;

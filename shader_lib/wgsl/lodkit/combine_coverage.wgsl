@@ -264,20 +264,22 @@ fn combine_read_estimated(older_color: texture_2d<f32>, older_id: texture_2d<u32
 }
 
 /// The read with the older-level depth pass (`level` at the pixel) for a pixel showing `id`:
-/// the level drawn there read where its surface was, else what lies behind `id`'s own level.
+/// the level drawn there (the t-instance the older buffer holds where its depth reprojects, else
+/// `id`'s) read where its surface was, else what lies behind `id`'s own level.
 fn combine_read_level_depth(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, level: f32, id: u32, uv: vec2<f32>, depth: f32, old: vec3<f32>, motion: vec2<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
-    let covered = depth_closer(level, combine_far_depth());
+    // A pixel showing no t-instance shows a level only in front of what it shows.
+    let covered = depth_closer(level, select(combine_far_depth(), depth, id == 0u));
     var owner = id;
-    if (covered && (id == 0u || depth_closer(level, depth))) {
+    if (covered) {
         let at = reproject(uv, level, combine_new_to_old(data, id)).xy + motion;
         let read = combine_texel(at, size);
         let g = lod_buffer_id(textureLoad(older_id, read, 0).x);
         if (g != 0u && (combine_object(data, g).flags & COMBINE_KNOWN) != 0u) {
             owner = g;
-        } else if (id == 0u) {
+        } else {
             let o = lod_buffer_id(textureLoad(older_id, combine_other_texel(older_id, 0u, read, at), 0).x);
-            owner = select(0u, o, o != 0u && (combine_object(data, o).flags & COMBINE_KNOWN) != 0u);
+            owner = select(id, o, o != 0u && (combine_object(data, o).flags & COMBINE_KNOWN) != 0u);
         }
     }
     if (owner == 0u) {
@@ -286,15 +288,27 @@ fn combine_read_level_depth(older_color: texture_2d<f32>, older_id: texture_2d<u
     if (covered) {
         let m = combine_new_to_old(data, owner);
         let base = reproject_base(uv, m);
-        let at = reproject_from_base(base, level, m).xy + motion;
+        let first = reproject_from_base(base, level, m).xy;
+        var at = first + motion;
         var texel = combine_texel(at, size);
         if (lod_buffer_id(textureLoad(older_id, texel, 0).x) != owner) {
             texel = combine_cover_texel(older_id, older_depth, owner, texel, base, level, m, motion, COMBINE_BLOCK_REACH);
         }
-        var color = textureLoad(older_color, texel, 0);
-        if (lod_buffer_id(textureLoad(older_id, texel, 0).x) == owner) {
-            color = combine_own_color(older_color, older_id, owner, at, color);
+        // The pixel's object motion is its newer level's: where the older level's points moved
+        // otherwise (a sway), the level is found where the camera alone puts it.
+        if (lod_buffer_id(textureLoad(older_id, texel, 0).x) != owner) {
+            texel = combine_texel(first, size);
+            at = first;
+            if (lod_buffer_id(textureLoad(older_id, texel, 0).x) != owner) {
+                texel = combine_cover_texel(older_id, older_depth, owner, texel, base, level, m, vec2<f32>(0.0), COMBINE_BLOCK_REACH);
+            }
         }
+        // No texel of the level near where it was (hidden last frame, or drawn there as an
+        // n-instance on its transition's first frame): the newer color, not what the read holds.
+        if (lod_buffer_id(textureLoad(older_id, texel, 0).x) != owner) {
+            return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
+        }
+        let color = combine_own_color(older_color, older_id, owner, at, textureLoad(older_color, texel, 0));
         return CombineRead(texel, color, true);
     }
     let at = old.xy + motion;

@@ -61,10 +61,13 @@ pub enum CombineRegions<'a> {
 }
 
 /// What a recording knows of where the older levels (those the older buffer holds) cover the
-/// screen. There is no default: lodkit's route is [`Known`](Self::Known) with the data
-/// [`CoverageLevels::data`](crate::combine_coverage::CoverageLevels::data) builds from the levels
-/// registered once per mesh; the estimate is a choice made knowingly, with the schedule it is
-/// made for.
+/// screen. There is no default: lodkit's route is [`Known`](Self::Known) with the older-level
+/// depth pass ([`LodBuffers::level_depth`] and the data
+/// [`CombineData::depth_pass`](crate::combine_coverage::CombineData::depth_pass) lays out), or,
+/// without that pass, the data
+/// [`CoverageLevels::data`](crate::combine_coverage::CoverageLevels::data) builds from the
+/// levels' silhouettes; the estimate is a choice made knowingly, with the schedule it is made
+/// for.
 #[derive(Clone, Copy, Debug)]
 pub enum CombineCoverage<'a> {
     /// Nothing: `lodkit::combine::combine_at_moved` (or `combine_at`) estimates it from last
@@ -77,9 +80,11 @@ pub enum CombineCoverage<'a> {
     Estimated,
     /// `lodkit::combine_coverage::combine_pixel` with this frame's [`CombineData`]: each
     /// t-instance by its route (its older level's silhouette, the older-level depth pass, the
-    /// estimate), as [`CoverageLevels::data`](crate::combine_coverage::CoverageLevels::data)
-    /// lays them out from the older levels' silhouettes under this frame's camera (the default
-    /// route, docs/frame-sequential.md).
+    /// estimate), as [`CombineData::depth_pass`](crate::combine_coverage::CombineData::depth_pass)
+    /// lays them out for the older-level depth pass (the default route,
+    /// docs/frame-sequential.md) or
+    /// [`CoverageLevels::data`](crate::combine_coverage::CoverageLevels::data) from the older
+    /// levels' silhouettes under this frame's camera.
     Known {
         /// The frame's data ([`CombineData::new`]) with its `new_to_old` equal to the
         /// recording's.

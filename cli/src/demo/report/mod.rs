@@ -368,11 +368,14 @@ The last column counts both kinds on every frame of the transition with both cam
 what each LOD alone covers at that frame: see-through / ghost pixel-frames. \
 `frame-seq-default` is frame-sequential LOD with the library's defaults, nothing else chosen: \
 `TransitionScheduler::new()` (the complementary schedule), `CombinePassDescriptor::default()`, \
-the pattern on the screen, each level registered once in `CoverageLevels` (a closed mesh by its \
-surface, an impostor card by its mask's outline) and the frame's data from \
-`CoverageLevels::data` with a default `CoverageFrame` (a scene with a swaying impostor card, \
-which has no exact silhouette, names the estimate for it); `frame-seq-silhouettes` the same \
-route with the paper's Fig. 2 schedule.\n";
+`LodBuffers::new`, the pattern on the screen, and the default route to the older levels' \
+coverage: the t-instances' older levels drawn again each frame, whole and depth only, into \
+`LodBuffers::level_depth` (its fragments and triangles counted in the row), and the frame's data \
+from `CombineData::depth_pass` with a default `DepthPassFrame`; `frame-seq-silhouettes` the same \
+with the route that draws no extra pass: each level registered once in `CoverageLevels` (a closed \
+mesh by its surface, an impostor card by its mask's outline) and the frame's data from \
+`CoverageLevels::data` (a scene with a swaying impostor card, which has no exact silhouette, \
+names the estimate for it).\n";
 
 /// Writes `benchmarks.md` and `quality.md` into `docs`.
 pub fn write_docs(report: &DemoReport, docs: &Path) -> Result<(), DemoError> {
