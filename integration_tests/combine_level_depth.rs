@@ -8,7 +8,10 @@
 //! - where the pixel's object motion (its newer level's) sends the read off the level, the
 //!   level is read where the camera alone puts it;
 //! - where no texel of the level lies near (drawn as an n-instance on its transition's first
-//!   frame), no older read: the newer color, not what the read holds.
+//!   frame), no older read: the newer color, not what the read holds;
+//! - with every t-instance in the depth pass (`COMBINE_ONLY_DEPTH_PASS`), a pixel showing an
+//!   n-instance where the pass drew no level reads nothing older (the estimate would show last
+//!   frame's level of an object whose transition has just ended, where it lay nearer).
 
 use glam::{UVec2, Vec2, Vec4};
 use lodkit::combine::{DepthConvention, LodImage, combine_uv};
@@ -28,6 +31,8 @@ const H: u32 = 6;
 /// Two t-instances whose older levels the depth pass holds.
 const A: u32 = 2;
 const B: u32 = 4;
+/// A t-instance of the older frame whose transition has ended (no record this frame).
+const ENDED: u32 = 6;
 /// Output words per case.
 const OUT: usize = 11;
 
@@ -78,6 +83,15 @@ fn cases() -> Vec<Case> {
             motion: Vec2::ZERO,
             level: 0.5,
         },
+        // An n-instance where the depth pass drew nothing; last frame's texel there holds, a
+        // little nearer, a t-instance whose transition has ended (no record: now an n-instance).
+        Case {
+            px: UVec2::new(6, 2),
+            word: lod_buffer_word(0, 3),
+            depth: 0.7,
+            motion: Vec2::ZERO,
+            level: 1.0,
+        },
     ]
 }
 
@@ -105,6 +119,7 @@ fn older() -> LodImage {
     set(4, 1, B, 0.55);
     set(3, 1, A, 0.5);
     set(2, 4, A, 0.5);
+    set(6, 2, ENDED, 0.69);
     for y in 3..=5 {
         for x in 7..=9 {
             set(x, y, 0, 0.5);
@@ -176,11 +191,12 @@ fn twin_words(older: &LodImage, data: &CombineData) -> Vec<u32> {
 /// The hand-made answers: which older texel each case reads, and what it shows.
 fn check_known(got: &[u32], older: &LodImage, who: &str) {
     let at = |x: u32, y: u32| older.colors[(y * W + x) as usize];
-    let expected: [(Option<UVec2>, Vec4); 4] = [
+    let expected: [(Option<UVec2>, Vec4); 5] = [
         (None, newer_color(0)),
         (Some(UVec2::new(4, 1)), at(4, 1)),
         (Some(UVec2::new(2, 4)), at(2, 4)),
         (None, newer_color(3)),
+        (None, newer_color(4)),
     ];
     for (k, (read, shown)) in expected.iter().enumerate() {
         let w = &got[k * OUT..(k + 1) * OUT];

@@ -62,6 +62,10 @@ pub const COMBINE_ROUTE_DEPTH_PASS: u32 = 8;
 pub const COMBINE_OBJECT_MOTION: u32 = 16;
 /// Frame flag (record 0): [`CombineNewer::level_depth`] holds the older-level depth pass.
 pub const COMBINE_LEVEL_DEPTH: u32 = 32;
+/// Frame flag (record 0): every t-instance the data describes takes the older-level depth pass
+/// ([`CombineData::depth_pass`]), so a pixel showing no t-instance where the pass drew no level
+/// in front reads nothing older: the newer color.
+pub const COMBINE_ONLY_DEPTH_PASS: u32 = 64;
 
 /// The newer buffer's texel at the pixel being combined, as the engine read it (mirror of WGSL
 /// `CombineNewer`).
@@ -434,6 +438,9 @@ pub fn combine_read(
             motion,
             convention,
         );
+    }
+    if frame.flags & COMBINE_ONLY_DEPTH_PASS != 0 {
+        return NOT_FOUND;
     }
     let r = combine_read_silhouettes(older, data, uv, depth, p, convention);
     if r.found {

@@ -6,7 +6,8 @@
 //! record of [`COMBINE_RECORD`] texels at `k * 6`: texels 0..3 the columns of its `new_to_old`
 //! (f32 bits), texel 4 its older level's silhouette table
 //! ([`bin_silhouette`]), texel 5 (flags, older_tau bits, record count, 0). Record 0 is the
-//! frame's: the camera's matrix, [`COMBINE_OBJECT_MOTION`] and [`COMBINE_LEVEL_DEPTH`], and the
+//! frame's: the camera's matrix, [`COMBINE_OBJECT_MOTION`], [`COMBINE_LEVEL_DEPTH`] and
+//! [`COMBINE_ONLY_DEPTH_PASS`], and the
 //! record count; an id between those given has the camera's matrix and no flags. The
 //! silhouettes' rows and segments follow the records.
 
@@ -14,8 +15,8 @@ use glam::Mat4;
 use thiserror::Error;
 
 use super::{
-    COMBINE_ANCHORED, COMBINE_KNOWN, COMBINE_LEVEL_DEPTH, COMBINE_OBJECT_MOTION, COMBINE_RECORD,
-    COMBINE_ROUTE_DEPTH_PASS, COMBINE_ROUTE_SILHOUETTE,
+    COMBINE_ANCHORED, COMBINE_KNOWN, COMBINE_LEVEL_DEPTH, COMBINE_OBJECT_MOTION,
+    COMBINE_ONLY_DEPTH_PASS, COMBINE_RECORD, COMBINE_ROUTE_DEPTH_PASS, COMBINE_ROUTE_SILHOUETTE,
 };
 use crate::silhouette::{Segment, bin_silhouette};
 
@@ -243,6 +244,16 @@ impl CombineData {
             }
             | if desc.level_depth {
                 COMBINE_LEVEL_DEPTH
+            } else {
+                0
+            }
+            | if desc.level_depth
+                && desc
+                    .objects
+                    .iter()
+                    .all(|o| o.route == CoverageRoute::DepthPass)
+            {
+                COMBINE_ONLY_DEPTH_PASS
             } else {
                 0
             };

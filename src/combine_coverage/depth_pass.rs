@@ -198,7 +198,8 @@ mod tests {
     use super::*;
     use crate::combine_coverage::{
         COMBINE_ANCHORED, COMBINE_KNOWN, COMBINE_LEVEL_DEPTH, COMBINE_OBJECT_MOTION,
-        COMBINE_ROUTE_DEPTH_PASS, combine_new_to_old, combine_object,
+        COMBINE_ONLY_DEPTH_PASS, COMBINE_ROUTE_DEPTH_PASS, CombineDataDescriptor,
+        CombineObjectData, CoverageRoute, combine_new_to_old, combine_object,
     };
 
     #[test]
@@ -224,7 +225,8 @@ mod tests {
         };
         let data = CombineData::depth_pass(&frame).unwrap();
         let record = combine_object(&data.texels, 0);
-        assert_eq!(record.flags & COMBINE_LEVEL_DEPTH, COMBINE_LEVEL_DEPTH);
+        let only = COMBINE_LEVEL_DEPTH | COMBINE_ONLY_DEPTH_PASS;
+        assert_eq!(record.flags & only, only);
         assert_eq!(record.flags & COMBINE_OBJECT_MOTION, 0);
         let two = combine_object(&data.texels, 2);
         let route = COMBINE_KNOWN | COMBINE_ROUTE_DEPTH_PASS;
@@ -235,6 +237,27 @@ mod tests {
         assert_eq!(combine_new_to_old(&data.texels, 5), own);
         // An id between them is unknown: the estimate.
         assert_eq!(combine_object(&data.texels, 3).flags, 0);
+        // One object on another route: the pass is read, but not for every t-instance.
+        let mixed = [
+            CombineObjectData {
+                id: 1,
+                route: CoverageRoute::DepthPass,
+                ..Default::default()
+            },
+            CombineObjectData {
+                id: 2,
+                route: CoverageRoute::Estimate,
+                ..Default::default()
+            },
+        ];
+        let data = CombineData::new(&CombineDataDescriptor {
+            level_depth: true,
+            objects: &mixed,
+            ..Default::default()
+        })
+        .unwrap();
+        let flags = combine_object(&data.texels, 0).flags;
+        assert_eq!(flags & only, COMBINE_LEVEL_DEPTH);
         let zero = [OlderDepth::default()];
         let e = CombineData::depth_pass(&DepthPassFrame {
             objects: &zero,

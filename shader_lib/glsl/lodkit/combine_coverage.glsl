@@ -17,7 +17,8 @@
 //   lodkit_CombineObject { new_to_old, silhouette, flags, older_tau }   one id's record
 //   LODKIT_COMBINE_RECORD, LODKIT_COMBINE_KNOWN, LODKIT_COMBINE_ANCHORED,
 //       LODKIT_COMBINE_ROUTE_SILHOUETTE, LODKIT_COMBINE_ROUTE_DEPTH_PASS,
-//       LODKIT_COMBINE_OBJECT_MOTION, LODKIT_COMBINE_LEVEL_DEPTH   the layout's flags
+//       LODKIT_COMBINE_OBJECT_MOTION, LODKIT_COMBINE_LEVEL_DEPTH, LODKIT_COMBINE_ONLY_DEPTH_PASS
+//       the layout's flags
 //   lodkit_combine_object(id) -> lodkit_CombineObject   the record of id (unknown past the records)
 //   lodkit_combine_new_to_old(id) -> mat4   the matrix reprojecting a pixel holding id
 //   lodkit_combine_far_depth() -> float   the far clip depth (an older-level depth pass's clear)
@@ -114,6 +115,8 @@ const uint LODKIT_COMBINE_ROUTE_DEPTH_PASS = 8u;
 const uint LODKIT_COMBINE_OBJECT_MOTION = 16u;
 /// Frame flag (record 0): lodkit_CombineNewer.level_depth holds the older-level depth pass.
 const uint LODKIT_COMBINE_LEVEL_DEPTH = 32u;
+/// Frame flag (record 0): every t-instance the data describes takes the older-level depth pass.
+const uint LODKIT_COMBINE_ONLY_DEPTH_PASS = 64u;
 
 /// The record of `id` in the data texture; past the records, the frame's matrix and no flags.
 lodkit_CombineObject lodkit_combine_object(uint id) {
@@ -468,6 +471,10 @@ lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, v
         lodkit_CombineObject frame = lodkit_combine_object(0u);
         if ((frame.flags & LODKIT_COMBINE_LEVEL_DEPTH) != 0u && lodkit_depth_closer(newer.level_depth, lodkit_combine_far_depth())) {
             return lodkit_combine_read_level_depth(newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
+        }
+        // Every t-instance's older level is in the depth pass, and none lies in front here.
+        if ((frame.flags & LODKIT_COMBINE_ONLY_DEPTH_PASS) != 0u) {
+            return lodkit_CombineRead(uvec2(0u), vec4(0.0), false);
         }
     }
     // Another t-instance's older level whose silhouette covers the pixel; else, behind a level,

@@ -9,7 +9,8 @@
 // unlike a storage buffer) holds per id a record of COMBINE_RECORD texels at id * 6: the columns
 // of its new_to_old (f32 bits), its silhouette table (lodkit::silhouette::silhouette_covers),
 // then (flags, older_tau bits, record count, 0); record 0 is the frame's (the camera's matrix,
-// COMBINE_OBJECT_MOTION, COMBINE_LEVEL_DEPTH, the record count); the binned silhouettes follow.
+// COMBINE_OBJECT_MOTION, COMBINE_LEVEL_DEPTH, COMBINE_ONLY_DEPTH_PASS, the record count); the
+// binned silhouettes follow.
 //
 // Exports:
 //   CombineNewer { color, word, depth, motion, pattern, level_depth }   the pixel's newer texel
@@ -17,7 +18,8 @@
 //       depth pass there
 //   CombineObject { new_to_old, silhouette, flags, older_tau }   one id's record
 //   COMBINE_RECORD, COMBINE_KNOWN, COMBINE_ANCHORED, COMBINE_ROUTE_SILHOUETTE,
-//       COMBINE_ROUTE_DEPTH_PASS, COMBINE_OBJECT_MOTION, COMBINE_LEVEL_DEPTH   the layout's flags
+//       COMBINE_ROUTE_DEPTH_PASS, COMBINE_OBJECT_MOTION, COMBINE_LEVEL_DEPTH,
+//       COMBINE_ONLY_DEPTH_PASS   the layout's flags
 //   combine_object(data, id) -> CombineObject   the record of id (unknown past the records)
 //   combine_new_to_old(data, id) -> mat4x4<f32>   the matrix reprojecting a pixel holding id
 //   combine_far_depth() -> f32   the far clip depth (an older-level depth pass's clear)
@@ -113,6 +115,8 @@ const COMBINE_ROUTE_DEPTH_PASS: u32 = 8u;
 const COMBINE_OBJECT_MOTION: u32 = 16u;
 /// Frame flag (record 0): CombineNewer.level_depth holds the older-level depth pass.
 const COMBINE_LEVEL_DEPTH: u32 = 32u;
+/// Frame flag (record 0): every t-instance the data describes takes the older-level depth pass.
+const COMBINE_ONLY_DEPTH_PASS: u32 = 64u;
 
 /// The record of `id` in the data texture; past the records, the frame's matrix and no flags.
 fn combine_object(data: texture_2d<u32>, id: u32) -> CombineObject {
@@ -464,6 +468,10 @@ fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_d
         let frame = combine_object(data, 0u);
         if ((frame.flags & COMBINE_LEVEL_DEPTH) != 0u && depth_closer(newer.level_depth, combine_far_depth())) {
             return combine_read_level_depth(older_color, older_id, older_depth, data, newer.level_depth, 0u, uv, newer.depth, old, newer.motion);
+        }
+        // Every t-instance's older level is in the depth pass, and none lies in front here.
+        if ((frame.flags & COMBINE_ONLY_DEPTH_PASS) != 0u) {
+            return CombineRead(vec2<u32>(0u), vec4<f32>(0.0), false);
         }
     }
     // Another t-instance's older level whose silhouette covers the pixel; else, behind a level,
