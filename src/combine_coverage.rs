@@ -7,8 +7,9 @@
 //! older-level depth pass the host draws, or the estimate from last frame's picture alone (the
 //! paper's). A pass drawn over the levels' silhouettes
 //! ([`silhouette_hull`](crate::silhouette::silhouette_hull)) calls the shader's `combine_pixel`
-//! at each of its pixels. The host builds the frame's data from levels registered once per mesh
-//! ([`CoverageLevels`]): the route lodkit takes by default.
+//! at each of its pixels. The host builds the frame's data for the older-level depth pass
+//! ([`CombineData::depth_pass`], lodkit's default route), or from levels registered once per mesh
+//! ([`CoverageLevels`]: their silhouettes, with no extra pass).
 
 use glam::{Mat4, UVec2, UVec4, Vec2, Vec3, Vec4};
 
@@ -63,8 +64,10 @@ pub const COMBINE_OBJECT_MOTION: u32 = 16;
 /// Frame flag (record 0): [`CombineNewer::level_depth`] holds the older-level depth pass.
 pub const COMBINE_LEVEL_DEPTH: u32 = 32;
 /// Frame flag (record 0): every t-instance the data describes takes the older-level depth pass
-/// ([`CombineData::depth_pass`]), so a pixel showing no t-instance where the pass drew no level
-/// in front reads nothing older: the newer color.
+/// (set by [`CombineData::new`] when the descriptor reads the pass and its objects, at least
+/// one, all take it, as [`CombineData::depth_pass`]'s do), so a pixel showing no t-instance
+/// where the pass drew no level in front reads nothing older: the newer color. A t-instance left
+/// out of the data is then not estimated at such pixels.
 pub const COMBINE_ONLY_DEPTH_PASS: u32 = 64;
 
 /// The newer buffer's texel at the pixel being combined, as the engine read it (mirror of WGSL
@@ -344,8 +347,9 @@ pub fn combine_read_silhouettes(
 /// does not cover the pixel, what lies behind the level: another level whose silhouette covers it
 /// ([`combine_read_silhouettes`]), else [`combine_behind_texel`] under the camera's
 /// reprojection alone, the frame's matrix and no motion: what lies behind a level does not move
-/// with it); for a pixel showing none, a level the depth pass drew there, else a level whose
-/// silhouette covers it, else the estimate.
+/// with it); for a pixel showing none, a level the depth pass drew there in front of it, else
+/// nothing where every t-instance takes the depth pass ([`COMBINE_ONLY_DEPTH_PASS`]), else a
+/// level whose silhouette covers it, else the estimate.
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]

@@ -514,7 +514,7 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             }
         }
         // See-through and ghosts, counted on every frame of the transition with both cameras:
-        // the combine that knows the older levels' silhouettes leaves a few pixel-frames (here,
+        // the combine that knows the older levels' coverage leaves a few pixel-frames (here,
         // 96x64 and 8 frames, 0-2 per scene and schedule; the estimate 18-85), each fewer than
         // the estimate with the same schedule. Limit: 3 above the measured. The default route,
         // the older-level depth pass, knows what the rasterizer covers and how deep: none.
@@ -530,10 +530,10 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             ("frame-seq-complementary", "frame-seq-default"),
         ] {
             let wrong = |r: &TransitionMetrics| r.see_through_pixel_frames + r.ghost_pixel_frames;
-            let (estimated, known) = (wrong(row(estimated)), wrong(row(known)));
+            let (estimated, count) = (wrong(row(estimated)), wrong(row(known)));
             assert!(
-                known <= 5 && known < estimated,
-                "in {}: see-through and ghosts {known} pixel-frames with the silhouettes, {estimated} estimated",
+                count <= 5 && count < estimated,
+                "in {}: see-through and ghosts {count} pixel-frames with {known}, {estimated} estimated",
                 scene.name
             );
         }

@@ -299,7 +299,7 @@ fn paper_schedule_on_the_object_shows_no_background() {
 
 /// Coverage from the older-level depth pass (`OlderCoverage::DepthPass`, for levels with no
 /// silhouette): no ghost, no background, less flicker than Bevy's crossfade, in both apps.
-/// Measured: ghosts 0 and 0; flicker 1.910 / 5.129 without the prepass, 1.924 / 5.163 with it
+/// Measured: ghosts 0 and 0; flicker 1.910 / 5.104 without the prepass, 1.923 / 5.137 with it
 /// (held to 1.95 / 5.22; the nearest older texel measures 1.92 / 5.27). The pass's samples,
 /// which lavapipe counts as fragment invocations, are in the total: 2.08 M, so frame-sequential
 /// LOD then costs 1.15x Bevy's crossfade without a prepass and 0.91x with one; shaded (prepass,

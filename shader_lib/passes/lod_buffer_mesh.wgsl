@@ -74,7 +74,9 @@ struct LodDraw {
 
 struct VertexOut {
     /// The older-level depth pass (fs_level_depth) runs this same vertex stage, so that it
-    /// covers the pixels the LOD pass (fs_main) covers with the same level.
+    /// covers the pixels the LOD pass (fs_main) covers with the same level. Not `@invariant`:
+    /// GLSL ES 3.0 (WebGL2) and MSL before 2.1 refuse it on this pass's targets; the same
+    /// module and entry point in both pipelines is what the reference relies on.
     @builtin(position) position: vec4<f32>,
     @location(0) normal: vec3<f32>,
     @location(1) object_pos: vec3<f32>,

@@ -77,7 +77,10 @@ pub struct CombineDataDescriptor<'a> {
     /// Whether each pixel's object motion is given (a LOD pass's motion target, an engine's
     /// motion vectors); otherwise t-instances are reprojected with their own matrices.
     pub object_motion: bool,
-    /// Whether the older-level depth pass is read.
+    /// Whether the older-level depth pass is read. With it, and objects that all take it, the
+    /// frame is flagged [`COMBINE_ONLY_DEPTH_PASS`]: a pixel showing no t-instance where the
+    /// pass drew no level in front reads nothing older (a t-instance left out of `objects` is
+    /// then not estimated there).
     pub level_depth: bool,
     /// The target's height in pixels (silhouettes are binned by its rows).
     pub height: u32,
@@ -248,6 +251,7 @@ impl CombineData {
                 0
             }
             | if desc.level_depth
+                && !desc.objects.is_empty()
                 && desc
                     .objects
                     .iter()

@@ -77,9 +77,10 @@ impl CombineData {
     /// ```
     /// # use lodkit::combine_coverage::*;
     /// let objects = [OlderDepth { id: 4, older_tau: Some(0.25), ..Default::default() }];
-    /// let data = CombineData::depth_pass(&DepthPassFrame { objects: &objects, ..Default::default() })
-    ///     .unwrap();
-    /// assert_eq!(combine_object(&data.texels, 0).flags & COMBINE_LEVEL_DEPTH, COMBINE_LEVEL_DEPTH);
+    /// let frame = DepthPassFrame { objects: &objects, ..Default::default() };
+    /// let data = CombineData::depth_pass(&frame).unwrap();
+    /// let flags = combine_object(&data.texels, 0).flags;
+    /// assert_eq!(flags & COMBINE_LEVEL_DEPTH, COMBINE_LEVEL_DEPTH);
     /// let o = combine_object(&data.texels, 4);
     /// assert_eq!(o.flags, COMBINE_KNOWN | COMBINE_ANCHORED | COMBINE_ROUTE_DEPTH_PASS);
     /// ```
@@ -108,11 +109,10 @@ impl CombineData {
 /// none): for a pixel showing `id` (0: none), its newer `depth`, the reprojection `old` of that
 /// depth and the object `motion`. A pixel showing no t-instance takes a level only where it lies
 /// in front of what the pixel shows. Where a level is drawn, its owner is the t-instance the older
-/// buffer holds where that level's depth reprojects (at the texel there, else the nearest of
-/// the 3x3 block holding an object), in front of the pixel's own level or behind it (the depth
-/// pass holds the nearest older level, which may be another t-instance's), else the pixel's
-/// own; read where its own surface was. Where none is, what lies behind the pixel's own older
-/// level.
+/// buffer holds where that level's depth reprojects, in front of the pixel's own level or behind
+/// it (the depth pass holds the nearest older level, which may be another t-instance's), or
+/// the nearest t-instance of the 3x3 block around that read, else the pixel's own; read where
+/// its own surface was, and where none of its texels lies near, nothing (the newer color). Where none is, what lies behind the pixel's own older level.
 ///
 /// Its parameters mirror the shader function's, one for one (hence more than seven).
 #[allow(clippy::too_many_arguments)]
@@ -144,6 +144,8 @@ pub fn combine_read_level_depth(
         if known(id_at(older, read)) {
             owner = id_at(older, read);
         } else {
+            // The read, made with the pixel's own matrix and motion, may miss another
+            // t-instance's level the pass holds: the nearest t-instance of the 3x3 block.
             let t = combine_other_texel(older, 0, read, read_at);
             if known(id_at(older, t)) {
                 owner = id_at(older, t);
@@ -257,6 +259,10 @@ mod tests {
         })
         .unwrap();
         let flags = combine_object(&data.texels, 0).flags;
+        assert_eq!(flags & only, COMBINE_LEVEL_DEPTH);
+        // No object: nothing to say of every t-instance.
+        let none = CombineData::depth_pass(&DepthPassFrame::default()).unwrap();
+        let flags = combine_object(&none.texels, 0).flags;
         assert_eq!(flags & only, COMBINE_LEVEL_DEPTH);
         let zero = [OlderDepth::default()];
         let e = CombineData::depth_pass(&DepthPassFrame {

@@ -124,9 +124,9 @@ impl LodBuffers {
     /// [`new`](Self::new) without the object motion target, for scenes where nothing moves by
     /// itself (the camera's motion is the combine's reprojection) or engines that pass motion
     /// vectors of their own to `combine_at_moved`: 8 bytes per pixel per buffer with an RGBA8
-    /// color beyond its depth attachment, and the older-level depth pass's target. The reference LOD pass writes no motion
-    /// into them and the combine pass reads none (a t-instance that moves by itself is read
-    /// where it is now).
+    /// color beyond its depth attachment, and the older-level depth pass's target. The reference
+    /// LOD pass writes no motion into them and the combine pass reads none (a t-instance that
+    /// moves by itself is read where it is now).
     pub fn without_motion(
         gpu: &GpuContext,
         width: u32,

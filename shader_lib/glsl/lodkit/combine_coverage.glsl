@@ -268,7 +268,9 @@ lodkit_CombineRead lodkit_combine_read_estimated(vec2 uv, float depth, vec4 base
 
 /// The read with the older-level depth pass (`level` at the pixel) for a pixel showing `id`:
 /// the level drawn there (the t-instance the older buffer holds where its depth reprojects, else
-/// `id`'s) read where its surface was, else what lies behind `id`'s own level.
+/// `id`'s; for a pixel showing none, only in front of what it shows) read where its surface was
+/// (nothing, the newer color, where none of its texels lies near), else what lies behind `id`'s
+/// own level.
 lodkit_CombineRead lodkit_combine_read_level_depth(float level, uint id, vec2 uv, float depth, vec3 old, vec2 motion) {
     uvec2 size = lodkit_combine_fetch_size();
     // A pixel showing no t-instance shows a level only in front of what it shows.
@@ -281,6 +283,7 @@ lodkit_CombineRead lodkit_combine_read_level_depth(float level, uint id, vec2 uv
         if (LODKIT_COMBINE_IS_KNOWN_(g)) {
             owner = g;
         } else {
+            // The read may miss another t-instance's level: the nearest one of the 3x3 block.
             uint o = lodkit_lod_buffer_id(lodkit_combine_fetch_word(lodkit_combine_other_texel(0u, read, at)));
             owner = LODKIT_COMBINE_IS_KNOWN_(o) ? o : id;
         }
@@ -434,8 +437,9 @@ lodkit_CombineRead lodkit_combine_read_silhouettes(vec2 uv, float depth, vec2 p)
 /// finds another object there that lodkit_combine_may_cover, else the level's own; where it does
 /// not cover the pixel, what lies behind the level: another level whose silhouette covers it, else
 /// lodkit_combine_behind_texel under the camera's reprojection alone, the frame's matrix and no
-/// motion: what lies behind a level does not move with it); else the depth pass's level, a
-/// covering silhouette, the estimate.
+/// motion: what lies behind a level does not move with it); else the depth pass's level in front
+/// of what the pixel shows, nothing where every t-instance takes the depth pass
+/// (LODKIT_COMBINE_ONLY_DEPTH_PASS), a covering silhouette, the estimate.
 lodkit_CombineRead lodkit_combine_read(lodkit_CombineNewer newer, uvec2 pixel, vec4 base, vec3 old, mat4 m) {
     uvec2 size = lodkit_combine_fetch_size();
     uint id = lodkit_lod_buffer_id(newer.word);

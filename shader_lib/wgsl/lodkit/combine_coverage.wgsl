@@ -269,7 +269,9 @@ fn combine_read_estimated(older_color: texture_2d<f32>, older_id: texture_2d<u32
 
 /// The read with the older-level depth pass (`level` at the pixel) for a pixel showing `id`:
 /// the level drawn there (the t-instance the older buffer holds where its depth reprojects, else
-/// `id`'s) read where its surface was, else what lies behind `id`'s own level.
+/// `id`'s; for a pixel showing none, only in front of what it shows) read where its surface was
+/// (nothing, the newer color, where none of its texels lies near), else what lies behind `id`'s
+/// own level.
 fn combine_read_level_depth(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, level: f32, id: u32, uv: vec2<f32>, depth: f32, old: vec3<f32>, motion: vec2<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     // A pixel showing no t-instance shows a level only in front of what it shows.
@@ -282,6 +284,7 @@ fn combine_read_level_depth(older_color: texture_2d<f32>, older_id: texture_2d<u
         if (g != 0u && (combine_object(data, g).flags & COMBINE_KNOWN) != 0u) {
             owner = g;
         } else {
+            // The read may miss another t-instance's level: the nearest one of the 3x3 block.
             let o = lod_buffer_id(textureLoad(older_id, combine_other_texel(older_id, 0u, read, at), 0).x);
             owner = select(id, o, o != 0u && (combine_object(data, o).flags & COMBINE_KNOWN) != 0u);
         }
@@ -433,8 +436,9 @@ fn combine_read_silhouettes(older_color: texture_2d<f32>, older_id: texture_2d<u
 /// object there that combine_may_cover, else the level's own; where it does not cover the
 /// pixel, what lies behind the level: another level whose silhouette covers it, else
 /// combine_behind_texel under the camera's reprojection alone, the frame's matrix and no motion:
-/// what lies behind a level does not move with it); else the depth pass's level, a covering
-/// silhouette, the estimate.
+/// what lies behind a level does not move with it); else the depth pass's level in front of what
+/// the pixel shows, nothing where every t-instance takes the depth pass (COMBINE_ONLY_DEPTH_PASS),
+/// a covering silhouette, the estimate.
 fn combine_read(older_color: texture_2d<f32>, older_id: texture_2d<u32>, older_depth: texture_2d<f32>, data: texture_2d<u32>, newer: CombineNewer, pixel: vec2<u32>, base: vec4<f32>, old: vec3<f32>, m: mat4x4<f32>) -> CombineRead {
     let size = textureDimensions(older_color, 0);
     let id = lod_buffer_id(newer.word);
