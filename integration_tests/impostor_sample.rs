@@ -102,6 +102,7 @@ layout(set = 0, binding = 4) uniform sampler atlas_sampler;
 #include \"lodkit/impostor.glsl\"
 vec4 lodkit_impostor_fetch_color(vec2 uv, float level) { return textureLod(sampler2D(color_atlas, atlas_sampler), uv, level); }
 vec4 lodkit_impostor_fetch_normal_depth(vec2 uv, float level) { return textureLod(sampler2D(normal_atlas, atlas_sampler), uv, level); }
+uint lodkit_impostor_atlas_texels() { return uint(textureSize(sampler2D(color_atlas, atlas_sampler), 0).x); }
 void main() {
     uint i = gl_WorkGroupID.x;
     vec4 o = rays[2u * i];

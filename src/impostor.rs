@@ -287,6 +287,21 @@ pub fn impostor_atlas_uv(frame: UVec2, n: u32, uv: Vec2) -> Vec2 {
     (frame.as_vec2() + uv.clamp(Vec2::ZERO, Vec2::ONE)) / n as f32
 }
 
+/// How far inside its frame (frame uv) a sample at mip `level` of an atlas whose frames are
+/// `texels` texels wide stays: half a texel of the coarsest mip trilinear filtering reads there
+/// (`2^ceil(level)` texels of mip 0), so bilinear filtering takes no texel of a neighbouring
+/// frame; at most 0.5, the frame's centre.
+///
+/// ```
+/// # use lodkit::impostor::impostor_frame_inset;
+/// assert_eq!(impostor_frame_inset(64.0, 0.0), 0.5 / 64.0);
+/// assert_eq!(impostor_frame_inset(64.0, 2.3), 4.0 / 64.0); // mips 2 and 3: a texel of mip 3
+/// assert_eq!(impostor_frame_inset(4.0, 5.0), 0.5);
+/// ```
+pub fn impostor_frame_inset(texels: f32, level: f32) -> f32 {
+    (0.5 * level.max(0.0).ceil().exp2() / texels).min(0.5)
+}
+
 /// The height `[-1, 1]` above a frame's plane of a stored depth in `[0, 1]`.
 pub fn impostor_depth_height(depth: f32) -> f32 {
     depth * 2.0 - 1.0

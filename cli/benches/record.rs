@@ -1,5 +1,5 @@
-//! Host time of one recording: lodkit's `CombinePass::record` (known coverage: the frame's
-//! `CombineData` uploaded with it), `UpsamplePass::record` and `GpuLodSelector::record`, each
+//! Host time of one recording: lodkit's `CombinePass::record` (its default route: the frame's
+//! `CombineData::depth_pass` uploaded with it, the older-level depth pass bound), `UpsamplePass::record` and `GpuLodSelector::record`, each
 //! against a plain wgpu pass an engine writes by hand around lodkit's pass shader, with the same
 //! bindings and the same uploads (its parameters with `queue.write_buffer`, the combine's data
 //! with `queue.write_texture`, its bind group made once), drawing the same full-screen triangle
@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 
 use criterion::Criterion;
 use glam::Mat4;
-use lodkit::combine_coverage::{CombineData, CombineDataDescriptor, CombineObjectData};
+use lodkit::combine_coverage::{CombineData, DepthPassFrame, OlderDepth};
 use lodkit::gpu::GpuContext;
 use lodkit::gpu::frame_sequential::{
     CombineCoverage, CombineFrame, CombinePass, CombinePassDescriptor, CombineRegions, LodBuffers,
@@ -186,17 +186,16 @@ fn combine(c: &mut Criterion, gpu: &GpuContext) -> String {
     .expect("the combine");
     let out = target(gpu, "combine target");
     let view = out.create_view(&Default::default());
-    // One object in transition, its older level's coverage estimated: one row of data texels.
+    // One object in transition on the default route, the older-level depth pass: one row of
+    // data texels.
     let m = Mat4::IDENTITY;
-    let objects = [CombineObjectData {
+    let objects = [OlderDepth {
         id: 1,
-        new_to_old: m,
+        new_to_old: None,
         older_tau: None,
-        route: Default::default(),
     }];
-    let data = CombineData::new(&CombineDataDescriptor {
+    let data = CombineData::depth_pass(&DepthPassFrame {
         new_to_old: m,
-        height: H,
         objects: &objects,
         ..Default::default()
     })
@@ -209,7 +208,7 @@ fn combine(c: &mut Criterion, gpu: &GpuContext) -> String {
         regions: CombineRegions::Everywhere,
         coverage: CombineCoverage::Known {
             data: &data,
-            level_depth: None,
+            level_depth: Some(buffers.level_depth()),
             pattern: None,
         },
     };
@@ -230,14 +229,6 @@ fn combine(c: &mut Criterion, gpu: &GpuContext) -> String {
         "plain data",
     )
     .expect("a data texture");
-    let depth = texture_2d(
-        gpu,
-        (W, H),
-        wgpu::TextureFormat::Depth32Float,
-        wgpu::TextureUsages::TEXTURE_BINDING,
-        "plain level depth",
-    )
-    .expect("a depth texture");
     let params = uniform_buffer(gpu, 64, "plain params").expect("a uniform");
     let motion = buffers.motion().expect("a motion target");
     let bind = [
@@ -250,7 +241,7 @@ fn combine(c: &mut Criterion, gpu: &GpuContext) -> String {
         Bound::Texture(motion),
         Bound::Buffer(&params),
         Bound::Texture(&data_texture),
-        Bound::Texture(&depth),
+        Bound::Texture(buffers.level_depth()),
         Bound::Texture(motion),
     ];
     let plain = Plain::new(gpu, ("combine", &["LODKIT_COMBINE_KNOWN"]), &entries, &bind);

@@ -6,7 +6,8 @@ use glam::{UVec2, Vec3, Vec4};
 
 use super::{
     ImpostorAtlas, ImpostorImage, impostor_atlas_uv, impostor_blend, impostor_depth_height,
-    impostor_frame_basis, impostor_frame_dir, impostor_frame_uv, impostor_ray_at_height,
+    impostor_frame_basis, impostor_frame_dir, impostor_frame_inset, impostor_frame_uv,
+    impostor_ray_at_height,
 };
 
 /// What one impostor fragment sees.
@@ -58,7 +59,8 @@ pub fn impostor_sample_level(images: &[ImpostorImage], uv: glam::Vec2, level: f3
 
 /// One frame's look along the ray `origin + t ray` (normalized object space): where the ray
 /// meets its plane, that texel's depth, and the colour, normal and point at the height that
-/// depth gives (one parallax step). Outside the frame's square the coverage is 0.
+/// depth gives (one parallax step), read inside the frame's inset ([`impostor_frame_inset`]).
+/// Outside the frame's square the coverage is 0.
 pub fn impostor_sample_frame(
     atlas: &ImpostorAtlas,
     frame: UVec2,
@@ -69,12 +71,20 @@ pub fn impostor_sample_frame(
     let n = atlas.layout.frames;
     let dir = impostor_frame_dir(frame, n, atlas.layout.shape.is_hemi());
     let basis = impostor_frame_basis(dir);
+    let texels = atlas.color.first().map_or(0.0, |i| i.size as f32) / n as f32;
+    let inset = impostor_frame_inset(texels, level);
+    let inside =
+        |uv: glam::Vec2| uv.clamp(glam::Vec2::splat(inset), glam::Vec2::splat(1.0 - inset));
     let uv0 = impostor_frame_uv(&basis, impostor_ray_at_height(origin, ray, dir, 0.0));
-    let depth0 =
-        impostor_sample_level(&atlas.normal_depth, impostor_atlas_uv(frame, n, uv0), level).w;
+    let depth0 = impostor_sample_level(
+        &atlas.normal_depth,
+        impostor_atlas_uv(frame, n, inside(uv0)),
+        level,
+    )
+    .w;
     let point = impostor_ray_at_height(origin, ray, dir, impostor_depth_height(depth0));
     let uv = impostor_frame_uv(&basis, point);
-    let at = impostor_atlas_uv(frame, n, uv);
+    let at = impostor_atlas_uv(frame, n, inside(uv));
     let mut color = impostor_sample_level(&atlas.color, at, level);
     if uv != uv.clamp(glam::Vec2::ZERO, glam::Vec2::ONE) {
         color.w = 0.0;

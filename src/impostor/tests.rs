@@ -251,3 +251,25 @@ fn a_chain_ends_in_its_impostor() {
     assert_eq!(group.levels().last().unwrap().mesh, "impostor");
     assert_eq!(group.max_distance(), chain.max_distance(&camera).ok());
 }
+
+#[test]
+fn a_sample_near_a_frame_edge_takes_nothing_of_the_next_frame() {
+    // Frames of one colour each (red = column): a look at frame (1, 1) of a 3 x 3 atlas, 4 texels
+    // a frame, straight along its direction, at frame uv (0.95, 0.5). At mip 1 (2 texels a frame)
+    // bilinear filtering there reaches 0.4 into frame (2, 1) unless the read stays half a texel
+    // of that mip inside the frame (impostor_frame_inset): red 1.4 without it.
+    let atlas = flat_atlas(3, ImpostorShape::Full);
+    let frame = UVec2::new(1, 1);
+    let dir = impostor_frame_dir(frame, 3, false);
+    let basis = impostor_frame_basis(dir);
+    let (u, v) = (0.95, 0.5);
+    let q = basis.x_axis * (2.0 * u - 1.0) - basis.y_axis * (2.0 * v - 1.0);
+    for level in [0.0, 0.5, 1.0, 1.7] {
+        let s = impostor_sample_frame(&atlas, frame, q + dir * 3.0, -dir, level);
+        assert!(
+            (s.color.truncate() - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-5,
+            "level {level}: {:?}",
+            s.color
+        );
+    }
+}

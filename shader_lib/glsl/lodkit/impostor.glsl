@@ -19,6 +19,7 @@
 //   lodkit_impostor_ray_at_height(origin, ray, dir, height) -> vec3
 //   lodkit_impostor_frame_uv(basis, q) -> vec2
 //   lodkit_impostor_atlas_uv(frame, n, uv) -> vec2
+//   lodkit_impostor_frame_inset(texels, level) -> float
 //   lodkit_impostor_depth_height(depth) -> float
 //   lodkit_ImpostorSample { color: vec4, normal: vec3, point: vec3 }
 //   lodkit_impostor_sample_frame(frame, n, hemi, origin, ray, level) -> lodkit_ImpostorSample
@@ -29,6 +30,7 @@
 // are compiled only where LODKIT_IMPOSTOR_HOOKS is defined before the include):
 //   vec4 lodkit_impostor_fetch_color(vec2 uv, float level)   the colour atlas (linear, clamp)
 //   vec4 lodkit_impostor_fetch_normal_depth(vec2 uv, float level)   the normal-depth atlas
+//   uint lodkit_impostor_atlas_texels()   the atlases' side in texels at mip 0
 // Shader defs: none.
 #ifndef LODKIT_IMPOSTOR_GLSL
 #define LODKIT_IMPOSTOR_GLSL
@@ -147,6 +149,13 @@ vec2 lodkit_impostor_atlas_uv(uvec2 frame, uint n, vec2 uv) {
     return (vec2(frame) + clamp(uv, vec2(0.0), vec2(1.0))) / float(n);
 }
 
+/// How far inside its frame (frame uv) a sample at mip `level` of an atlas whose frames are
+/// `texels` texels wide stays: half a texel of the coarsest mip trilinear filtering reads there
+/// (at most 0.5, the frame's centre).
+float lodkit_impostor_frame_inset(float texels, float level) {
+    return min(0.5 * exp2(ceil(max(level, 0.0))) / texels, 0.5);
+}
+
 /// The height [-1, 1] above a frame's plane of a stored depth in [0, 1].
 float lodkit_impostor_depth_height(float depth) {
     return depth * 2.0 - 1.0;
@@ -164,16 +173,22 @@ struct lodkit_ImpostorSample {
 vec4 lodkit_impostor_fetch_color(vec2 uv, float level);
 /// Hook: the normal-depth atlas at `uv`, mip `level`.
 vec4 lodkit_impostor_fetch_normal_depth(vec2 uv, float level);
+/// Hook: the atlases' side in texels at mip 0.
+uint lodkit_impostor_atlas_texels();
 
-/// One frame's look along the ray (one parallax step); coverage 0 outside the frame's square.
+/// One frame's look along the ray (one parallax step), read inside the frame's inset
+/// (lodkit_impostor_frame_inset); coverage 0 outside the frame's square.
 lodkit_ImpostorSample lodkit_impostor_sample_frame(uvec2 frame, uint n, bool hemi, vec3 origin, vec3 ray, float level) {
     vec3 dir = lodkit_impostor_frame_dir(frame, n, hemi);
     mat3 basis = lodkit_impostor_frame_basis(dir);
+    float inset = lodkit_impostor_frame_inset(float(lodkit_impostor_atlas_texels()) / float(n), level);
+    vec2 lo = vec2(inset);
+    vec2 hi = vec2(1.0 - inset);
     vec2 uv0 = lodkit_impostor_frame_uv(basis, lodkit_impostor_ray_at_height(origin, ray, dir, 0.0));
-    float depth0 = lodkit_impostor_fetch_normal_depth(lodkit_impostor_atlas_uv(frame, n, uv0), level).w;
+    float depth0 = lodkit_impostor_fetch_normal_depth(lodkit_impostor_atlas_uv(frame, n, clamp(uv0, lo, hi)), level).w;
     vec3 point = lodkit_impostor_ray_at_height(origin, ray, dir, lodkit_impostor_depth_height(depth0));
     vec2 uv = lodkit_impostor_frame_uv(basis, point);
-    vec2 atlas = lodkit_impostor_atlas_uv(frame, n, uv);
+    vec2 atlas = lodkit_impostor_atlas_uv(frame, n, clamp(uv, lo, hi));
     vec4 color = lodkit_impostor_fetch_color(atlas, level);
     if (any(notEqual(uv, clamp(uv, vec2(0.0), vec2(1.0))))) {
         color.w = 0.0;

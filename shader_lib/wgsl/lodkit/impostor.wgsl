@@ -27,6 +27,8 @@
 //       origin + t ray where dot(q, dir) = height
 //   impostor_frame_uv(basis, q) -> vec2<f32>   uv of point q in the frame of `basis`
 //   impostor_atlas_uv(frame, n, uv) -> vec2<f32>   atlas uv of frame uv (clamped into the frame)
+//   impostor_frame_inset(texels, level) -> f32   how far inside its frame a sample at mip level
+//       stays (half a texel of the coarsest mip it reads), so no neighbouring frame bleeds in
 //   impostor_depth_height(depth) -> f32   stored depth [0, 1] back to height [-1, 1]
 //   ImpostorSample { color: vec4<f32>, normal: vec3<f32>, point: vec3<f32> }
 //   impostor_sample_frame(color_atlas, normal_atlas, samp, frame, n, hemi, origin, ray, level)
@@ -160,6 +162,14 @@ fn impostor_atlas_uv(frame: vec2<u32>, n: u32, uv: vec2<f32>) -> vec2<f32> {
     return (vec2<f32>(frame) + clamp(uv, vec2<f32>(0.0), vec2<f32>(1.0))) / f32(n);
 }
 
+/// How far inside its frame (frame uv) a sample at mip `level` of an atlas whose frames are
+/// `texels` texels wide stays: half a texel of the coarsest mip trilinear filtering reads there,
+/// so bilinear filtering takes no texel of a neighbouring frame (at most 0.5, the frame's
+/// centre).
+fn impostor_frame_inset(texels: f32, level: f32) -> f32 {
+    return min(0.5 * exp2(ceil(max(level, 0.0))) / texels, 0.5);
+}
+
 /// The height [-1, 1] above a frame's plane of a stored depth in [0, 1].
 fn impostor_depth_height(depth: f32) -> f32 {
     return depth * 2.0 - 1.0;
@@ -176,16 +186,19 @@ struct ImpostorSample {
 }
 
 /// One frame's look along the ray: where the ray meets its plane, that texel's depth, and the
-/// colour, normal and point at the height that depth gives (one parallax step). Outside the
-/// frame's square the coverage is 0.
+/// colour, normal and point at the height that depth gives (one parallax step), read inside the
+/// frame's inset (impostor_frame_inset). Outside the frame's square the coverage is 0.
 fn impostor_sample_frame(color_atlas: texture_2d<f32>, normal_atlas: texture_2d<f32>, samp: sampler, frame: vec2<u32>, n: u32, hemi: bool, origin: vec3<f32>, ray: vec3<f32>, level: f32) -> ImpostorSample {
     let dir = impostor_frame_dir(frame, n, hemi);
     let basis = impostor_frame_basis(dir);
+    let inset = impostor_frame_inset(f32(textureDimensions(color_atlas, 0).x) / f32(n), level);
+    let lo = vec2<f32>(inset);
+    let hi = vec2<f32>(1.0 - inset);
     let uv0 = impostor_frame_uv(basis, impostor_ray_at_height(origin, ray, dir, 0.0));
-    let depth0 = textureSampleLevel(normal_atlas, samp, impostor_atlas_uv(frame, n, uv0), level).w;
+    let depth0 = textureSampleLevel(normal_atlas, samp, impostor_atlas_uv(frame, n, clamp(uv0, lo, hi)), level).w;
     let point = impostor_ray_at_height(origin, ray, dir, impostor_depth_height(depth0));
     let uv = impostor_frame_uv(basis, point);
-    let atlas = impostor_atlas_uv(frame, n, uv);
+    let atlas = impostor_atlas_uv(frame, n, clamp(uv, lo, hi));
     var color = textureSampleLevel(color_atlas, samp, atlas, level);
     if (any(uv != clamp(uv, vec2<f32>(0.0), vec2<f32>(1.0)))) {
         color.w = 0.0;
