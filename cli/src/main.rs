@@ -160,7 +160,8 @@ enum Command {
         /// A RON scene to measure instead of the built-in ones.
         #[arg(long)]
         scene: Option<PathBuf>,
-        /// Interleaved pairs per pass-time ratio (a quarter of it: whole-frame timing rounds).
+        /// Interleaved pairs per pass-time ratio (a quarter of it: the frame-cost breakdown's timing
+        /// rounds; an eighth: whole-frame timing rounds).
         #[arg(long, default_value_t = 40)]
         pairs: usize,
         /// Also write benchmarks.md, quality.md and the guides' pictures into this folder

@@ -287,6 +287,18 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             t.outside_rects
         ));
     }
+    // Scenes are measured side by side (the most objects first); the rows still come in the
+    // scenes' order, each scene's techniques in `Technique::ALL`'s.
+    let rows: Vec<(&str, &str)> = report
+        .transitions
+        .iter()
+        .map(|t| (t.scene.as_str(), t.technique.as_str()))
+        .collect();
+    let expected: Vec<(&str, &str)> = scenes
+        .iter()
+        .flat_map(|s| Technique::ALL.map(|t| (s.name.as_str(), t.name())))
+        .collect();
+    assert_eq!(rows, expected);
     for u in &report.upsampling {
         say(&format!(
             "demo figure upsampling r={}: psnr {:?} ssim {:?}",

@@ -52,7 +52,8 @@ pub struct DemoOptions {
     /// A RON scene to measure instead of the built-in ones.
     pub scene: Option<PathBuf>,
     /// Interleaved pairs per pass-time ratio (1..=10000); a quarter of it (at least 3) is the
-    /// number of rounds of whole-frame timing.
+    /// number of rounds of the frame-cost breakdown's pass timing, an eighth (at least 3) that
+    /// of whole-frame timing (a whole frame is long and steady next to one pass).
     pub timing_pairs: usize,
     /// Folder to write `benchmarks.md`, `quality.md` and the guides' pictures (`img/`) into.
     pub docs: Option<PathBuf>,
@@ -177,6 +178,85 @@ pub fn run(options: &DemoOptions) -> Result<DemoReport, DemoError> {
     run_on(&gpu, options, &scenes)
 }
 
+/// Most scenes whose transitions are measured at once.
+const MAX_SCENE_WORKERS: usize = 4;
+
+/// The transitions of every scene, in `scenes`' order, and the fragment counter's description.
+///
+/// Scenes are measured side by side, one thread each, up to the machine's cores (at most
+/// [`MAX_SCENE_WORKERS`]): a scene's metrics are CPU work between its GPU runs, so a second
+/// scene's runs keep the cores busy meanwhile. The scene with the most objects starts first.
+/// Nothing a scene measures depends on another's (its own renderer, counters and files; no
+/// figure here is a time), so the rows are the same as one by one.
+fn measure_transitions(
+    gpu: &GpuContext,
+    options: &DemoOptions,
+    scenes: &[DemoScene],
+    bar: &crate::progress::Progress,
+) -> Result<(Vec<transitions::TransitionMetrics>, String), DemoError> {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    for scene in scenes {
+        scene.check().map_err(|message| SceneError::Invalid {
+            path: format!("scene `{}`", scene.name),
+            message,
+        })?;
+    }
+    let measure = |scene: &DemoScene| {
+        bar.set_message(format!("scene {}", scene.name));
+        let renderer = render::SceneRenderer::new(gpu, scene, options.size, options.frames)?;
+        let counter = renderer.counter().kind().describe().to_owned();
+        let mut tick = |name: &str| bar.done(format!("scene {}: {name}", scene.name));
+        let rows = transitions::measure_scene(
+            gpu,
+            &renderer,
+            &scene.name,
+            options.size,
+            &options.out,
+            &mut tick,
+        )?;
+        Ok::<_, DemoError>((rows, counter))
+    };
+    let mut order: Vec<usize> = (0..scenes.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(scenes[i].objects.len()));
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .clamp(1, MAX_SCENE_WORKERS)
+        .min(scenes.len());
+    let next = AtomicUsize::new(0);
+    let results: Vec<Mutex<Option<Result<_, DemoError>>>> =
+        scenes.iter().map(|_| Mutex::new(None)).collect();
+    std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| {
+                while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    let result = measure(&scenes[i]);
+                    let failed = result.is_err();
+                    if let Ok(mut slot) = results[i].lock() {
+                        *slot = Some(result);
+                    }
+                    if failed {
+                        // The run fails: no other scene starts.
+                        next.store(order.len(), Ordering::Relaxed);
+                    }
+                }
+            });
+        }
+    });
+    let (mut rows, mut counter) = (Vec::new(), String::new());
+    for slot in results {
+        let result = slot
+            .into_inner()
+            .map_err(|_| DemoError::Internal("a scene's thread panicked".to_owned()))?;
+        // A scene not measured because another failed first: that failure is returned below.
+        let Some(result) = result else { continue };
+        let (scene_rows, scene_counter) = result?;
+        rows.extend(scene_rows);
+        counter = scene_counter;
+    }
+    Ok((rows, counter))
+}
+
 /// Runs the demo on `gpu` over `scenes`.
 pub fn run_on(
     gpu: &GpuContext,
@@ -190,34 +270,23 @@ pub fn run_on(
     let steps =
         scenes.len() * render::Technique::ALL.len() + upsample_quality::RESIZE_FACTORS.len() + 7;
     let bar = crate::progress::Progress::new(options.progress, steps);
-    let mut transitions = Vec::new();
-    let mut counter = String::new();
-    for scene in scenes {
-        scene.check().map_err(|message| SceneError::Invalid {
-            path: format!("scene `{}`", scene.name),
-            message,
-        })?;
-        bar.set_message(format!("scene {}", scene.name));
-        let renderer = render::SceneRenderer::new(gpu, scene, options.size, options.frames)?;
-        counter = renderer.counter().kind().describe().to_owned();
-        let mut tick = |name: &str| bar.done(format!("scene {}: {name}", scene.name));
-        transitions.extend(transitions::measure_scene(
-            gpu,
-            &renderer,
-            &scene.name,
-            options.size,
-            out,
-            &mut tick,
-        )?);
-    }
+    let (transitions, counter) = measure_transitions(gpu, options, scenes, &bar)?;
     bar.set_message("framebuffer LOD");
     let mut tick = |name: &str| bar.done(format!("framebuffer LOD: {name}"));
     let rounds = (options.timing_pairs / 4).max(3);
+    let frame_rounds = (options.timing_pairs / 8).max(3);
     let timer = clock::Timer::new(gpu, RECORDINGS)?;
-    let upsampling =
-        upsample_quality::measure_upsampling(gpu, &timer, options.size, rounds, out, &mut tick)?;
+    let upsampling = upsample_quality::measure_upsampling(
+        gpu,
+        &timer,
+        options.size,
+        frame_rounds,
+        out,
+        &mut tick,
+    )?;
     bar.set_message("framebuffer LOD: frame cost and shading sweep");
-    let frame_cost = frame_cost::measure_frame_cost(gpu, &timer, options.fb_size, rounds)?;
+    let frame_cost =
+        frame_cost::measure_frame_cost(gpu, &timer, options.fb_size, rounds, frame_rounds)?;
     bar.inc(1);
     bar.set_message("framebuffer LOD: controllers on the real frame");
     let closed_loop = closed_loop::measure_closed_loop(gpu, options.fb_size)?;

@@ -84,8 +84,12 @@ pub struct FrameCost {
     /// Recordings per timed run of the sweep (1 on GPU timestamps: a whole frame is long
     /// enough to time alone).
     pub sweep_recordings: usize,
-    /// Timing rounds per figure (medians).
+    /// Timing rounds per figure of the breakdown (medians).
     pub rounds: usize,
+    /// Timing rounds per figure of the sweep (medians), at least 3: a whole frame is long and
+    /// steady next to one pass, and the sweep's frames at the heaviest shading work are a large
+    /// part of the demo's rendering time.
+    pub sweep_rounds: usize,
     /// The breakdown at [`BREAKDOWN_WORK`].
     pub breakdown: Vec<PassTimes>,
     /// The sweep over [`SWEEP_WORK`].
@@ -110,14 +114,16 @@ impl FrameCost {
     }
 }
 
-/// Measures the breakdown and the sweep on the edge scene at `size`, medians of `rounds`.
+/// Measures the breakdown and the sweep on the edge scene at `size`: the breakdown's figures
+/// medians of `rounds`, the sweep's of `sweep_rounds` (each at least 3).
 pub fn measure_frame_cost(
     gpu: &GpuContext,
     timer: &Timer,
     size: (u32, u32),
     rounds: usize,
+    sweep_rounds: usize,
 ) -> Result<FrameCost, DemoError> {
-    let rounds = rounds.max(3);
+    let (rounds, sweep_rounds) = (rounds.max(3), sweep_rounds.max(3));
     let (frame, mut scene) = EdgeFrame::new(gpu, timer, size)?;
     // Pass by pass, rounds interleaved over the configurations; round 0 warms up.
     scene.set_shading_work(BREAKDOWN_WORK);
@@ -183,7 +189,7 @@ pub fn measure_frame_cost(
         lod_frame(SWEEP_FACTORS[0], 1)?;
         let mut full_ms = Vec::new();
         let mut lod = [[Vec::new(), Vec::new()], [Vec::new(), Vec::new()]];
-        for _ in 0..rounds {
+        for _ in 0..sweep_rounds {
             full_ms.push(frame.shade(&scene, 1.0, ShadingTerm::Full, 0)?);
             for (k, &r) in SWEEP_FACTORS.iter().enumerate() {
                 for (p, times) in lod.iter_mut().enumerate() {
@@ -204,6 +210,7 @@ pub fn measure_frame_cost(
         recordings: timer.recordings(),
         sweep_recordings: sweep_timer.recordings(),
         rounds,
+        sweep_rounds,
         breakdown,
         sweep,
     })

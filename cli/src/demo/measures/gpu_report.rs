@@ -87,7 +87,7 @@ pub fn measure(gpu: &GpuContext, options: &GpuReportOptions) -> Result<GpuReport
     for &size in combine_sizes {
         pass_ratios.extend(combine_timing::combine_vs_copy(gpu, &timer, size, pairs)?);
     }
-    let frame_cost = frame_cost::measure_frame_cost(gpu, &timer, fb_size, 3)?;
+    let frame_cost = frame_cost::measure_frame_cost(gpu, &timer, fb_size, 3, 3)?;
     let selection = selection::measure(gpu, &timer, 3, select_sizes)?;
     Ok(GpuReport {
         adapter: gpu.adapter_summary(),

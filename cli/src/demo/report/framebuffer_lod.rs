@@ -34,7 +34,8 @@ pub fn html(report: &DemoReport) -> String {
         "time of each pass, per resize factor and route",
     ));
     s.push_str(&format!(
-        "<p>{SWEEP_TEXT} {}</p>\n",
+        "<p>{SWEEP_TEXT} Medians of {} rounds. {}</p>\n",
+        cost.sweep_rounds,
         frame_cost::summary(cost)
     ));
     s.push_str(&frame_cost::sweep_table(cost).html());
@@ -70,7 +71,9 @@ pub fn benchmarks_markdown(report: &DemoReport) -> String {
     s.push_str(&frame_cost::breakdown_table(cost).markdown());
     s.push_str("\n![Time of each pass per resize factor and route](img/frame-breakdown.png)\n");
     s.push_str(&format!(
-        "\n## Framebuffer LOD at {w}x{h}: speed-up against shading cost\n\n{SWEEP_TEXT} {}\n\n",
+        "\n## Framebuffer LOD at {w}x{h}: speed-up against shading cost\n\n{SWEEP_TEXT} Medians \
+         of {} rounds. {}\n\n",
+        cost.sweep_rounds,
         frame_cost::summary(cost)
     ));
     s.push_str(&frame_cost::sweep_table(cost).markdown());
