@@ -23,8 +23,9 @@
 //! does, for that).
 //!
 //! An impostor level (`lodkit lod --impostor`: a card node whose extras hold `lodkit_impostor`,
-//! the last of the node's levels) is left out with a warning: lodkit_bevy draws no impostor
-//! yet, and the card alone would show the object's front from every side (edge-on from 90°).
+//! the last of the node's levels) is left out with a warning: a frame-sequential group's levels
+//! are meshes (draw impostors with [`ImpostorMaterial`](crate::impostor::ImpostorMaterial)),
+//! and the card alone would show the object's front from every side (edge-on from 90°).
 //! The last mesh level is shown in its place, up to where the node is hidden.
 
 use bevy::asset::LoadContext;
@@ -233,8 +234,9 @@ impl MsftLod {
             if !std::mem::replace(&mut self.impostor_warned, true) {
                 warn!(
                     "{}: impostor levels (`lodkit lod --impostor`; the first: node {id}) left \
-                     out: lodkit_bevy draws no impostor yet; each node's last mesh level is \
-                     shown up to where the node is hidden",
+                     out: a frame-sequential group's levels are meshes (ImpostorMaterial draws \
+                     impostors); each node's last mesh level is shown up to where the node is \
+                     hidden",
                     load_context.path()
                 );
             }

@@ -22,6 +22,9 @@
 //!   `StandardMaterial`s; [`gltf_lod`] makes groups of glTF files with `MSFT_lod` levels as
 //!   Bevy's loader spawns them, and [`auto_lod::AutoLod`] of any entity with a mesh, its levels
 //!   built in the background.
+//! - [`ImpostorPlugin`](impostor::ImpostorPlugin) with [`ImpostorMaterial`](impostor::ImpostorMaterial):
+//!   octahedral impostors baked by lodkit, drawn as a Bevy material lit by Bevy's PBR lighting,
+//!   the last level of a chain past the meshes. See [`impostor`].
 //!
 //! lodkit is used with `default-features = false`: it brings no naga of its own; Bevy links its
 //! WESL modules (wesl-rs), as it links its own.
@@ -43,6 +46,7 @@ pub mod frame_sequential;
 pub mod framebuffer_lod;
 #[cfg(feature = "gltf")]
 pub mod gltf_lod;
+pub mod impostor;
 #[cfg(feature = "lod_chain")]
 pub mod lod_chain;
 mod shaders;
@@ -66,5 +70,6 @@ pub mod prelude {
         FramebufferLodFrameTimes, FramebufferLodPlugin, FramebufferLodResolution,
         FramebufferLodState, FramebufferLodSystems, FramebufferLodUpsample, FramerateTarget,
     };
+    pub use crate::impostor::{ImpostorMaterial, ImpostorPlugin};
     pub use crate::shaders::LodkitShadersPlugin;
 }

@@ -1,0 +1,398 @@
+//! Octahedral impostors in Bevy: [`ImpostorMaterial`] draws an atlas that lodkit baked
+//! (`lodkit::gpu::impostor::bake_impostor`, or `lodkit lod --impostor`) as a Bevy material, and
+//! [`ImpostorPlugin`] registers it.
+//!
+//! The entity carries the card mesh [`ImpostorMaterial::card_mesh`] (six vertices whose
+//! positions span the bounding sphere's box, so Bevy culls it as the object, and whose uv is the
+//! card's corner) and the material. Its vertex shader turns the card to face the camera,
+//! through the sphere's centre, sized to the cone from the eye tangent to the sphere; its
+//! fragment shader blends the three frames nearest the view ray with one parallax step each
+//! (lodkit's `impostor_sample`, the module every lodkit host draws impostors with), drops what
+//! the atlas does not cover, writes the depth of the surface the frames saw (so other objects
+//! intersect the impostor as they would the mesh) and shades the baked base colour and normal
+//! with Bevy's PBR lighting: the scene's lights, received shadows, fog and tonemapping, as a
+//! `StandardMaterial` with the material's roughness and metallic. An entity with Bevy's
+//! `VisibilityRange` fades in and out with Bevy's dither, so a mesh chain drawn with visibility
+//! ranges can end in an impostor.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use lodkit::impostor::ImpostorAtlas;
+//! use lodkit_bevy::impostor::{ImpostorMaterial, ImpostorPlugin};
+//!
+//! fn spawn(
+//!     atlas: &ImpostorAtlas,
+//!     commands: &mut Commands,
+//!     meshes: &mut Assets<Mesh>,
+//!     images: &mut Assets<Image>,
+//!     materials: &mut Assets<ImpostorMaterial>,
+//! ) -> Result<(), lodkit_bevy::impostor::ImpostorMaterialError> {
+//!     let material = ImpostorMaterial::new(atlas, images)?;
+//!     commands.spawn((
+//!         Mesh3d(meshes.add(ImpostorMaterial::card_mesh(&atlas.layout))),
+//!         MeshMaterial3d(materials.add(material)),
+//!         Transform::from_xyz(0.0, 0.0, -10.0),
+//!     ));
+//!     Ok(())
+//! }
+//! # let _ = (ImpostorPlugin, spawn);
+//! ```
+//!
+//! Limits: the instance's transform must be a rotation, a uniform scale and a translation (a
+//! sheared or non-uniformly scaled impostor draws at the wrong depth); views are perspective;
+//! the impostor casts no shadow and is not drawn in Bevy's prepasses (a camera with a depth
+//! prepass still depth-tests it in the main pass; its depth is not in the prepass's texture);
+//! frame-sequential LOD groups take mesh levels only.
+
+use bevy::asset::{RenderAssetUsages, uuid_handle};
+use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
+use bevy::mesh::{Indices, PrimitiveTopology};
+use bevy::prelude::*;
+use bevy::reflect::TypePath;
+use bevy::render::render_resource::{
+    AsBindGroup, Extent3d, ShaderType, TextureDataOrder, TextureDimension, TextureFormat,
+};
+use bevy::shader::ShaderRef;
+use lodkit::impostor::{ImpostorAtlas, ImpostorError, ImpostorImage, ImpostorLayout};
+
+use crate::LodkitShadersPlugin;
+
+/// The shader of [`ImpostorMaterial`] (`impostor.wesl`).
+const IMPOSTOR_SHADER: Handle<Shader> = uuid_handle!("9a4e61c2-7b3f-4d85-b0e9-2c6f8a1d5e73");
+
+/// Registers [`ImpostorMaterial`] (and lodkit's shader modules, where
+/// [`LodkitShadersPlugin`] is not added yet).
+pub struct ImpostorPlugin;
+
+impl Plugin for ImpostorPlugin {
+    fn build(&self, app: &mut App) {
+        if !app.is_plugin_added::<LodkitShadersPlugin>() {
+            app.add_plugins(LodkitShadersPlugin);
+        }
+        app.world_mut()
+            .resource_mut::<Assets<Shader>>()
+            .insert(
+                &IMPOSTOR_SHADER,
+                Shader::from_wesl(
+                    include_str!("impostor.wesl"),
+                    "embedded://lodkit_bevy/impostor.wesl",
+                ),
+            )
+            .expect("UUID handles never fail to insert");
+        app.add_plugins(MaterialPlugin::<ImpostorMaterial>::default());
+    }
+}
+
+/// What the shader reads of an impostor besides its atlases (`impostor.wesl`'s
+/// `ImpostorParams`).
+#[derive(ShaderType, Clone, Copy, Debug, PartialEq)]
+pub struct ImpostorParams {
+    /// xyz: the bounding sphere's centre (object space); w: its radius.
+    pub sphere: Vec4,
+    /// x: frames per side, y: 1 for the hemisphere, z: texels per frame side; w unused.
+    pub atlas: UVec4,
+    /// x: perceptual roughness, y: metallic (as `StandardMaterial`'s); z, w unused.
+    pub surface: Vec4,
+}
+
+/// An octahedral impostor's material: its layout, its two atlases with their mip chains, and
+/// the surface Bevy's lighting shades it as. Build it with [`ImpostorMaterial::new`]; draw it on
+/// [`ImpostorMaterial::card_mesh`].
+#[derive(Asset, AsBindGroup, TypePath, Clone, Debug)]
+pub struct ImpostorMaterial {
+    /// The layout and the surface.
+    #[uniform(0)]
+    pub params: ImpostorParams,
+    /// Base colour and coverage: `Rgba8UnormSrgb`, the whole mip chain, sampled linearly with
+    /// mipmaps and clamped to the edge (the sampler both atlases are read with).
+    #[texture(1)]
+    #[sampler(3)]
+    pub color: Handle<Image>,
+    /// Object-space normal `* 0.5 + 0.5` and the stored depth: `Rgba16Float`, the whole mip
+    /// chain.
+    #[texture(2)]
+    pub normal_depth: Handle<Image>,
+}
+
+/// An atlas [`ImpostorMaterial::new`] cannot draw.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ImpostorMaterialError {
+    /// The layout is out of range.
+    #[error("ImpostorMaterial::new: atlas.layout: {0}")]
+    Layout(#[from] ImpostorError),
+    /// A mip chain does not match the layout.
+    #[error(
+        "ImpostorMaterial::new: atlas.{atlas} has {found}, expected {expected} levels halving from \
+         {size} x {size} texels"
+    )]
+    MipChain {
+        /// `color` or `normal_depth`.
+        atlas: &'static str,
+        /// What it has.
+        found: String,
+        /// The levels the layout has (`ImpostorAtlas::mip_levels`).
+        expected: u32,
+        /// The atlas's side at level 0.
+        size: u32,
+    },
+}
+
+impl ImpostorMaterial {
+    /// The material of `atlas` (checked: a layout lodkit can draw, each mip chain whole), its
+    /// two atlases added to `images`; roughness 1 and metallic 0, as `lodkit lod --impostor`
+    /// writes its impostor's material.
+    pub fn new(
+        atlas: &ImpostorAtlas,
+        images: &mut Assets<Image>,
+    ) -> Result<Self, ImpostorMaterialError> {
+        let layout = atlas.layout;
+        layout.validate()?;
+        let levels = ImpostorAtlas::mip_levels(&layout);
+        let size = layout.atlas_size();
+        for (name, chain) in [
+            ("color", &atlas.color),
+            ("normal_depth", &atlas.normal_depth),
+        ] {
+            let whole = chain.len() == levels as usize
+                && chain.iter().enumerate().all(|(k, image)| {
+                    image.size == size >> k && image.texels.len() == (image.size as usize).pow(2)
+                });
+            if !whole {
+                return Err(ImpostorMaterialError::MipChain {
+                    atlas: name,
+                    found: format!(
+                        "{} levels of {:?} texels a side",
+                        chain.len(),
+                        chain.iter().map(|i| i.size).collect::<Vec<_>>()
+                    ),
+                    expected: levels,
+                    size,
+                });
+            }
+        }
+        let color = atlas
+            .color
+            .iter()
+            .flat_map(ImpostorImage::to_srgba8)
+            .collect();
+        let normal_depth = atlas
+            .normal_depth
+            .iter()
+            .flat_map(|image| &image.texels)
+            .flat_map(|t| t.map(|c| half::f16::from_f32(c).to_le_bytes()))
+            .flatten()
+            .collect();
+        Ok(Self {
+            params: Self::params(&layout),
+            color: images.add(atlas_image(
+                size,
+                levels,
+                color,
+                TextureFormat::Rgba8UnormSrgb,
+            )),
+            normal_depth: images.add(atlas_image(
+                size,
+                levels,
+                normal_depth,
+                TextureFormat::Rgba16Float,
+            )),
+        })
+    }
+
+    /// The uniform of `layout`, roughness 1 and metallic 0.
+    pub fn params(layout: &ImpostorLayout) -> ImpostorParams {
+        ImpostorParams {
+            sphere: Vec3::from(layout.center).extend(layout.radius),
+            atlas: UVec4::new(
+                layout.frames,
+                u32::from(layout.shape.is_hemi()),
+                layout.frame_size,
+                0,
+            ),
+            surface: Vec4::new(1.0, 0.0, 0.0, 0.0),
+        }
+    }
+
+    /// The card every impostor of `layout` is drawn on: two triangles whose positions span the
+    /// bounding sphere's box (Bevy's culling and its visibility ranges see the object) and whose
+    /// `UV_0` is the card's corner (-1 or 1 each way; the shader places the card).
+    pub fn card_mesh(layout: &ImpostorLayout) -> Mesh {
+        let corners = [
+            [-1.0, -1.0],
+            [1.0, -1.0],
+            [1.0, 1.0],
+            [-1.0, -1.0],
+            [1.0, 1.0],
+            [-1.0, 1.0],
+        ];
+        let center = Vec3::from(layout.center);
+        let positions: Vec<[f32; 3]> = corners
+            .iter()
+            .enumerate()
+            .map(|(k, &[x, y])| {
+                // Alternate the box's depth so the six points span all of it.
+                let z = if k % 2 == 0 { -1.0 } else { 1.0 };
+                (center + Vec3::new(x, y, z) * layout.radius).to_array()
+            })
+            .collect();
+        Mesh::new(
+            PrimitiveTopology::TriangleList,
+            RenderAssetUsages::RENDER_WORLD,
+        )
+        .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
+        .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, corners.to_vec())
+        .with_inserted_indices(Indices::U16((0..6).collect()))
+    }
+}
+
+/// One atlas as a Bevy image: `levels` mip levels from `size` texels a side, `data` level
+/// after level, sampled linearly with mipmaps, clamped to the edge.
+fn atlas_image(size: u32, levels: u32, data: Vec<u8>, format: TextureFormat) -> Image {
+    let mut image = Image::new_uninit(
+        Extent3d {
+            width: size,
+            height: size,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        format,
+        RenderAssetUsages::RENDER_WORLD,
+    );
+    image.data = Some(data);
+    image.data_order = TextureDataOrder::MipMajor;
+    image.texture_descriptor.mip_level_count = levels;
+    image.sampler = ImageSampler::Descriptor(ImageSamplerDescriptor {
+        address_mode_u: ImageAddressMode::ClampToEdge,
+        address_mode_v: ImageAddressMode::ClampToEdge,
+        mag_filter: ImageFilterMode::Linear,
+        min_filter: ImageFilterMode::Linear,
+        mipmap_filter: ImageFilterMode::Linear,
+        ..default()
+    });
+    image
+}
+
+impl Material for ImpostorMaterial {
+    fn vertex_shader() -> ShaderRef {
+        IMPOSTOR_SHADER.into()
+    }
+
+    fn fragment_shader() -> ShaderRef {
+        IMPOSTOR_SHADER.into()
+    }
+
+    /// The shader discards what the atlas does not cover.
+    fn alpha_mode(&self) -> AlphaMode {
+        AlphaMode::Mask(0.5)
+    }
+
+    /// Bevy's prepass shaders know nothing of the card: not drawn there.
+    fn enable_prepass() -> bool {
+        false
+    }
+
+    /// Nor in shadow maps.
+    fn enable_shadows() -> bool {
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lodkit::impostor::ImpostorShape;
+
+    fn layout() -> ImpostorLayout {
+        ImpostorLayout {
+            frames: 2,
+            frame_size: 4,
+            shape: ImpostorShape::Hemi,
+            center: [1.0, 2.0, 3.0],
+            radius: 0.5,
+        }
+    }
+
+    /// An atlas of `layout` whose chains have `levels` levels (the layout's own: 3).
+    fn atlas(levels: u32) -> ImpostorAtlas {
+        let layout = layout();
+        let chain = (0..levels)
+            .map(|k| ImpostorImage::filled(layout.atlas_size() >> k, [0.5; 4]))
+            .collect::<Vec<_>>();
+        ImpostorAtlas {
+            layout,
+            color: chain.clone(),
+            normal_depth: chain,
+        }
+    }
+
+    #[test]
+    fn an_atlas_becomes_two_images_with_their_mip_chains() {
+        let mut images = Assets::<Image>::default();
+        let levels = ImpostorAtlas::mip_levels(&layout());
+        assert_eq!(levels, 3, "8, 4 and 2 texels a side");
+        let material = ImpostorMaterial::new(&atlas(levels), &mut images).unwrap();
+        let color = images.get(&material.color).unwrap();
+        assert_eq!(color.texture_descriptor.mip_level_count, 3);
+        assert_eq!(
+            color.texture_descriptor.format,
+            TextureFormat::Rgba8UnormSrgb
+        );
+        // 8^2 + 4^2 + 2^2 texels of 4 bytes, and of 8 bytes (four halves).
+        assert_eq!(color.data.as_ref().map(Vec::len), Some(84 * 4));
+        let normal = images.get(&material.normal_depth).unwrap();
+        assert_eq!(normal.texture_descriptor.format, TextureFormat::Rgba16Float);
+        assert_eq!(normal.data.as_ref().map(Vec::len), Some(84 * 8));
+        // 0.5 as a half: 0x3800, little-endian.
+        assert_eq!(
+            normal.data.as_ref().map(|d| [d[0], d[1]]),
+            Some([0x00, 0x38])
+        );
+        assert_eq!(material.params.sphere, Vec4::new(1.0, 2.0, 3.0, 0.5));
+        assert_eq!(material.params.atlas, UVec4::new(2, 1, 4, 0));
+    }
+
+    #[test]
+    fn an_atlas_it_cannot_draw_is_an_error_naming_the_part() {
+        let mut images = Assets::<Image>::default();
+        let short = ImpostorMaterial::new(&atlas(2), &mut images).unwrap_err();
+        assert!(
+            matches!(
+                short,
+                ImpostorMaterialError::MipChain {
+                    atlas: "color",
+                    expected: 3,
+                    ..
+                }
+            ),
+            "{short}"
+        );
+        let mut bad = atlas(3);
+        bad.layout.frames = 1;
+        let layout = ImpostorMaterial::new(&bad, &mut images).unwrap_err();
+        assert!(
+            matches!(layout, ImpostorMaterialError::Layout(_)),
+            "{layout}"
+        );
+        assert!(layout.to_string().contains("frames"), "{layout}");
+        assert_eq!(images.len(), 0, "no image added for an atlas refused");
+    }
+
+    #[test]
+    fn the_card_mesh_spans_the_bounding_sphere_box() {
+        let mesh = ImpostorMaterial::card_mesh(&layout());
+        let Some(bevy::mesh::VertexAttributeValues::Float32x3(positions)) =
+            mesh.attribute(Mesh::ATTRIBUTE_POSITION)
+        else {
+            panic!("positions as Float32x3");
+        };
+        let (lo, hi) = positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(Vec3::from(p)), hi.max(Vec3::from(p))),
+        );
+        assert_eq!(
+            (lo, hi),
+            (Vec3::new(0.5, 1.5, 2.5), Vec3::new(1.5, 2.5, 3.5))
+        );
+        assert_eq!(mesh.count_vertices(), 6);
+    }
+}
