@@ -11,6 +11,7 @@ mod cli;
 mod combine_regions;
 mod demo;
 mod demo_chain;
+mod demo_cli;
 mod docs_figures;
 mod engine_tree;
 mod fast_path;
