@@ -367,10 +367,13 @@ impl LodBufferRenderer {
             clear,
             counter,
         } = *frame;
-        const CALL: &str = "LodBufferRenderer::render";
-        same_color_format(CALL, "buffers", buffers.color_format(), self.color_format)?;
-        self.draws.check_count(CALL, items.len())?;
-        gpu.recording(CALL, || {
+        let call = match level_depth {
+            true => "LodBufferRenderer::render_level_depth",
+            false => "LodBufferRenderer::render",
+        };
+        same_color_format(call, "buffers", buffers.color_format(), self.color_format)?;
+        self.draws.check_count(call, items.len())?;
+        gpu.recording(call, || {
             let camera = LodCameraUniform {
                 view_proj: view.view_proj.to_cols_array_2d(),
                 prev_view_proj: view.prev_view_proj.to_cols_array_2d(),
