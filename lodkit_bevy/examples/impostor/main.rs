@@ -23,6 +23,7 @@
 //!
 //! Exit codes: 0 done, 1 nothing rendered, 2 usage or I/O error.
 
+mod crossfade;
 #[path = "../common/frames.rs"]
 #[allow(
     dead_code,
@@ -38,7 +39,6 @@ use std::process::ExitCode;
 
 use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
-use bevy::camera::visibility::VisibilityRange;
 use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
@@ -337,86 +337,21 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
     let at_switch = measure(&mut app, distance, false)?;
     let at_half = measure(&mut app, distance * 0.5, false)?;
     let walled = measure(&mut app, distance, true)?;
-    // Bevy's own crossfade (`VisibilityRange`): the mesh fading out, the impostor fading in
-    // over the same margin around the camera, from the first view. Bevy's dither gives the two
-    // complementary pixels, so every pixel both cover alone shows one of them.
-    let view = views[0];
-    let eye = center + view * distance;
-    let d0 = eye.length(); // VisibilityRange measures from the entity's origin.
-    let margin = (d0 * 0.9)..(d0 * 1.1);
-    let world = app.world_mut();
-    world.entity_mut(tree_entity).insert((
-        Visibility::Visible,
-        VisibilityRange {
-            start_margin: 0.0..0.0,
-            end_margin: margin.clone(),
-            use_aabb: false,
-        },
-    ));
-    world.entity_mut(impostor_entity).insert((
-        Visibility::Visible,
-        VisibilityRange {
-            start_margin: margin,
-            end_margin: 1e9..1e9,
-            use_aabb: false,
-        },
-    ));
-    let up = if view.y.abs() > 0.95 {
-        Vec3::Z
-    } else {
-        Vec3::Y
+    // The impostor as the last level of Bevy's crossfade.
+    let shot = crossfade::Shot {
+        target: target.clone(),
+        eye: center + views[0] * distance,
+        center,
+        near: distance * 0.05,
     };
-    let camera = world
-        .spawn((
-            Camera3d::default(),
-            Camera {
-                clear_color: ClearColorConfig::Custom(Color::srgb_u8(
-                    BACKGROUND[0],
-                    BACKGROUND[1],
-                    BACKGROUND[2],
-                )),
-                ..default()
-            },
-            Projection::Perspective(PerspectiveProjection {
-                fov: FOV.to_radians(),
-                near: distance * 0.05,
-                ..default()
-            }),
-            RenderTarget::from(target.clone()),
-            Msaa::Off,
-            Tonemapping::None,
-            DebandDither::Disabled,
-            Transform::from_translation(eye).looking_at(center, up),
-        ))
-        .id();
-    headless::step(&mut app);
-    let faded = capture(&mut app, &target).map_err(|e| (1, e))?;
-    // The impostor's half alone: the dither keeps part of its pixels.
-    app.world_mut()
-        .entity_mut(tree_entity)
-        .insert(Visibility::Hidden);
-    headless::step(&mut app);
-    let fading_in = capture(&mut app, &target).map_err(|e| (1, e))?;
-    app.world_mut().despawn(camera);
     let (mesh_alone, impostor_alone) = &at_switch.captures[0];
-    let (m, i, f) = (
-        coverage(mesh_alone),
-        coverage(impostor_alone),
-        coverage(&faded),
-    );
-    let see_through = (0..f.len()).filter(|&p| m[p] && i[p] && !f[p]).count();
-    let from_impostor = (0..f.len())
-        .filter(|&p| f[p] && faded.rgba[4 * p..4 * p + 3] != mesh_alone.rgba[4 * p..4 * p + 3])
-        .count();
-    let covered = f.iter().filter(|c| **c).count();
-    let kept = coverage(&fading_in).iter().filter(|c| **c).count() as f32
-        / i.iter().filter(|c| **c).count().max(1) as f32;
-    println!(
-        "crossfade through Bevy's VisibilityRange at its midpoint: {covered} px covered, {} \
-         differ from the mesh alone, {see_through} px where both cover alone show neither; the \
-         impostor fading in alone keeps {:.2} of its pixels",
-        from_impostor, kept
-    );
+    let references = crossfade::References {
+        mesh: mesh_alone,
+        impostor: impostor_alone,
+        coverage: &coverage,
+    };
+    let entities = [tree_entity, impostor_entity];
+    let crossfade = crossfade::visibility_range(&mut app, &shot, entities, &references)?;
     println!(
         "switch distance {normalized:.1} (view-normalized), {distance:.2} object units (radius \
          {:.2}); outline distance between mesh and impostor over {} views: worst {:.2} px at it, \
@@ -456,10 +391,9 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
             "fewest_mesh_pixels": at_switch.fewest,
             "worst_px_with_wall": walled.worst,
             "fewest_mesh_pixels_with_wall": walled.fewest,
-            "crossfade_covered": covered,
-            "crossfade_differs_from_mesh": from_impostor,
-            "crossfade_see_through": see_through,
-            "crossfade_impostor_kept": kept,
+            "crossfade_see_through": crossfade.see_through,
+            "crossfade_impostor_kept": crossfade.kept,
+            "crossfade_differs_from_mesh": crossfade.differs,
         });
         let text = serde_json::to_string_pretty(&json).map_err(|e| (2, e.to_string()))?;
         std::fs::write(path, text).map_err(|e| (2, format!("{}: {e}", path.display())))?;
