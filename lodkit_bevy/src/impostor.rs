@@ -13,7 +13,11 @@
 //! with Bevy's PBR lighting: the scene's lights, received shadows, fog and tonemapping, as a
 //! `StandardMaterial` with the material's roughness and metallic. An entity with Bevy's
 //! `VisibilityRange` fades in and out with Bevy's dither, so a mesh chain drawn with visibility
-//! ranges can end in an impostor.
+//! ranges can end in an impostor. With
+//! [`FrameSequentialMaterialPlugin::<ImpostorMaterial>`](crate::frame_sequential::FrameSequentialMaterialPlugin)
+//! it is the last level of a frame-sequential group (`LevelMaterial::custom`; the shader ends
+//! with `lod_level_color`), blended with the screen-door dither: lodkit cannot repeat the alpha
+//! test of a material of the app's own type in the combine.
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -41,8 +45,7 @@
 //! Limits: the instance's transform must be a rotation, a uniform scale and a translation (a
 //! sheared or non-uniformly scaled impostor draws at the wrong depth); views are perspective;
 //! the impostor casts no shadow and is not drawn in Bevy's prepasses (a camera with a depth
-//! prepass still depth-tests it in the main pass; its depth is not in the prepass's texture);
-//! frame-sequential LOD groups take mesh levels only.
+//! prepass still depth-tests it in the main pass; its depth is not in the prepass's texture).
 
 use bevy::asset::{RenderAssetUsages, uuid_handle};
 use bevy::image::{ImageAddressMode, ImageFilterMode, ImageSampler, ImageSamplerDescriptor};
@@ -55,7 +58,7 @@ use bevy::render::render_resource::{
 use bevy::shader::ShaderRef;
 use lodkit::impostor::{ImpostorAtlas, ImpostorError, ImpostorImage, ImpostorLayout};
 
-use crate::LodkitShadersPlugin;
+use crate::shaders::LodkitShadersPlugin;
 
 /// The shader of [`ImpostorMaterial`] (`impostor.wesl`).
 const IMPOSTOR_SHADER: Handle<Shader> = uuid_handle!("9a4e61c2-7b3f-4d85-b0e9-2c6f8a1d5e73");
@@ -69,6 +72,8 @@ impl Plugin for ImpostorPlugin {
         if !app.is_plugin_added::<LodkitShadersPlugin>() {
             app.add_plugins(LodkitShadersPlugin);
         }
+        // The shader ends with lod_level_color (a level of a frame-sequential group).
+        crate::shaders::register_level_libraries(app);
         app.world_mut()
             .resource_mut::<Assets<Shader>>()
             .insert(
@@ -299,7 +304,7 @@ impl Material for ImpostorMaterial {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::impostor::*;
     use lodkit::impostor::ImpostorShape;
 
     fn layout() -> ImpostorLayout {

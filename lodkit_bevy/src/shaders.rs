@@ -33,9 +33,19 @@ impl Plugin for LodkitShadersPlugin {
     }
 }
 
+/// The names [`register_library`] has registered in this app.
+#[derive(Resource, Default)]
+struct Libraries(Vec<&'static str>);
+
 /// Registers a WESL library module of lodkit_bevy's own under `embedded://lodkit_bevy/<name>.wesl`,
-/// importable as `lodkit_bevy::<name>`, kept loaded for the app's lifetime.
-pub(crate) fn register_library(app: &mut App, name: &str, source: &'static str) {
+/// importable as `lodkit_bevy::<name>`, kept loaded for the app's lifetime; once per app, however
+/// many plugins ask for it.
+pub(crate) fn register_library(app: &mut App, name: &'static str, source: &'static str) {
+    let mut libraries = app.world_mut().get_resource_or_init::<Libraries>();
+    if libraries.0.contains(&name) {
+        return;
+    }
+    libraries.0.push(name);
     let handle = app
         .world_mut()
         .resource_mut::<Assets<Shader>>()
@@ -47,4 +57,20 @@ pub(crate) fn register_library(app: &mut App, name: &str, source: &'static str) 
         .resource_mut::<LodkitShaders>()
         .0
         .push(handle);
+}
+
+/// Registers the modules a material's shader imports to draw a level of a frame-sequential LOD
+/// group (`lodkit_bevy::frame_sequential_level` and the `lodkit_bevy::frame_sequential` it
+/// imports).
+pub(crate) fn register_level_libraries(app: &mut App) {
+    register_library(
+        app,
+        "frame_sequential",
+        include_str!("frame_sequential/frame_sequential.wesl"),
+    );
+    register_library(
+        app,
+        "frame_sequential_level",
+        include_str!("frame_sequential/frame_sequential_level.wesl"),
+    );
 }

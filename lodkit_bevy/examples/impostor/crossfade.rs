@@ -21,7 +21,7 @@ pub struct Shot {
 
 impl Shot {
     /// The example's camera at the shot (no MSAA, no tonemapping: the background exact).
-    fn camera(&self) -> impl Bundle {
+    pub fn camera(&self) -> impl Bundle {
         let view = (self.eye - self.center).normalize();
         let up = if view.y.abs() > 0.95 {
             Vec3::Z

@@ -30,9 +30,13 @@ mod crossfade;
     reason = "shared by the examples and tests; each uses a part"
 )]
 mod frames;
+mod group;
 #[path = "../common/headless.rs"]
 #[allow(dead_code, reason = "shared by the examples; each uses a part")]
 mod headless;
+#[path = "../frame_sequential/measure.rs"]
+#[allow(dead_code, reason = "shared with the other examples; each uses a part")]
+mod measure;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -49,6 +53,9 @@ use lodkit::impostor::{
     ImpostorAtlas, impostor_decode, impostor_frame_dir, impostor_switch_distance,
 };
 use lodkit::lod_chain::PixelErrorCamera;
+use lodkit_bevy::frame_sequential::{
+    FrameSequentialDefaultCamera, FrameSequentialLodPlugin, FrameSequentialMaterialPlugin,
+};
 use lodkit_bevy::impostor::{ImpostorMaterial, ImpostorPlugin};
 use lodkit_scenes::tree::LeafyTree;
 
@@ -186,7 +193,12 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
     let distance = normalized * camera.p11() as f32;
 
     let mut app = build_app(|app| {
-        app.add_plugins(ImpostorPlugin);
+        app.add_plugins((
+            ImpostorPlugin,
+            FrameSequentialLodPlugin,
+            FrameSequentialMaterialPlugin::<ImpostorMaterial>::default(),
+        ))
+        .insert_resource(FrameSequentialDefaultCamera(false));
     });
     let world = app.world_mut();
     world.spawn((
@@ -337,7 +349,7 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
     let at_switch = measure(&mut app, distance, false)?;
     let at_half = measure(&mut app, distance * 0.5, false)?;
     let walled = measure(&mut app, distance, true)?;
-    // The impostor as the last level of Bevy's crossfade.
+    // The impostor as the last level: of Bevy's crossfade, of a lodkit group.
     let shot = crossfade::Shot {
         target: target.clone(),
         eye: center + views[0] * distance,
@@ -352,6 +364,8 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
     };
     let entities = [tree_entity, impostor_entity];
     let crossfade = crossfade::visibility_range(&mut app, &shot, entities, &references)?;
+    let group = group::frame_sequential_group(&mut app, &shot, entities, &references, false)?;
+    let group_hard = group::frame_sequential_group(&mut app, &shot, entities, &references, true)?;
     println!(
         "switch distance {normalized:.1} (view-normalized), {distance:.2} object units (radius \
          {:.2}); outline distance between mesh and impostor over {} views: worst {:.2} px at it, \
@@ -394,6 +408,8 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
             "crossfade_see_through": crossfade.see_through,
             "crossfade_impostor_kept": crossfade.kept,
             "crossfade_differs_from_mesh": crossfade.differs,
+            "group": group,
+            "group_hard_switch": group_hard,
         });
         let text = serde_json::to_string_pretty(&json).map_err(|e| (2, e.to_string()))?;
         std::fs::write(path, text).map_err(|e| (2, format!("{}: {e}", path.display())))?;

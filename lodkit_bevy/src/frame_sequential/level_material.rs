@@ -103,6 +103,15 @@ where
             apply_drawer_materials::<ExtendedMaterial<B, E>>.in_set(ApplyDrawerMaterials),
         ),
     );
+    // A drawer's material changes, and may change type, as its group's level does: Bevy must see
+    // the change in the same frame (its check of the entities to specialize again runs after
+    // the drawers' commands), or the render world binds the new material on the old type's
+    // pipeline (wgpu validation fails where the two types differ) or specializes a frame late.
+    app.configure_sets(
+        PostUpdate,
+        ApplyDrawerMaterials
+            .before(bevy::pbr::check_entities_needing_specialization::<ExtendedMaterial<B, E>>),
+    );
 }
 
 /// The systems that derive level materials: after the groups' drawers are spawned, before

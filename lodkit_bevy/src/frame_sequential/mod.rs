@@ -155,16 +155,7 @@ impl Plugin for FrameSequentialLodPlugin {
         if !app.is_plugin_added::<LodkitShadersPlugin>() {
             app.add_plugins(LodkitShadersPlugin);
         }
-        crate::shaders::register_library(
-            app,
-            "frame_sequential",
-            include_str!("frame_sequential.wesl"),
-        );
-        crate::shaders::register_library(
-            app,
-            "frame_sequential_level",
-            include_str!("frame_sequential_level.wesl"),
-        );
+        crate::shaders::register_level_libraries(app);
         embedded_asset!(app, "combine.wesl");
         embedded_asset!(app, "older_depth.wesl");
         app.world_mut()
