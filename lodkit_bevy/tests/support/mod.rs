@@ -112,3 +112,28 @@ fn newest_source(root: &Path, path: &Path, example: &str) -> Option<SystemTime> 
     walk(&root.join("examples/common"), &mut newest);
     newest
 }
+
+/// Holds one transition run of an example's report (`measure::Figures` as JSON, with the levels
+/// each group drew) to what every smooth lodkit transition shows: no background where every
+/// level covers, nothing drawn where none does, the levels `drawn`, each pixel changed one way
+/// (flicker against the finest level at most 1.1) and a pop at most `share` of switching at
+/// once (`hard`).
+#[allow(dead_code, reason = "not every test reads a transition")]
+pub fn assert_smooth_transition(
+    name: &str,
+    run: &serde_json::Value,
+    drawn: serde_json::Value,
+    hard: f64,
+    share: f64,
+) {
+    assert_eq!(run["see_through"], 0, "{name}: {run}");
+    assert_eq!(run["ghosts"], 0, "{name}: {run}");
+    assert_eq!(run["drawn"], drawn, "{name}: {run}");
+    let flicker = run["flicker_vs_fine"].as_f64().unwrap();
+    assert!(flicker <= 1.1, "{name}: flicker {flicker}: {run}");
+    let pop = run["pop"].as_f64().unwrap();
+    assert!(
+        pop <= share * hard,
+        "{name}: pop {pop} against switching at once {hard}"
+    );
+}
