@@ -23,9 +23,10 @@
 //! does, for that).
 //!
 //! An impostor level (`lodkit lod --impostor`: a card node whose extras hold `lodkit_impostor`,
-//! the last of the node's levels) is left out with a warning: a frame-sequential group's levels
-//! are meshes (draw impostors with [`ImpostorMaterial`](crate::impostor::ImpostorMaterial)),
-//! and the card alone would show the object's front from every side (edge-on from 90°).
+//! the last of the node's levels) is left out with a warning: the loader does not build an
+//! [`ImpostorMaterial`](crate::impostor::ImpostorMaterial) from the file's atlas yet (the file
+//! holds mip level 0 only), and the card alone would show the object's front from every side
+//! (edge-on from 90°).
 //! The last mesh level is shown in its place, up to where the node is hidden.
 
 use bevy::asset::LoadContext;
@@ -234,9 +235,8 @@ impl MsftLod {
             if !std::mem::replace(&mut self.impostor_warned, true) {
                 warn!(
                     "{}: impostor levels (`lodkit lod --impostor`; the first: node {id}) left \
-                     out: a frame-sequential group's levels are meshes (ImpostorMaterial draws \
-                     impostors); each node's last mesh level is shown up to where the node is \
-                     hidden",
+                     out: the loader does not build an ImpostorMaterial from the file's atlas \
+                     yet; each node's last mesh level is shown up to where the node is hidden",
                     load_context.path()
                 );
             }

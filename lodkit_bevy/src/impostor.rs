@@ -62,6 +62,9 @@ use crate::shaders::LodkitShadersPlugin;
 
 /// The shader of [`ImpostorMaterial`] (`impostor.wesl`).
 const IMPOSTOR_SHADER: Handle<Shader> = uuid_handle!("9a4e61c2-7b3f-4d85-b0e9-2c6f8a1d5e73");
+/// Its prepass and shadow shader (`impostor_prepass.wesl`): draws nothing.
+const IMPOSTOR_PREPASS_SHADER: Handle<Shader> =
+    uuid_handle!("4c8d2e71-9f3a-4b56-a1e0-7d5b3c9f2a84");
 
 /// Registers [`ImpostorMaterial`] (and lodkit's shader modules, where
 /// [`LodkitShadersPlugin`] is not added yet).
@@ -81,6 +84,16 @@ impl Plugin for ImpostorPlugin {
                 Shader::from_wesl(
                     include_str!("impostor.wesl"),
                     "embedded://lodkit_bevy/impostor.wesl",
+                ),
+            )
+            .expect("UUID handles never fail to insert");
+        app.world_mut()
+            .resource_mut::<Assets<Shader>>()
+            .insert(
+                &IMPOSTOR_PREPASS_SHADER,
+                Shader::from_wesl(
+                    include_str!("impostor_prepass.wesl"),
+                    "embedded://lodkit_bevy/impostor_prepass.wesl",
                 ),
             )
             .expect("UUID handles never fail to insert");
@@ -220,7 +233,8 @@ impl ImpostorMaterial {
 
     /// The card every impostor of `layout` is drawn on: two triangles whose positions span the
     /// bounding sphere's box (Bevy's culling and its visibility ranges see the object) and whose
-    /// `UV_0` is the card's corner (-1 or 1 each way; the shader places the card).
+    /// `UV_0` is the card's corner (-1 or 1 each way; the shader places the card). Its normals
+    /// (+z) are there for Bevy's pipelines that ask for them; the shader reads none.
     pub fn card_mesh(layout: &ImpostorLayout) -> Mesh {
         let corners = [
             [-1.0, -1.0],
@@ -245,6 +259,7 @@ impl ImpostorMaterial {
             RenderAssetUsages::RENDER_WORLD,
         )
         .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
+        .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 0.0, 1.0]; 6])
         .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, corners.to_vec())
         .with_inserted_indices(Indices::U16((0..6).collect()))
     }
@@ -299,6 +314,17 @@ impl Material for ImpostorMaterial {
     /// Nor in shadow maps.
     fn enable_shadows() -> bool {
         false
+    }
+
+    /// Where it is drawn there all the same (a level of a frame-sequential group: the level
+    /// material's extension decides), the card draws nothing.
+    fn prepass_vertex_shader() -> ShaderRef {
+        IMPOSTOR_PREPASS_SHADER.into()
+    }
+
+    /// As [`prepass_vertex_shader`](Self::prepass_vertex_shader).
+    fn prepass_fragment_shader() -> ShaderRef {
+        IMPOSTOR_PREPASS_SHADER.into()
     }
 }
 

@@ -83,4 +83,12 @@ fn impostor_material_is_the_last_level_of_a_frame_sequential_group() {
     assert!(hard >= 0.9, "the hard switch pops: {r}");
     let drawn = serde_json::json!([0, 1]);
     support::assert_smooth_transition("group", &r["group"], drawn, hard, 0.35);
+    // With a depth and normal prepass and a light casting shadows the group switches at once
+    // (lodkit_bevy: a level material with a prepass shader of its own), and the card draws
+    // nothing in the prepass: no background where both levels cover (a throwaway edit without
+    // the impostor's prepass shader left Bevy's default one drawing the raw card box into the
+    // depth prepass: 728 see-through pixel-frames).
+    let prepass = &r["group_prepass"];
+    assert_eq!(prepass["see_through"], 0, "{prepass}");
+    assert_eq!(prepass["ghosts"], 0, "{prepass}");
 }

@@ -226,30 +226,44 @@ fn measure_transitions(
     let next = AtomicUsize::new(0);
     let results: Vec<Mutex<Option<Result<_, DemoError>>>> =
         scenes.iter().map(|_| Mutex::new(None)).collect();
+    // The first scene to fail, in time: a scene running beside it may fail because of it (a
+    // lost device), and the first failure is the one to report.
+    let first_failure: Mutex<Option<usize>> = Mutex::new(None);
     std::thread::scope(|s| {
         for _ in 0..workers {
             s.spawn(|| {
                 while let Some(&i) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
                     let result = measure(&scenes[i]);
-                    let failed = result.is_err();
-                    if let Ok(mut slot) = results[i].lock() {
-                        *slot = Some(result);
-                    }
-                    if failed {
+                    if result.is_err() {
                         // The run fails: no other scene starts.
                         next.store(order.len(), Ordering::Relaxed);
+                        let mut first = first_failure
+                            .lock()
+                            .unwrap_or_else(std::sync::PoisonError::into_inner);
+                        first.get_or_insert(i);
                     }
+                    *results[i]
+                        .lock()
+                        .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(result);
                 }
             });
         }
     });
+    let mut results: Vec<Option<Result<_, DemoError>>> = results
+        .into_iter()
+        .map(|slot| {
+            slot.into_inner()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        })
+        .collect();
+    let first = first_failure
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if let Some(Some(Err(e))) = first.and_then(|i| results.get_mut(i)).map(Option::take) {
+        return Err(e);
+    }
     let (mut rows, mut counter) = (Vec::new(), String::new());
-    for slot in results {
-        let result = slot
-            .into_inner()
-            .map_err(|_| DemoError::Internal("a scene's thread panicked".to_owned()))?;
-        // A scene not measured because another failed first: that failure is returned below.
-        let Some(result) = result else { continue };
+    for result in results.into_iter().flatten() {
         let (scene_rows, scene_counter) = result?;
         rows.extend(scene_rows);
         counter = scene_counter;

@@ -13,9 +13,13 @@ use crate::{BACKGROUND, FOV};
 
 /// Where the camera stands and what it draws into.
 pub struct Shot {
+    /// The image the camera draws into.
     pub target: Handle<Image>,
+    /// The camera's position.
     pub eye: Vec3,
+    /// The point it looks at (the bounding sphere's centre).
     pub center: Vec3,
+    /// The near plane's distance.
     pub near: f32,
 }
 
@@ -54,8 +58,11 @@ impl Shot {
 
 /// The mesh alone and the impostor alone from the shot, and which pixels show the tree.
 pub struct References<'a> {
+    /// The mesh alone.
     pub mesh: &'a Frame,
+    /// The impostor alone.
     pub impostor: &'a Frame,
+    /// Which pixels of a frame show the tree.
     pub coverage: &'a dyn Fn(&Frame) -> Vec<bool>,
 }
 

@@ -4,6 +4,7 @@
 //! while the LOD bias ramps across it, held to the mesh alone and the impostor alone seen from
 //! the same camera (`measure::Figures`: pop, flicker, see-through and ghost pixel-frames).
 
+use bevy::core_pipeline::prepass::{DepthPrepass, NormalPrepass};
 use bevy::prelude::*;
 use lodkit::select::{LodGroup, TransitionMode};
 use lodkit_bevy::frame_sequential::{
@@ -19,15 +20,27 @@ use crate::{BACKGROUND, FOV, SIZE};
 /// Frames of the run: the LOD bias ramps from 0.8 to 1.25 over them, across the switch.
 const FRAMES: usize = 56;
 
+/// How a run draws the group.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Run {
+    /// lodkit's default, smooth.
+    Smooth,
+    /// Switching at once (`TransitionMode::Hard`).
+    Hard,
+    /// Smooth, on a camera with Bevy's depth and normal prepass and under a light that casts
+    /// shadows: the card must draw nothing in either.
+    Prepass,
+}
+
 /// Runs the group from the shot's camera (`Msaa::Off`), the mesh from `tree`'s components and
-/// the card from `impostor`'s, switching smoothly (lodkit's default) or at once (`hard`);
-/// returns the figures and the levels drawn, as JSON.
+/// the card from `impostor`'s, as `run` says; returns the figures and the levels drawn, as
+/// JSON.
 pub fn frame_sequential_group(
     app: &mut App,
     shot: &Shot,
     [tree, impostor]: [Entity; 2],
     references: &References,
-    hard: bool,
+    run: Run,
 ) -> Result<serde_json::Value, (u8, String)> {
     let world = app.world_mut();
     let tree = world.entity(tree);
@@ -63,10 +76,24 @@ pub fn frame_sequential_group(
         .id();
     let mut lod = FrameSequentialLod::default();
     lod.settings.bias = 0.8;
-    if hard {
+    if run == Run::Hard {
         lod.settings.transition = TransitionMode::Hard;
     }
     let camera = world.spawn((shot.camera(), lod)).id();
+    let mut spawned = vec![camera, entity];
+    if run == Run::Prepass {
+        world
+            .entity_mut(camera)
+            .insert((DepthPrepass, NormalPrepass));
+        let light = world.spawn((
+            DirectionalLight {
+                shadow_maps_enabled: true,
+                ..default()
+            },
+            Transform::from_xyz(-2.0, 6.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+        spawned.push(light.id());
+    }
     for _ in 0..3 {
         step(app);
     }
@@ -84,8 +111,8 @@ pub fn frame_sequential_group(
             drawn.push(levels.drawn);
         }
     }
-    let frames = finish_readback(app, readback, &[camera, entity], FRAMES, (SIZE, SIZE))
-        .map_err(|e| (1, e))?;
+    let frames =
+        finish_readback(app, readback, &spawned, FRAMES, (SIZE, SIZE)).map_err(|e| (1, e))?;
     let fine = vec![references.mesh.clone(); FRAMES];
     let coarse = vec![references.impostor.clone(); FRAMES];
     let figures = crate::measure::Figures::of(
@@ -98,7 +125,11 @@ pub fn frame_sequential_group(
     .map_err(|e| (1, e.to_string()))?;
     println!(
         "frame-sequential group, mesh -> impostor{}: {}; levels drawn {drawn:?}",
-        if hard { ", switching at once" } else { "" },
+        match run {
+            Run::Smooth => "",
+            Run::Hard => ", switching at once",
+            Run::Prepass => ", with a depth and normal prepass and shadows",
+        },
         figures.line()
     );
     let mut json = figures.json();

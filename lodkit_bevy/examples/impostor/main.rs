@@ -364,8 +364,13 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
     };
     let entities = [tree_entity, impostor_entity];
     let crossfade = crossfade::visibility_range(&mut app, &shot, entities, &references)?;
-    let group = group::frame_sequential_group(&mut app, &shot, entities, &references, false)?;
-    let group_hard = group::frame_sequential_group(&mut app, &shot, entities, &references, true)?;
+    let mut group =
+        |run| group::frame_sequential_group(&mut app, &shot, entities, &references, run);
+    let (smooth, hard, prepass) = (
+        group(group::Run::Smooth)?,
+        group(group::Run::Hard)?,
+        group(group::Run::Prepass)?,
+    );
     println!(
         "switch distance {normalized:.1} (view-normalized), {distance:.2} object units (radius \
          {:.2}); outline distance between mesh and impostor over {} views: worst {:.2} px at it, \
@@ -408,8 +413,9 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
             "crossfade_see_through": crossfade.see_through,
             "crossfade_impostor_kept": crossfade.kept,
             "crossfade_differs_from_mesh": crossfade.differs,
-            "group": group,
-            "group_hard_switch": group_hard,
+            "group": smooth,
+            "group_hard_switch": hard,
+            "group_prepass": prepass,
         });
         let text = serde_json::to_string_pretty(&json).map_err(|e| (2, e.to_string()))?;
         std::fs::write(path, text).map_err(|e| (2, format!("{}: {e}", path.display())))?;
