@@ -42,8 +42,6 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use bevy::asset::RenderAssetUsages;
-use bevy::camera::RenderTarget;
-use bevy::core_pipeline::tonemapping::{DebandDither, Tonemapping};
 use bevy::mesh::{Indices, PrimitiveTopology};
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
@@ -262,30 +260,13 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
             } else {
                 Vec3::Y
             };
-            let camera = app
-                .world_mut()
-                .spawn((
-                    Camera3d::default(),
-                    Camera {
-                        clear_color: ClearColorConfig::Custom(Color::srgb_u8(
-                            BACKGROUND[0],
-                            BACKGROUND[1],
-                            BACKGROUND[2],
-                        )),
-                        ..default()
-                    },
-                    Projection::Perspective(PerspectiveProjection {
-                        fov: FOV.to_radians(),
-                        near: distance * 0.05,
-                        ..default()
-                    }),
-                    RenderTarget::from(target.clone()),
-                    Msaa::Off,
-                    Tonemapping::None,
-                    DebandDither::Disabled,
-                    Transform::from_translation(eye).looking_at(center, up),
-                ))
-                .id();
+            let shot = crossfade::Shot {
+                target: target.clone(),
+                eye,
+                center,
+                near: distance * 0.05,
+            };
+            let camera = app.world_mut().spawn(shot.camera()).id();
             let wall = wall.then(|| {
                 let at = center + view * (WALL_AHEAD * radius);
                 app.world_mut()
@@ -331,17 +312,13 @@ fn run(out: &Path, report: Option<&Path>) -> Result<(), (u8, String)> {
             .entity_mut(entity)
             .insert(Visibility::Visible);
     }
-    let warm_up = app
-        .world_mut()
-        .spawn((
-            Camera3d::default(),
-            RenderTarget::from(target.clone()),
-            Msaa::Off,
-            Tonemapping::None,
-            DebandDither::Disabled,
-            Transform::from_translation(center + Vec3::Z * distance).looking_at(center, Vec3::Y),
-        ))
-        .id();
+    let warm_up = crossfade::Shot {
+        target: target.clone(),
+        eye: center + Vec3::Z * distance,
+        center,
+        near: distance * 0.05,
+    };
+    let warm_up = app.world_mut().spawn(warm_up.camera()).id();
     for _ in 0..4 {
         headless::step(&mut app);
     }
