@@ -281,7 +281,9 @@ impl LodChainLevel {
     pub fn simplifier_error(&self) -> f32 {
         self.simplifier_error
     }
-    /// Time taken to make this level: simplifying, measuring its bound and compacting it.
+    /// Time taken to make this level: simplifying, measuring its bound and compacting it (wall
+    /// clock; a level's bound runs while the next level is simplified, so the levels' times
+    /// overlap).
     pub fn time(&self) -> std::time::Duration {
         self.time
     }

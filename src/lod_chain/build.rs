@@ -71,61 +71,86 @@ pub(super) fn build(
     )];
     let mut current = mesh.indices.to_vec();
     let mut sloppy = false;
-    for i in 1..descriptor.levels {
-        let started = std::time::Instant::now();
-        let target = ((triangles as f64) * f64::from(descriptor.ratio).powi(i as i32))
-            .round()
-            .max(1.0) as usize;
-        let mut result_error = 0.0f32;
-        let mut simplifier = Simplifier::Regular;
-        let mut indices = Vec::new();
-        if !sloppy {
-            indices = meshopt::simplify_with_attributes_and_locks_decoder(
-                &current,
-                positions,
-                &attributes,
-                if weights.is_empty() { &[] } else { &weights },
-                stride * std::mem::size_of::<f32>(),
-                &locks,
-                target * 3,
-                descriptor.max_relative_error,
-                options,
-                Some(&mut result_error),
-            );
-            sloppy =
-                descriptor.sloppy_fallback && (indices.len() / 3) as f64 > target as f64 * STALL;
+    std::thread::scope(|scope| {
+        // The original's R-tree, which every level's bound searches, is built on another core
+        // while the first level is simplified; each level's bound runs while the next level is
+        // simplified (meshoptimizer's simplifier uses one core), one bound at a time (each
+        // holds its level's surface and R-tree).
+        let original = &original;
+        if descriptor.levels > 1 {
+            scope.spawn(move || original.index());
         }
-        if sloppy {
-            let sloppy_locks: Vec<bool> = locks
-                .iter()
-                .map(|l| l.contains(SimplifyVertex::Lock))
-                .collect();
-            let mut sloppy_error = 0.0f32;
-            let candidate = meshopt::simplify_sloppy_with_locks_decoder(
-                &current,
-                positions,
-                &sloppy_locks,
-                target * 3,
-                descriptor.max_relative_error,
-                Some(&mut sloppy_error),
-            );
-            if indices.is_empty() || (!candidate.is_empty() && candidate.len() < indices.len()) {
-                indices = candidate;
-                result_error = sloppy_error;
-                simplifier = Simplifier::Sloppy;
+        let mut bounding: Option<std::thread::ScopedJoinHandle<LodChainLevel>> = None;
+        for i in 1..descriptor.levels {
+            let started = std::time::Instant::now();
+            let target = ((triangles as f64) * f64::from(descriptor.ratio).powi(i as i32))
+                .round()
+                .max(1.0) as usize;
+            let mut result_error = 0.0f32;
+            let mut simplifier = Simplifier::Regular;
+            let mut indices = Vec::new();
+            if !sloppy {
+                indices = meshopt::simplify_with_attributes_and_locks_decoder(
+                    &current,
+                    positions,
+                    &attributes,
+                    if weights.is_empty() { &[] } else { &weights },
+                    stride * std::mem::size_of::<f32>(),
+                    &locks,
+                    target * 3,
+                    descriptor.max_relative_error,
+                    options,
+                    Some(&mut result_error),
+                );
+                sloppy = descriptor.sloppy_fallback
+                    && (indices.len() / 3) as f64 > target as f64 * STALL;
             }
+            if sloppy {
+                let sloppy_locks: Vec<bool> = locks
+                    .iter()
+                    .map(|l| l.contains(SimplifyVertex::Lock))
+                    .collect();
+                let mut sloppy_error = 0.0f32;
+                let candidate = meshopt::simplify_sloppy_with_locks_decoder(
+                    &current,
+                    positions,
+                    &sloppy_locks,
+                    target * 3,
+                    descriptor.max_relative_error,
+                    Some(&mut sloppy_error),
+                );
+                if indices.is_empty() || (!candidate.is_empty() && candidate.len() < indices.len())
+                {
+                    indices = candidate;
+                    result_error = sloppy_error;
+                    simplifier = Simplifier::Sloppy;
+                }
+            }
+            let fewer = (indices.len() as f64) <= current.len() as f64 * MIN_REDUCTION;
+            if indices.is_empty() || !fewer {
+                break;
+            }
+            if let Some(previous) = bounding.take() {
+                levels.push(
+                    previous
+                        .join()
+                        .unwrap_or_else(|e| std::panic::resume_unwind(e)),
+                );
+            }
+            let level = indices.clone();
+            bounding = Some(scope.spawn(move || {
+                let (error, capped) = level_bound(original, &level, tolerance);
+                let mut level = make_level(mesh, &level, error, simplifier, result_error * scale);
+                level.error_capped = capped;
+                level.time = started.elapsed();
+                level
+            }));
+            current = indices;
         }
-        let fewer = (indices.len() as f64) <= current.len() as f64 * MIN_REDUCTION;
-        if indices.is_empty() || !fewer {
-            break;
+        if let Some(last) = bounding {
+            levels.push(last.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
         }
-        let (error, capped) = level_bound(positions, mesh.indices, &original, &indices, tolerance);
-        let mut level = make_level(mesh, &indices, error, simplifier, result_error * scale);
-        level.error_capped = capped;
-        level.time = started.elapsed();
-        levels.push(level);
-        current = indices;
-    }
+    });
     if levels.len() == 1 && descriptor.levels > 1 && descriptor.small_mesh == SmallMesh::Error {
         return Err(LodChainError::TooSmall { triangles });
     }
@@ -138,17 +163,22 @@ pub(super) fn build(
 
 /// Upper bound of the two-sided Hausdorff distance between the original and `level` (both index
 /// the same vertex buffer), and whether its work was capped (a looser upper bound).
-fn level_bound(
-    positions: &[[f32; 3]],
-    original_indices: &[u32],
-    original: &Surface,
-    level: &[u32],
-    tolerance: Tolerance,
-) -> (f32, bool) {
+fn level_bound(original: &Surface, level: &[u32], tolerance: Tolerance) -> (f32, bool) {
     let capped_before = original.capped();
-    let to_original = directed_bound(positions, level, original, tolerance);
-    let simplified = Surface::new(positions, level);
-    let to_level = directed_bound(positions, original_indices, &simplified, tolerance);
+    let simplified = Surface::new(original.positions(), level);
+    // The level's R-tree (for the second direction's exact searches) is built on another core
+    // while the first direction runs.
+    let (to_original, to_level) = std::thread::scope(|scope| {
+        let indexing = scope.spawn(|| simplified.index());
+        let to_original = directed_bound(&simplified, original, tolerance);
+        indexing
+            .join()
+            .unwrap_or_else(|e| std::panic::resume_unwind(e));
+        (
+            to_original,
+            directed_bound(original, &simplified, tolerance),
+        )
+    });
     let capped = original.capped() > capped_before || simplified.capped() > 0;
     (round_up_f32(to_original.max(to_level)), capped)
 }

@@ -13,64 +13,33 @@
 //! - **Partition** ([`partition`]): `Q` cut into convex pieces along the outlines of the target
 //!   triangles under it, each piece bounded by the convex bound of the triangle over it.
 //!
-//! [`directed_bound`] evaluates `f` at every vertex of the source (the largest value found, `lb`,
-//! is a lower bound of the supremum), then bounds every source triangle with the cheapest of
-//! these that is within the tolerance of `lb`: Lipschitz and convex first, then the partition
-//! among the nearest triangles of its corners, then the partition among every target triangle
-//! near it. The triangles still above the tolerance are looked at again, largest bound first:
-//! `f` at the point where the bound is reached often raises `lb` to it; the rest are refined
-//! ([`refine`]: cut at the edge midpoints, each piece bounded again). The result is the largest
-//! bound over all triangles: an upper bound whatever the cuts and candidates, which only decide
-//! how tight it is (at most `lb + tolerance` above the largest distance found unless a piece
-//! reaches the depth limit; then still an upper bound, only a looser one). Distances are
-//! computed in f64 from the f32 positions; the caller rounds up.
+//! [`directed_bound`] bounds `f` at every vertex of the source from above by walking the target's
+//! connectivity from the target vertex nearest to it along the source's edges ([`walk`]; the
+//! levels of a chain keep a subset of the original's vertices), and at the centroid of every
+//! triangle whose corners are all on the target. The largest of these are searched exactly (an
+//! R-tree) until the rest are no larger than the largest exact distance found, `lb`, a lower
+//! bound of the supremum. Every source triangle is then bounded by the cheapest of the bounds
+//! above that is within the tolerance of `lb`: Lipschitz and convex first (with the upper
+//! bounds at the corners, which both allow), then the partition among the target triangles
+//! connected to its corners' and centroid's nearest ones under it, then the partition among
+//! every target triangle near it. The triangles still above the tolerance are looked at again,
+//! largest bound first: `f` at the point where the bound is reached often raises `lb` to it;
+//! the rest are refined ([`refine`]: cut at the edge midpoints, each piece bounded again). The
+//! result is the largest bound over all triangles: an upper bound whatever the walks, cuts and
+//! candidates, which only decide how tight it is (at most `lb + tolerance` above the largest
+//! distance found unless a piece reaches the depth limit; then still an upper bound, only a
+//! looser one). Distances are computed in f64 from the f32 positions; the caller rounds up.
 
 mod partition;
 mod refine;
+mod surface;
+mod walk;
 
 use glam::DVec3;
-use rstar::{AABB, PointDistance, RTree, RTreeObject};
 
-/// A triangle of the target surface in the R-tree.
-#[derive(Clone)]
-struct Tri {
-    a: DVec3,
-    b: DVec3,
-    c: DVec3,
-    envelope: AABB<[f64; 3]>,
-}
-
-impl Tri {
-    fn distance(&self, p: DVec3) -> f64 {
-        self.distance2(p).sqrt()
-    }
-
-    fn distance2(&self, p: DVec3) -> f64 {
-        point_triangle_distance2(p, self.a, self.b, self.c)
-    }
-}
-
-impl RTreeObject for Tri {
-    type Envelope = AABB<[f64; 3]>;
-    fn envelope(&self) -> Self::Envelope {
-        self.envelope
-    }
-}
-
-impl PointDistance for Tri {
-    fn distance_2(&self, point: &[f64; 3]) -> f64 {
-        point_triangle_distance2(DVec3::from_array(*point), self.a, self.b, self.c)
-    }
-
-    /// The box's distance first: most triangles a search visits are farther than that already.
-    fn distance_2_if_less_or_equal(&self, point: &[f64; 3], max_distance_2: f64) -> Option<f64> {
-        if self.envelope.distance_2(point) > max_distance_2 {
-            return None;
-        }
-        let d = self.distance_2(point);
-        (d <= max_distance_2).then_some(d)
-    }
-}
+pub(crate) use surface::Surface;
+use surface::{Corners, Sample, query_box};
+use walk::Found;
 
 /// Squared distance from `p` to the segment `a`-`b` (a point when `a == b`).
 fn point_segment_distance2(p: DVec3, a: DVec3, b: DVec3) -> f64 {
@@ -84,183 +53,50 @@ fn point_segment_distance2(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     (a + ab * t - p).length_squared()
 }
 
-/// Squared distance from `p` to the closed triangle `a b c`; a degenerate triangle (collinear or
-/// coincident corners) is the union of its edges.
+/// Squared distance from `p` to the closed triangle `a b c`: Ericson's Voronoi-region test
+/// ("Real-Time Collision Detection", 5.1.5), corners and edges first, the face last. A
+/// degenerate triangle (collinear or coincident corners, or so nearly that its squared cross
+/// product is below 1e-10 of the product of its sides' squares, where rounding decides the
+/// face's test) is the union of its edges: the two differ by at most its width, below 1e-5 of
+/// its sides.
 pub(crate) fn point_triangle_distance2(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let n = (b - a).cross(c - a);
-    let nn = n.length_squared();
-    if nn > 0.0 {
-        let inside = (b - a).cross(p - a).dot(n) >= 0.0
-            && (c - b).cross(p - b).dot(n) >= 0.0
-            && (a - c).cross(p - c).dot(n) >= 0.0;
-        if inside {
-            let h = (p - a).dot(n);
-            return h * h / nn;
-        }
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.length_squared();
     }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length_squared();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 > d3 {
+        return (ap - ab * (d1 / (d1 - d3))).length_squared();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length_squared();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 > d6 {
+        return (ap - ac * (d2 / (d2 - d6))).length_squared();
+    }
+    let va = d3 * d6 - d5 * d4;
+    let (e, f) = (d4 - d3, d5 - d6);
+    if va <= 0.0 && e >= 0.0 && f >= 0.0 && e + f > 0.0 {
+        return (bp - (c - b) * (e / (e + f))).length_squared();
+    }
+    let area = va + vb + vc;
+    let flat = ab.cross(ac).length_squared() <= 1e-10 * ab.length_squared() * ac.length_squared();
+    if !flat && area > 0.0 && va >= 0.0 && vb >= 0.0 && vc >= 0.0 {
+        return (ap - ab * (vb / area) - ac * (vc / area)).length_squared();
+    }
+    // Degenerate, or no region held within rounding: the nearest point is on an edge.
     point_segment_distance2(p, a, b)
         .min(point_segment_distance2(p, b, c))
         .min(point_segment_distance2(p, c, a))
-}
-
-/// A vertex of the target surface and one triangle it is a corner of: the nearest vertex's
-/// triangle is an upper bound of the distance that costs no more on slivers than elsewhere.
-struct Corner {
-    at: [f64; 3],
-    tri: Tri,
-}
-
-impl RTreeObject for Corner {
-    type Envelope = AABB<[f64; 3]>;
-    fn envelope(&self) -> Self::Envelope {
-        AABB::from_point(self.at)
-    }
-}
-
-impl PointDistance for Corner {
-    fn distance_2(&self, point: &[f64; 3]) -> f64 {
-        DVec3::from(self.at).distance_squared(DVec3::from(*point))
-    }
-}
-
-/// The most triangle boxes a point may lie in for the exact nearest-triangle search: past it
-/// (long slivers spanning the mesh: a triangle list read as a fan, positions read from the
-/// wrong place) the search would weigh much of the mesh for every point, and the distance is
-/// bounded instead by the nearest vertex's triangle and the first of those boxes' triangles
-/// (an upper bound still; the bound is then reported as capped).
-const NEAREST_OVERLAP: usize = 64;
-
-/// A triangle mesh to measure distances to.
-pub(crate) struct Surface {
-    tree: RTree<Tri>,
-    /// Each vertex used, with a triangle it is a corner of.
-    corners: RTree<Corner>,
-    /// Which vertices the triangles use (`d = 0` there).
-    vertices: Vec<bool>,
-    /// Distances bounded rather than found ([`NEAREST_OVERLAP`]), and bounds whose budget ran
-    /// out ([`BUDGET_PER_TRIANGLE`]): the work capped on this surface so far.
-    capped: std::sync::atomic::AtomicUsize,
-}
-
-impl Surface {
-    /// The triangles `indices` of `positions` (indices already checked).
-    pub(crate) fn new(positions: &[[f32; 3]], indices: &[u32]) -> Self {
-        let p = |i: u32| DVec3::from(positions[i as usize].map(f64::from));
-        let tris: Vec<Tri> = indices
-            .chunks_exact(3)
-            .map(|t| {
-                let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-                Tri {
-                    a,
-                    b,
-                    c,
-                    envelope: AABB::from_corners(lo.to_array(), hi.to_array()),
-                }
-            })
-            .collect();
-        let mut vertices = vec![false; positions.len()];
-        let mut corners = Vec::new();
-        for (t, tri) in indices.chunks_exact(3).zip(&tris) {
-            for &i in t {
-                if !std::mem::replace(&mut vertices[i as usize], true) {
-                    corners.push(Corner {
-                        at: p(i).to_array(),
-                        tri: tri.clone(),
-                    });
-                }
-            }
-        }
-        Surface {
-            tree: RTree::bulk_load(tris),
-            corners: RTree::bulk_load(corners),
-            vertices,
-            capped: std::sync::atomic::AtomicUsize::new(0),
-        }
-    }
-
-    /// How much work was capped on this surface so far (see the field).
-    pub(crate) fn capped(&self) -> usize {
-        self.capped.load(std::sync::atomic::Ordering::Relaxed)
-    }
-
-    pub(super) fn note_capped(&self) {
-        self.capped
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    }
-
-    /// Its number of triangles.
-    fn triangles(&self) -> usize {
-        self.tree.size()
-    }
-
-    /// Whether a triangle of the surface has vertex `v` of the shared positions.
-    fn has_vertex(&self, v: u32) -> bool {
-        self.vertices.get(v as usize).copied().unwrap_or(false)
-    }
-
-    /// The triangles whose bounding boxes meet the box of the triangle `s` moved by up to
-    /// `margin` along its normal either way (the target triangles within `margin` of `s`'s
-    /// plane that are over or under it), in no order.
-    fn candidates(&self, s: &[DVec3; 3], margin: f64) -> impl Iterator<Item = &Tri> {
-        let n = (s[1] - s[0]).cross(s[2] - s[0]).normalize_or_zero();
-        let grow = if n == DVec3::ZERO {
-            DVec3::splat(margin)
-        } else {
-            n.abs() * margin
-        } + DVec3::splat(longest_side(s) * 1e-9);
-        let lo = s[0].min(s[1]).min(s[2]) - grow;
-        let hi = s[0].max(s[1]).max(s[2]) + grow;
-        self.tree
-            .locate_in_envelope_intersecting(&AABB::from_corners(lo.to_array(), hi.to_array()))
-    }
-
-    /// Distance from `p` to the surface and the nearest triangle (+inf and `None` for an empty
-    /// surface).
-    /// Where the boxes of more than [`NEAREST_OVERLAP`] triangles hold `p`, an upper bound of
-    /// that distance and a triangle at most that far (noted as capped).
-    fn nearest(&self, p: DVec3) -> Sample<'_> {
-        let point = AABB::from_point(p.to_array());
-        let overlap = self
-            .tree
-            .locate_in_envelope_intersecting(&point)
-            .take(NEAREST_OVERLAP + 1)
-            .count();
-        let found = if overlap <= NEAREST_OVERLAP {
-            self.tree.nearest_neighbor(&p.to_array())
-        } else {
-            self.note_capped();
-            let corner = self.corners.nearest_neighbor(&p.to_array()).map(|c| &c.tri);
-            corner
-                .into_iter()
-                .chain(
-                    self.tree
-                        .locate_in_envelope_intersecting(&point)
-                        .take(NEAREST_OVERLAP),
-                )
-                .min_by(|a, b| a.distance2(p).total_cmp(&b.distance2(p)))
-        };
-        match found {
-            Some(t) => Sample {
-                at: p,
-                distance: t.distance(p),
-                nearest: Some(t),
-            },
-            None => Sample {
-                at: p,
-                distance: f64::INFINITY,
-                nearest: None,
-            },
-        }
-    }
-}
-
-/// A point where `f` was evaluated.
-#[derive(Clone, Copy)]
-struct Sample<'a> {
-    at: DVec3,
-    distance: f64,
-    nearest: Option<&'a Tri>,
 }
 
 /// When a piece of a triangle is refined no further.
@@ -292,6 +128,9 @@ const MARGIN: f64 = 0.05;
 /// looser) and nothing is refined further; the surface notes the bound as capped.
 const BUDGET_PER_TRIANGLE: u64 = 64;
 
+/// The most target triangles a flood gathers for one source triangle's partition.
+const FLOOD_LIMIT: usize = 256;
+
 /// What is left of a bound's budget of candidate triangles ([`BUDGET_PER_TRIANGLE`]).
 struct Budget(std::sync::atomic::AtomicU64);
 
@@ -302,33 +141,55 @@ impl Budget {
         ))
     }
 
-    /// The candidates of `target` for `s` ([`Surface::candidates`]), taken from the budget;
-    /// None when the budget has fewer left (the query stops there, so an exhausted budget costs
-    /// no more than it has left).
-    fn candidates<'a>(
-        &self,
-        target: &'a Surface,
-        s: &[DVec3; 3],
-        margin: f64,
-    ) -> Option<Vec<&'a Tri>> {
+    /// Takes `n` candidates from the budget; false (and the budget emptied) when it has fewer.
+    fn take(&self, n: u64) -> bool {
         use std::sync::atomic::Ordering::Relaxed;
-        let left = self.0.load(Relaxed);
-        let limit = usize::try_from(left).unwrap_or(usize::MAX);
-        let found: Vec<&Tri> = target
-            .candidates(s, margin)
-            .take(limit.saturating_add(1))
-            .collect();
-        let n = found.len() as u64;
         match self
             .0
             .fetch_update(Relaxed, Relaxed, |left| left.checked_sub(n))
         {
-            Ok(_) => Some(found),
+            Ok(_) => true,
             Err(_) => {
                 self.0.store(0, Relaxed);
-                None
+                false
             }
         }
+    }
+
+    /// The candidates of `target` for `s` ([`Surface::candidates`]), taken from the budget;
+    /// None when the budget has fewer left (the query stops there, so an exhausted budget costs
+    /// no more than it has left).
+    fn candidates(&self, target: &Surface, s: &Corners, margin: f64) -> Option<Vec<Corners>> {
+        let limit = usize::try_from(self.left()).unwrap_or(usize::MAX);
+        let found: Vec<Corners> = target
+            .candidates(s, margin)
+            .take(limit.saturating_add(1))
+            .map(|t| t.corners)
+            .collect();
+        self.take(found.len() as u64).then_some(found)
+    }
+
+    /// The target triangles connected to `seeds` that can cut `s`'s partition
+    /// ([`partition::Under`], [`Surface::flood`]), taken from the budget; None past
+    /// [`FLOOD_LIMIT`] or the budget.
+    fn flood(
+        &self,
+        target: &Surface,
+        seeds: &[u32],
+        s: &Corners,
+        margin: f64,
+    ) -> Option<Vec<Corners>> {
+        let found = match partition::Under::new(s, margin) {
+            Some(under) => {
+                target.flood(seeds, |t| under.holds(&target.corners_of(t)), FLOOD_LIMIT)?
+            }
+            None => {
+                let (lo, hi) = query_box(s, margin);
+                target.flood(seeds, |t| target.meets(t, lo, hi), FLOOD_LIMIT)?
+            }
+        };
+        self.take(found.len() as u64)
+            .then(|| found.iter().map(|&t| target.corners_of(t)).collect())
     }
 
     fn left(&self) -> u64 {
@@ -340,112 +201,90 @@ impl Budget {
     }
 }
 
-/// Upper bound of `sup_{x in source} d(x, target)` over the triangles `indices` of `positions`
-/// (which the target indexes too).
-pub(crate) fn directed_bound(
-    positions: &[[f32; 3]],
-    indices: &[u32],
-    target: &Surface,
-    tolerance: Tolerance,
-) -> f64 {
-    directed_bound_within(positions, indices, target, tolerance, BUDGET_PER_TRIANGLE)
+/// Upper bound of `sup_{x in source} d(x, target)` (the two surfaces index the same
+/// positions).
+pub(crate) fn directed_bound(source: &Surface, target: &Surface, tolerance: Tolerance) -> f64 {
+    directed_bound_within(source, target, tolerance, BUDGET_PER_TRIANGLE)
 }
 
 /// [`directed_bound`] with `per_triangle` candidates of budget per triangle.
 pub(crate) fn directed_bound_within(
-    positions: &[[f32; 3]],
-    indices: &[u32],
+    source: &Surface,
     target: &Surface,
     tolerance: Tolerance,
     per_triangle: u64,
 ) -> f64 {
-    let p = |i: u32| DVec3::from(positions[i as usize].map(f64::from));
-    let budget = Budget::new(per_triangle, indices.len() / 3 + target.triangles());
-    // f at every vertex the source uses (with the nearest triangle): zero at the target's own
-    // vertices.
-    let mut used: Vec<u32> = indices.to_vec();
-    used.sort_unstable();
-    used.dedup();
-    let samples = parallel_map(&used, |&v| {
-        if target.has_vertex(v) {
-            (0.0, None)
-        } else {
-            let s = target.nearest(p(v));
-            (s.distance, s.nearest)
-        }
-    });
-    let mut at_vertex = vec![(0.0, None); positions.len()];
-    for (&v, &s) in used.iter().zip(&samples) {
-        at_vertex[v as usize] = s;
-    }
-    let triangles: Vec<[u32; 3]> = indices
-        .chunks_exact(3)
-        .map(|t| [t[0], t[1], t[2]])
-        .collect();
-    // f at the centroid of every triangle whose corners are all on the target (no nearest
-    // triangle to start from): with the vertices, a lower bound close to the supremum before
-    // any triangle is bounded.
-    let centres = parallel_map(&triangles, |t| {
-        t.iter()
-            .all(|&v| at_vertex[v as usize].1.is_none())
-            .then(|| target.nearest((p(t[0]) + p(t[1]) + p(t[2])) / 3.0))
-    });
-    let mut lb = samples
-        .iter()
-        .map(|s| s.0)
-        .chain(centres.iter().flatten().map(|s| s.distance))
-        .fold(0.0, f64::max);
+    let budget = Budget::new(per_triangle, source.triangles() + target.triangles());
+    // f at every vertex of the source (zero at the target's own vertices), and at the centroid
+    // of every triangle whose corners are all on the target (which say nothing of it): walked,
+    // upper bounds; the largest of them searched exactly for the lower bound `lb`.
+    let mut at_vertex = walk::vertex_samples(source, target);
+    let mut centres = walk::centre_samples(source, target);
+    let mut lb = walk::exact_lower_bound(source, target, &mut at_vertex, &mut centres);
     // Every triangle's bound: the cheap ones where they are within the tolerance already, the
-    // partition among the nearest triangles of its corners (or centroid) where not, and among
-    // all the target triangles near it where that is not enough.
-    let work: Vec<([u32; 3], Option<Sample>)> = triangles.iter().copied().zip(centres).collect();
+    // partition among the target triangles connected to the nearest ones under it where not,
+    // and among all the target triangles near it where that is not enough.
+    let ids: Vec<u32> = (0..source.triangles() as u32).collect();
     let accept = lb + tolerance.slack(lb);
-    let first = parallel_map(&work, |(t, centre)| {
-        let corners = t.map(p);
-        let f = t.map(|v| at_vertex[v as usize].0);
-        let mut near: Vec<&Tri> = Vec::with_capacity(3);
-        for n in t
-            .iter()
-            .filter_map(|&v| at_vertex[v as usize].1)
-            .chain(centre.and_then(|c| c.nearest))
-        {
-            if !near.iter().any(|&m| std::ptr::eq(m, n)) {
+    let first = parallel_map(&ids, |&k| {
+        let t = source.triangle(k);
+        let corners = t.map(|v| source.point(v));
+        let f: [Found; 3] = t.map(|v| at_vertex[v as usize]);
+        let centre = centres[k as usize];
+        let mut near: Vec<u32> = Vec::with_capacity(4);
+        for n in f.iter().chain(&centre).filter_map(|s| s.nearest) {
+            if !near.contains(&n) {
                 near.push(n);
             }
         }
         let longest = longest_side(&corners);
-        let lipschitz = f[0].max(f[1]).max(f[2]) + longest / 3f64.sqrt();
+        let local = f[0]
+            .distance
+            .max(f[1].distance)
+            .max(f[2].distance)
+            .max(centre.map_or(0.0, |c| c.distance));
+        let lipschitz = f[0].distance.max(f[1].distance).max(f[2].distance) + longest / 3f64.sqrt();
         let convex = near
             .iter()
-            .map(|n| corners.iter().map(|&x| n.distance(x)).fold(0.0, f64::max))
+            .map(|&n| {
+                corners
+                    .iter()
+                    .map(|&x| target.distance2_to(n, x))
+                    .fold(0.0, f64::max)
+                    .sqrt()
+            })
             .fold(f64::INFINITY, f64::min);
         let mut best = (lipschitz.min(convex), None);
         if best.0 <= accept {
             return best;
         }
-        if near.len() > 1
-            && let Some(b) = partition::partition_bound(corners, &near)
-            && b.bound < best.0
-        {
-            best = (b.bound, Some(b.at));
-            if b.bound <= accept {
-                return best;
+        let margin = 2.0 * local + MARGIN * longest;
+        for stage in 0..3 {
+            let candidates = match stage {
+                0 if near.len() > 1 => Some(near.iter().map(|&n| target.corners_of(n)).collect()),
+                0 => continue,
+                1 => budget.flood(target, &near, &corners, margin),
+                _ => budget.candidates(target, &corners, margin),
+            };
+            let Some(candidates) = candidates else {
+                if budget.exhausted() {
+                    target.note_capped();
+                    return best;
+                }
+                continue;
+            };
+            if let Some(b) = partition::partition_bound(corners, &candidates)
+                && b.bound < best.0
+            {
+                best = (b.bound, Some(b.at));
+                if b.bound <= accept {
+                    return best;
+                }
             }
         }
-        let local = f[0]
-            .max(f[1])
-            .max(f[2])
-            .max(centre.map_or(0.0, |c| c.distance));
-        let Some(candidates) = budget.candidates(target, &corners, 2.0 * local + MARGIN * longest)
-        else {
-            target.note_capped();
-            return best;
-        };
-        match partition::partition_bound(corners, &candidates) {
-            Some(b) if b.bound < best.0 => (b.bound, Some(b.at)),
-            _ => best,
-        }
+        best
     });
+
     // Branch and bound: only a triangle whose bound is above the tolerance of the largest
     // distance found so far is looked at again, largest first.
     let mut reported = lb;
@@ -479,7 +318,9 @@ pub(crate) fn directed_bound_within(
                 continue;
             }
         }
-        let corners = triangles[k].map(|v| target.nearest(p(v)));
+        let corners = source
+            .triangle(k as u32)
+            .map(|v| target.nearest(source.point(v)));
         let refined = refine::refine(target, corners, 0, &mut lb, tolerance, &budget);
         reported = reported.max(refined.min(bound));
     }
@@ -571,6 +412,6 @@ mod tests {
             relative: 0.05,
             absolute: 1e-5,
         };
-        assert!(directed_bound(&p, &idx, &s, tolerance) < 1e-12);
+        assert!(directed_bound(&s, &s, tolerance) < 1e-12);
     }
 }

@@ -13,7 +13,8 @@
 
 use glam::{DVec2, DVec3};
 
-use super::Tri;
+use super::point_triangle_distance2;
+use super::surface::Corners;
 
 /// Most corners a piece may have (a triangle cut by a few lines); a piece that would need more
 /// gives the partition up ([`partition_bound`] returns `None`).
@@ -42,11 +43,72 @@ impl Frame {
     }
 }
 
+/// Which target triangles can cut a source triangle's partition: those within `margin` of its
+/// plane whose projections overlap its own (the candidates a flood keeps).
+pub(super) struct Under {
+    frame: Frame,
+    normal: DVec3,
+    whole: Piece,
+    lo: DVec2,
+    hi: DVec2,
+    margin: f64,
+}
+
+impl Under {
+    /// `None` for a triangle of zero area (no plane).
+    pub(super) fn new(s: &Corners, margin: f64) -> Option<Under> {
+        let normal = (s[1] - s[0]).cross(s[2] - s[0]);
+        if normal.length_squared() == 0.0 {
+            return None;
+        }
+        let normal = normal.normalize();
+        let u = (s[1] - s[0]).normalize();
+        let frame = Frame {
+            origin: s[0],
+            u,
+            w: normal.cross(u),
+        };
+        let q = s.map(|p| frame.to_plane(p));
+        let grow = DVec2::splat(FLAT * super::longest_side(s));
+        let mut whole = Piece::new();
+        for c in q {
+            whole.push(c).ok()?;
+        }
+        Some(Under {
+            lo: q[0].min(q[1]).min(q[2]) - grow,
+            hi: q[0].max(q[1]).max(q[2]) + grow,
+            frame,
+            normal,
+            whole,
+            margin,
+        })
+    }
+
+    /// Whether the triangle `t` is within the margin of the plane, over or under the triangle
+    /// (its projection overlapping the triangle's; one of zero area, its box meeting the
+    /// triangle's).
+    pub(super) fn holds(&self, t: &Corners) -> bool {
+        let h = t.map(|p| (p - self.frame.origin).dot(self.normal));
+        if h[0].min(h[1]).min(h[2]) > self.margin || h[0].max(h[1]).max(h[2]) < -self.margin {
+            return false;
+        }
+        let (q, area) = project(&self.frame, t);
+        let (lo, hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+        if lo.cmpgt(self.hi).any() || hi.cmplt(self.lo).any() {
+            return false;
+        }
+        area == 0.0 || overlaps(&self.whole, &q, 0.0)
+    }
+}
+
 /// A convex piece of `S`, counter-clockwise in plane coordinates.
 #[derive(Clone, Copy)]
 struct Piece {
     len: usize,
     corners: [DVec2; MAX_CORNERS],
+    /// The corners' box (a candidate whose box is apart is not weighed further).
+    lo: DVec2,
+    hi: DVec2,
 }
 
 impl Piece {
@@ -54,6 +116,8 @@ impl Piece {
         Piece {
             len: 0,
             corners: [DVec2::ZERO; MAX_CORNERS],
+            lo: DVec2::INFINITY,
+            hi: DVec2::NEG_INFINITY,
         }
     }
 
@@ -64,16 +128,18 @@ impl Piece {
     fn push(&mut self, c: DVec2) -> Result<(), Overflow> {
         *self.corners.get_mut(self.len).ok_or(Overflow)? = c;
         self.len += 1;
+        self.lo = self.lo.min(c);
+        self.hi = self.hi.max(c);
         Ok(())
     }
 
     /// Largest squared distance from the piece's corners to `t`, and the corner where it is.
-    fn bound(&self, frame: &Frame, t: &Tri) -> (f64, DVec3) {
+    fn bound(&self, frame: &Frame, t: &Corners) -> (f64, DVec3) {
         self.corners()
             .iter()
             .map(|&c| {
                 let x = frame.to_space(c);
-                (t.distance2(x), x)
+                (point_triangle_distance2(x, t[0], t[1], t[2]), x)
             })
             .fold((-1.0, DVec3::ZERO), |a, b| if b.0 > a.0 { b } else { a })
     }
@@ -130,6 +196,17 @@ fn cut(
     Ok((inside.nonempty(), outside.nonempty()))
 }
 
+/// `t`'s corners in `frame`'s plane, counter-clockwise, and twice its projected area (zero for
+/// a segment or a point).
+fn project(frame: &Frame, t: &Corners) -> ([DVec2; 3], f64) {
+    let mut q = t.map(|p| frame.to_plane(p));
+    let area = cross(q[0], q[1], q[2]);
+    if area < 0.0 {
+        q.swap(1, 2);
+    }
+    (q, area.abs())
+}
+
 /// `(b - a) x (p - a)`: positive when `p` is left of the line from `a` to `b`.
 fn cross(a: DVec2, b: DVec2, p: DVec2) -> f64 {
     (b - a).perp_dot(p - a)
@@ -168,13 +245,13 @@ pub(super) struct PartitionBound {
 
 /// A candidate projected onto `S`'s plane: its distance from the plane (at its centroid), its
 /// corners counter-clockwise in the plane, and the triangle.
-type Projected<'a> = (f64, [DVec2; 3], &'a Tri);
+type Projected<'a> = (f64, [DVec2; 3], &'a Corners);
 
 /// Upper bound of `sup_{x in S} d(x, target)` for the triangle `s`, from `candidates` (target
 /// triangles, any order: those nearest to `S`'s plane cut first). `None` when a piece needs too
 /// many corners or a left-over piece has no candidate to bound it; the caller then bounds `S`
 /// another way.
-pub(super) fn partition_bound(s: [DVec3; 3], candidates: &[&Tri]) -> Option<PartitionBound> {
+pub(super) fn partition_bound(s: Corners, candidates: &[Corners]) -> Option<PartitionBound> {
     let normal = (s[1] - s[0]).cross(s[2] - s[0]);
     if normal.length_squared() == 0.0 {
         // A triangle of zero area is the segment its corners span: bounded as a whole.
@@ -200,41 +277,50 @@ pub(super) fn partition_bound(s: [DVec3; 3], candidates: &[&Tri]) -> Option<Part
         });
     let mut projected: Vec<Projected> = candidates
         .iter()
-        .filter_map(|&t| {
-            let mut q = [t.a, t.b, t.c].map(|p| frame.to_plane(p));
+        .filter_map(|t| {
+            let (q, area) = project(&frame, t);
             let (qlo, qhi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
-            if qlo.cmpge(hi).any() || qhi.cmple(lo).any() {
+            if qlo.cmpge(hi).any() || qhi.cmple(lo).any() || area == 0.0 {
                 return None;
             }
-            let area = cross(q[0], q[1], q[2]);
-            if area == 0.0 {
-                return None;
-            }
-            if area < 0.0 {
-                q.swap(1, 2);
-            }
-            let height = ((t.a + t.b + t.c) / 3.0 - s[0]).dot(n).abs();
+            let height = ((t[0] + t[1] + t[2]) / 3.0 - s[0]).dot(n).abs();
             Some((height, q, t))
         })
         .collect();
     projected.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    // The pieces no candidate has covered yet. A candidate cuts only the pieces it overlaps:
+    // the part outside each of its edges stays (in place of the piece, or at the end), the part
+    // inside all three is bounded by it and leaves.
     let mut left = vec![whole];
-    let mut next = Vec::new();
     let mut best = (-1.0, s[0]);
     for (_, q, t) in &projected {
-        next.clear();
-        for piece in &left {
-            if !overlaps(piece, q, flat) {
-                next.push(*piece);
+        let count = left.len();
+        let mut removed = false;
+        let (qlo, qhi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+        for k in 0..count {
+            let piece = &left[k];
+            if qlo.cmpge(piece.hi).any() || qhi.cmple(piece.lo).any() || !overlaps(piece, q, flat) {
                 continue;
             }
-            let mut inside = Some(*piece);
-            for k in 0..3 {
-                let (a, b) = (q[k], q[(k + 1) % 3]);
+            let mut inside = Some(left[k]);
+            let mut kept = false;
+            for e in 0..3 {
+                let (a, b) = (q[e], q[(e + 1) % 3]);
                 let Some(p) = inside else { break };
                 let (i, o) = cut(&p, |x| cross(a, b, x), flat * (b - a).length()).ok()?;
-                next.extend(o);
+                if let Some(o) = o {
+                    if kept {
+                        left.push(o);
+                    } else {
+                        left[k] = o;
+                        kept = true;
+                    }
+                }
                 inside = i;
+            }
+            if !kept {
+                left[k].len = 0;
+                removed = true;
             }
             if let Some(p) = inside {
                 let b = p.bound(&frame, t);
@@ -243,7 +329,9 @@ pub(super) fn partition_bound(s: [DVec3; 3], candidates: &[&Tri]) -> Option<Part
                 }
             }
         }
-        std::mem::swap(&mut left, &mut next);
+        if removed {
+            left.retain(|p| p.len > 0);
+        }
         if left.is_empty() {
             break;
         }
@@ -265,12 +353,12 @@ pub(super) fn partition_bound(s: [DVec3; 3], candidates: &[&Tri]) -> Option<Part
 }
 
 /// The bound of a triangle of zero area by its best single candidate.
-fn whole_bound(s: [DVec3; 3], candidates: &[&Tri]) -> Option<PartitionBound> {
+fn whole_bound(s: Corners, candidates: &[Corners]) -> Option<PartitionBound> {
     candidates
         .iter()
         .map(|t| {
             s.iter()
-                .map(|&x| (t.distance2(x), x))
+                .map(|&x| (point_triangle_distance2(x, t[0], t[1], t[2]), x))
                 .fold((-1.0, s[0]), |a, b| if b.0 > a.0 { b } else { a })
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))
@@ -310,14 +398,18 @@ mod tests {
             DVec3::new(0.71, 0.23, 0.1),
             DVec3::new(0.33, 0.87, 0.1),
         ];
-        let c: Vec<_> = s.candidates(&tri, 0.2).collect();
+        let c: Vec<Corners> = s.candidates(&tri, 0.2).map(|t| t.corners).collect();
         assert!(c.len() > 100, "{} candidates", c.len());
         let b = partition_bound(tri, &c).expect("a bound");
         // The corners are 0.1 above the grid (in f64).
         assert!((b.bound - 0.1).abs() < 1e-9, "{}", b.bound);
         let single = c
             .iter()
-            .map(|t| tri.iter().map(|&x| t.distance(x)).fold(0.0, f64::max))
+            .map(|t| {
+                tri.iter()
+                    .map(|&x| point_triangle_distance2(x, t[0], t[1], t[2]).sqrt())
+                    .fold(0.0, f64::max)
+            })
             .fold(f64::INFINITY, f64::min);
         // Measured 0.417: the best single grid triangle is four times as loose.
         assert!(single > 3.0 * b.bound, "{single}");

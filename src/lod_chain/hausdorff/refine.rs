@@ -18,9 +18,9 @@ const MAX_DEPTH: u32 = 12;
 ///
 /// and the piece is cut in four while that is above `lb` plus the tolerance. Every `f`
 /// evaluated raises `lb`.
-pub(super) fn refine<'a>(
-    target: &'a Surface,
-    c: [Sample<'a>; 3],
+pub(super) fn refine(
+    target: &Surface,
+    c: [Sample; 3],
     depth: u32,
     lb: &mut f64,
     tolerance: Tolerance,
@@ -36,7 +36,12 @@ pub(super) fn refine<'a>(
         .iter()
         .chain([&centre])
         .filter_map(|s| s.nearest)
-        .map(|t| p.iter().map(|&x| t.distance(x)).fold(0.0, f64::max))
+        .map(|t| {
+            p.iter()
+                .map(|&x| target.distance2_to(t, x))
+                .fold(0.0, f64::max)
+                .sqrt()
+        })
         .fold(f64::INFINITY, f64::min);
     let mut bound = lipschitz.min(convex);
     let mut spent = false;
