@@ -77,9 +77,7 @@ pub(super) fn build(
         // simplified (meshoptimizer's simplifier uses one core), one bound at a time (each
         // holds its level's surface and R-tree).
         let original = &original;
-        if descriptor.levels > 1 {
-            scope.spawn(move || original.index());
-        }
+        let indexing = (descriptor.levels > 1).then(|| scope.spawn(move || original.index()));
         let mut bounding: Option<std::thread::ScopedJoinHandle<LodChainLevel>> = None;
         for i in 1..descriptor.levels {
             let started = std::time::Instant::now();
@@ -149,6 +147,11 @@ pub(super) fn build(
         }
         if let Some(last) = bounding {
             levels.push(last.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+        }
+        if let Some(indexing) = indexing {
+            indexing
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e));
         }
     });
     if levels.len() == 1 && descriptor.levels > 1 && descriptor.small_mesh == SmallMesh::Error {

@@ -8,8 +8,8 @@
 //!   which is used), so `sup_Q f <= max f(corners) + r`.
 //! - **Convex**: for any one triangle `t` of the target, `f(x) <= d(x, t)`, and `d(., t)` is convex
 //!   (the distance to a convex set), so over the triangle `Q` its maximum is at a corner:
-//!   `sup_Q f <= max d(corner, t)`. The candidates `t` are the triangles nearest to `Q`'s
-//!   corners and centroid.
+//!   `sup_Q f <= max d(corner, t)`. The candidates `t` are the triangles the walks found for
+//!   `Q`'s corners and centroid (the nearest, or near ones).
 //! - **Partition** ([`partition`]): `Q` cut into convex pieces along the outlines of the target
 //!   triangles under it, each piece bounded by the convex bound of the triangle over it.
 //!
@@ -17,18 +17,20 @@
 //! connectivity from the target vertex nearest to it along the source's edges ([`walk`]; the
 //! levels of a chain keep a subset of the original's vertices), and at the centroid of every
 //! triangle whose corners are all on the target. The largest of these are searched exactly (an
-//! R-tree) until the rest are no larger than the largest exact distance found, `lb`, a lower
-//! bound of the supremum. Every source triangle is then bounded by the cheapest of the bounds
+//! R-tree) until the rest are no larger than the largest distance found, `lb`, a lower bound of
+//! the supremum (unless a search was capped: then an upper bound of a distance, and the bound is
+//! reported as capped). Every source triangle is then bounded by the cheapest of the bounds
 //! above that is within the tolerance of `lb`: Lipschitz and convex first (with the upper
-//! bounds at the corners, which both allow), then the partition among the target triangles
-//! connected to its corners' and centroid's nearest ones under it, then the partition among
-//! every target triangle near it. The triangles still above the tolerance are looked at again,
+//! bounds at the corners, which both allow), then the partition among the walks' triangles of
+//! its corners and centroid, then among those and the target triangles connected to them that
+//! lie over or under it ([`walk`]'s flood), then among every target triangle near it (the
+//! R-tree). The triangles still above the tolerance are looked at again,
 //! largest bound first: `f` at the point where the bound is reached often raises `lb` to it;
 //! the rest are refined ([`refine`]: cut at the edge midpoints, each piece bounded again). The
 //! result is the largest bound over all triangles: an upper bound whatever the walks, cuts and
 //! candidates, which only decide how tight it is (at most `lb + tolerance` above the largest
-//! distance found unless a piece reaches the depth limit; then still an upper bound, only a
-//! looser one). Distances are computed in f64 from the f32 positions; the caller rounds up.
+//! distance found unless a piece reaches the depth limit or the budget runs out; then still an
+//! upper bound, only a looser one). Distances are computed in f64 from the f32 positions; the caller rounds up.
 
 mod partition;
 mod refine;

@@ -8,8 +8,10 @@
 //! a vertex with the current one). A walk can stop at a triangle that is not the nearest (a
 //! fold of the target): its distance is then larger than the true one, an upper bound of it,
 //! which is all the triangles' bounds need. The largest distance found, which decides how
-//! tight the bound is, comes only from exact searches ([`exact_lower_bound`]). [`Surface::flood`]
-//! gathers the target triangles under a source triangle the same way, for its partition.
+//! tight the bound is, comes from searches of the whole target ([`exact_lower_bound`]; exact
+//! unless a search was capped, and then the level says so). [`Surface::flood`] gathers the
+//! target triangles a source triangle's partition may weigh, breadth first over shared
+//! vertices from its nearest ones.
 
 use std::cell::RefCell;
 
@@ -27,6 +29,10 @@ const MAX_RING: usize = 64;
 
 /// No vertex.
 const NONE: u32 = u32::MAX;
+
+/// Triangles a flood may look at per triangle it may keep (a well-shaped mesh's flood looks at
+/// 3 to 6).
+const FLOOD_LOOKS: usize = 8;
 
 /// `f`, the distance to the target, at a point of the source: an upper bound of it with the
 /// triangle that gives it, exact when it comes from a search of the whole target.
@@ -142,7 +148,8 @@ impl Surface<'_> {
     }
 
     /// The triangles connected to `seeds` through shared vertices that `keep` keeps, and the
-    /// seeds; `None` when there are more than `limit`. Each vertex's triangles are looked at
+    /// seeds (kept or not); `None` when there are more than `limit`, or when it has looked at
+    /// more than [`FLOOD_LOOKS`] times `limit` triangles. Each vertex's triangles are looked at
     /// once.
     pub(super) fn flood(
         &self,
@@ -168,10 +175,15 @@ impl Surface<'_> {
                     reached(t, &mut marks, &mut vertices);
                 }
             }
+            let mut looks = 0;
             while let Some(v) = vertices.pop() {
                 let ring = self.incident(v);
                 if ring.len() > MAX_RING {
                     continue;
+                }
+                looks += ring.len();
+                if looks > FLOOD_LOOKS * limit {
+                    return None;
                 }
                 for &t in ring {
                     if marks.triangle(t) && keep(t) {
@@ -276,9 +288,11 @@ pub(super) fn centre_samples(source: &Surface, target: &Surface) -> Vec<Option<F
 /// Walked samples checked by an exact search at a time.
 const BATCH: usize = 256;
 
-/// The largest exact distance among the samples: the walked ones are searched exactly, largest
-/// first, until every one left is at most the largest exact distance found (a walk's distance
-/// is never below the exact one); each searched sample is replaced by the exact one.
+/// The largest searched distance among the samples: the walked ones are searched, largest
+/// first, until every one left is at most the largest distance found (a walk's distance is
+/// never below the exact one); each searched sample keeps the nearer of its walk and its search
+/// (a capped search, [`Surface::nearest`], can find a farther triangle than the walk did; both
+/// are upper bounds, and `lb` is then one too, which only loosens the bound).
 pub(super) fn exact_lower_bound(
     source: &Surface,
     target: &Surface,
