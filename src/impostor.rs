@@ -11,6 +11,7 @@
 
 mod atlas;
 mod bound;
+mod gltf;
 mod sample;
 
 /// The key of a glTF node's `extras` under which `lodkit lod --impostor` writes an impostor
@@ -24,6 +25,7 @@ pub use atlas::{
 #[cfg(feature = "lod_chain")]
 pub use bound::{ImpostorPlacement, impostor_placement, impostor_switch_distance};
 pub use bound::{impostor_angle, impostor_error};
+pub use gltf::ImpostorGltfExtras;
 pub use sample::{ImpostorSample, impostor_sample, impostor_sample_frame, impostor_sample_level};
 
 use glam::{Mat3, UVec2, Vec2, Vec3};
@@ -72,6 +74,20 @@ pub enum ImpostorError {
         value: String,
         /// What it must be.
         expected: &'static str,
+    },
+    /// An atlas image whose size is not the layout's.
+    #[error(
+        "impostor {atlas} atlas is {width} x {height} texels: the layout needs {expected} x {expected}"
+    )]
+    ImageSize {
+        /// `color` or `normal_depth`.
+        atlas: &'static str,
+        /// Its width.
+        width: u32,
+        /// Its height.
+        height: u32,
+        /// The layout's [`ImpostorLayout::atlas_size`].
+        expected: u32,
     },
 }
 

@@ -408,6 +408,52 @@ fn committed_gltf_scene_is_what_lodkit_lod_writes() {
     assert_eq!(doc.materials().count(), 5);
 }
 
+/// The same scene with impostors (`impostor_scene.glb`, what lodkit_bevy's `gltf_scene` example
+/// draws with `--gltf`): the document is what the writer and `lodkit lod --impostor` write now,
+/// all but where the buffer's bytes lie (the atlases are PNGs of a GPU's bake: their sizes, and
+/// so every buffer view after them, differ with the GPU); each object ends in its impostor, whose
+/// extras read as `ImpostorGltfExtras` of 8 x 8 frames of 32 texels.
+#[test]
+fn committed_impostor_scene_is_what_lodkit_lod_writes() {
+    use lodkit_cli::demo::fixtures::gltf_scene::{IMPOSTOR_ASSET, impostor_lod_args, write};
+    let _gpu = lodkit_test_gpu!();
+    let dir = Scratch::folder();
+    write(&dir).unwrap();
+    let out = dir.join("impostor_scene.glb");
+    let mut args = vec!["lod".to_owned(), "scene.gltf".to_owned()];
+    args.extend(impostor_lod_args(&out));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, _, stderr) = run(&dir, &args);
+    assert_eq!(code, 0, "{stderr}");
+    let committed = crate::support::workspace_root().join(IMPOSTOR_ASSET);
+    let fix = "regenerate it with `bash scripts/gltf-scene.sh`";
+    let on_disk =
+        std::fs::read(&committed).unwrap_or_else(|e| panic!("{}: {e}; {fix}", committed.display()));
+    let document = |glb: &[u8]| {
+        let (mut json, _) = glb_parts(glb).expect("a GLB");
+        let o = json.as_object_mut().unwrap();
+        o.remove("bufferViews");
+        o.remove("buffers");
+        json
+    };
+    assert!(
+        document(&on_disk) == document(&std::fs::read(&out).unwrap()),
+        "{} is stale or was edited by hand; {fix}",
+        committed.display()
+    );
+    let (json, _) = glb_parts(&on_disk).unwrap();
+    let nodes = json["nodes"].as_array().unwrap();
+    for name in ["ball", "tree", "ring", "crate"] {
+        let node = nodes.iter().find(|n| n["name"] == name).unwrap();
+        let ids = node["extensions"]["MSFT_lod"]["ids"].as_array().unwrap();
+        let last = &nodes[ids.last().unwrap().as_u64().unwrap() as usize];
+        let extras: lodkit::impostor::ImpostorGltfExtras =
+            serde_json::from_value(last["extras"]["lodkit_impostor"].clone())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!((extras.frames, extras.frame_size), (8, 32), "{name}");
+    }
+}
+
 /// The JSON chunk's value (numbers as the f32 they stand for: how a float is printed differs
 /// with serde_json's features, which differ between a test build and `cargo run`) and the
 /// binary chunk's bytes of a GLB file.

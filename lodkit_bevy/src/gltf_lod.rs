@@ -23,11 +23,17 @@
 //! does, for that).
 //!
 //! An impostor level (`lodkit lod --impostor`: a card node whose extras hold `lodkit_impostor`,
-//! the last of the node's levels) is left out with a warning: the loader does not build an
-//! [`ImpostorMaterial`](crate::impostor::ImpostorMaterial) from the file's atlas yet (the file
-//! holds mip level 0 only), and the card alone would show the object's front from every side
-//! (edge-on from 90°).
-//! The last mesh level is shown in its place, up to where the node is hidden.
+//! [`ImpostorGltfExtras`](lodkit::impostor::ImpostorGltfExtras), the last of the node's levels)
+//! is drawn with an [`ImpostorMaterial`](crate::impostor::ImpostorMaterial) (the plugin adds
+//! [`ImpostorPlugin`](crate::impostor::ImpostorPlugin)): its two atlas images, as Bevy's loader
+//! read them, get their mip chains (`ImpostorMaterial::from_level0_images`) once per file, and
+//! the card is [`ImpostorMaterial::card_mesh`](crate::impostor::ImpostorMaterial::card_mesh) of
+//! the layout, not the file's quad (which shows the object's front from every side). The
+//! impostor is the whole mesh's picture: it is the last level of the group of the node's first
+//! primitive, and the groups of its other primitives are hidden from the impostor's distance
+//! on. An impostor that cannot be drawn (extras that do not read, images that are not loaded or
+//! not an atlas of the layout) is left out with a warning naming the node and why, and the last
+//! mesh level is shown in its place, up to where the node is hidden.
 
 use bevy::asset::LoadContext;
 use bevy::gltf::extensions::{
@@ -39,8 +45,13 @@ use bevy::prelude::*;
 use lodkit::select::LodGroup;
 
 use crate::frame_sequential::levels::{
-    FrameSequentialGroup, FrameSequentialSystems, LodLevel, LodLevels,
+    FrameSequentialGroup, FrameSequentialSystems, LevelMaterial, LodLevel, LodLevels,
 };
+use crate::impostor::ImpostorMaterial;
+
+mod impostor;
+
+pub use impostor::GltfLodImpostor;
 
 /// The viewport aspect (width / height) a file's `MSFT_screencoverage` is read with: `lodkit
 /// lod`'s default `--aspect`, 16:9.
@@ -57,6 +68,9 @@ pub struct GltfLod {
     pub distances: Vec<f32>,
     /// Beyond this view-normalized distance nothing is shown (the last coverage).
     pub max_distance: Option<f32>,
+    /// The impostor that ends the levels, where the file has one (its switch distance is the
+    /// last of [`distances`](Self::distances)).
+    pub impostor: Option<GltfLodImpostor>,
 }
 
 /// One primitive of a node with LOD levels: [`GltfLod::primitives`].
@@ -87,6 +101,8 @@ pub(crate) fn build(app: &mut App) {
         .register_type::<GltfLodLevel>()
         .register_type::<Vec<GltfLodPrimitive>>()
         .register_type::<Vec<GltfLodLevel>>()
+        .register_type::<GltfLodImpostor>()
+        .register_type::<Option<GltfLodImpostor>>()
         .register_type::<Option<Handle<StandardMaterial>>>()
         .register_type::<Option<f32>>()
         .register_type::<Vec<f32>>();
@@ -95,6 +111,7 @@ pub(crate) fn build(app: &mut App) {
         .0
         .write_blocking()
         .push(Box::new(MsftLod::default()));
+    app.init_resource::<impostor::GltfImpostors>();
     app.add_systems(PostUpdate, spawn_gltf_groups.before(FrameSequentialSystems));
 }
 
@@ -103,11 +120,11 @@ pub(crate) fn build(app: &mut App) {
 struct MsftLod {
     /// Per node: its mesh's index and each primitive's material index.
     nodes: Vec<Option<(usize, Vec<Option<usize>>)>>,
-    /// Per node: whether it is an impostor's card (`lodkit lod --impostor`: its extras hold
-    /// `lodkit_impostor`).
-    impostors: Vec<bool>,
-    /// Whether this load warned of an impostor level left out (once per file).
-    impostor_warned: bool,
+    /// Per node: None where it is no impostor's card (`lodkit lod --impostor`: its extras hold
+    /// `lodkit_impostor`), else what its extras say.
+    impostors: Vec<Option<Result<lodkit::impostor::ImpostorGltfExtras, String>>>,
+    /// Per image: the first texture that shows it.
+    image_textures: Vec<Option<usize>>,
 }
 
 impl GltfExtensionHandler for MsftLod {
@@ -121,7 +138,6 @@ impl GltfExtensionHandler for MsftLod {
         gltf: &gltf::Gltf,
         _settings: &bevy::gltf::GltfLoaderSettings,
     ) {
-        self.impostor_warned = false;
         self.nodes = gltf
             .nodes()
             .map(|node| {
@@ -131,15 +147,8 @@ impl GltfExtensionHandler for MsftLod {
                 })
             })
             .collect();
-        self.impostors = gltf
-            .nodes()
-            .map(|node| {
-                node.extras().as_ref().is_some_and(|extras| {
-                    gltf::json::deserialize::from_str::<gltf::json::Value>(extras.get())
-                        .is_ok_and(|v| v.get(lodkit::impostor::IMPOSTOR_GLTF_EXTRAS_KEY).is_some())
-                })
-            })
-            .collect();
+        self.impostors = impostor::impostor_nodes(gltf);
+        self.image_textures = impostor::image_textures(gltf);
     }
 
     fn on_gltf_node(
@@ -181,17 +190,17 @@ impl MsftLod {
             .and_then(|ids| ids.as_array())
             .ok_or("no \"ids\" array")?;
         let mut level_nodes = Vec::new();
-        let mut impostor = None;
+        let mut impostor_node = None;
         for (k, id) in ids.iter().enumerate() {
             let id = id
                 .as_u64()
                 .and_then(|i| usize::try_from(i).ok())
                 .ok_or_else(|| format!("id {id} is not a node index"))?;
-            if self.impostors.get(id).copied().unwrap_or(false) {
+            if let Some(Some(extras)) = self.impostors.get(id) {
                 if k + 1 < ids.len() {
                     return Err(format!("impostor level node {id} is not the last level"));
                 }
-                impostor = Some(id);
+                impostor_node = Some((id, extras.clone()));
                 continue;
             }
             match self.nodes.get(id) {
@@ -227,22 +236,26 @@ impl MsftLod {
             return Err(format!("the mesh's box has no size (radius {radius})"));
         }
         let mut coverage = screen_coverage(node)?;
-        if let Some(id) = impostor {
-            // Its card would show the object's front from every side: the last mesh level is
-            // shown instead, up to where the node is hidden (its coverage, the impostor's
-            // switch, goes).
-            without_last_level(coverage.as_mut(), ids.len())?;
-            if !std::mem::replace(&mut self.impostor_warned, true) {
-                warn!(
-                    "{}: impostor levels (`lodkit lod --impostor`; the first: node {id}) left \
-                     out: the loader does not build an ImpostorMaterial from the file's atlas \
-                     yet; each node's last mesh level is shown up to where the node is hidden",
-                    load_context.path()
-                );
+        let mut impostor = None;
+        if let Some((id, extras)) = impostor_node {
+            let read = extras
+                .and_then(|x| impostor::gltf_impostor(load_context, &x, &self.image_textures));
+            match read {
+                Ok(i) => impostor = Some(i),
+                Err(why) => {
+                    // The last mesh level is shown up to where the node is hidden (the
+                    // impostor's switch coverage goes).
+                    without_last_level(coverage.as_mut(), ids.len())?;
+                    warn!(
+                        "{}: impostor level node {id} left out ({why}); the last mesh level is \
+                         shown up to where the node is hidden",
+                        load_context.path()
+                    );
+                }
             }
         }
-        let (distances, max_distance) =
-            switch_distances(radius, coverage.as_deref(), level_nodes.len())?;
+        let coarser = level_nodes.len() + usize::from(impostor.is_some());
+        let (distances, max_distance) = switch_distances(radius, coverage.as_deref(), coarser)?;
         let primitives = mesh
             .primitives()
             .map(|p| {
@@ -278,6 +291,7 @@ impl MsftLod {
             primitives,
             distances,
             max_distance,
+            impostor,
         })
     }
 }
@@ -366,18 +380,45 @@ pub fn switch_distances(
     Ok((distances, max_distance))
 }
 
-/// Turns the primitive entities of each node the loader marked into LOD groups.
+/// The group of `distances` hidden beyond `max` (where given).
+fn lod_group(distances: &[f32], max: Option<f32>) -> Result<LodGroup, String> {
+    let group = LodGroup::from_distances(distances).map_err(|e| e.to_string())?;
+    match max {
+        Some(max) => group.with_max_distance(max).map_err(|e| e.to_string()),
+        None => Ok(group),
+    }
+}
+
+/// Turns the primitive entities of each node the loader marked into LOD groups: where the node
+/// has an impostor, the first primitive's group ends in it and the others' in a level that
+/// draws nothing, at the same distance.
 fn spawn_gltf_groups(
     mut commands: Commands,
     nodes: Query<(Entity, &GltfLod, &Children), Added<GltfLod>>,
     primitives: Query<(&Mesh3d, &MeshMaterial3d<StandardMaterial>)>,
+    mut impostors: ResMut<impostor::GltfImpostors>,
+    mut images: ResMut<Assets<Image>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut impostor_materials: ResMut<Assets<ImpostorMaterial>>,
 ) {
     for (node, lod, children) in &nodes {
-        let mut group = LodGroup::from_distances(&lod.distances);
-        if let (Ok(g), Some(max)) = (&group, lod.max_distance) {
-            group = g.clone().with_max_distance(max);
-        }
-        let group = match group {
+        let drawn = lod.impostor.as_ref().and_then(|i| {
+            impostors
+                .get(i, &mut images, &mut meshes, &mut impostor_materials)
+                .inspect_err(|why| {
+                    warn!(
+                        "glTF node {node}: impostor level left out ({why}); the last mesh level \
+                         is shown up to where the node is hidden"
+                    )
+                })
+                .ok()
+        });
+        let mesh_levels = lod.distances.len() - usize::from(lod.impostor.is_some());
+        let distances = match &drawn {
+            Some(_) => &lod.distances[..],
+            None => &lod.distances[..mesh_levels],
+        };
+        let group = match lod_group(distances, lod.max_distance) {
             Ok(group) => group,
             Err(e) => {
                 warn!(
@@ -391,14 +432,29 @@ fn spawn_gltf_groups(
             let Ok((mesh, material)) = primitives.get(child) else {
                 continue;
             };
-            let Some(primitive) = lod.primitives.iter().find(|p| p.mesh == mesh.0) else {
+            let Some(k) = lod.primitives.iter().position(|p| p.mesh == mesh.0) else {
                 continue;
             };
+            let primitive = &lod.primitives[k];
             let mut levels = vec![LodLevel::new(mesh.0.clone(), material.0.clone())];
             levels.extend(primitive.levels.iter().map(|level| {
                 let material = level.material.clone().unwrap_or_else(|| material.0.clone());
                 LodLevel::new(level.mesh.clone(), material)
             }));
+            if let Some(draw) = &drawn {
+                levels.push(if k == 0 {
+                    LodLevel::new(
+                        draw.card.clone(),
+                        LevelMaterial::custom(draw.material.clone()),
+                    )
+                } else {
+                    // The others' last level draws nothing from the impostor's switch.
+                    LodLevel {
+                        mesh: draw.nothing.clone(),
+                        material: levels[levels.len() - 1].material.clone(),
+                    }
+                });
+            }
             commands
                 .entity(child)
                 .remove::<(Mesh3d, MeshMaterial3d<StandardMaterial>)>()

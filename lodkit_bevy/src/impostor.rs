@@ -67,11 +67,25 @@ const IMPOSTOR_PREPASS_SHADER: Handle<Shader> =
     uuid_handle!("4c8d2e71-9f3a-4b56-a1e0-7d5b3c9f2a84");
 
 /// Registers [`ImpostorMaterial`] (and lodkit's shader modules, where
-/// [`LodkitShadersPlugin`] is not added yet).
+/// [`LodkitShadersPlugin`] is not added yet). Adding it more than once is harmless (with the
+/// `gltf` feature [`FrameSequentialLodPlugin`](crate::FrameSequentialLodPlugin) adds it, to draw
+/// the impostor levels of glTF files).
 pub struct ImpostorPlugin;
 
+/// Marks an app [`ImpostorPlugin`] has built.
+#[derive(Resource)]
+struct ImpostorPluginBuilt;
+
 impl Plugin for ImpostorPlugin {
+    fn is_unique(&self) -> bool {
+        false
+    }
+
     fn build(&self, app: &mut App) {
+        if app.world().contains_resource::<ImpostorPluginBuilt>() {
+            return;
+        }
+        app.insert_resource(ImpostorPluginBuilt);
         if !app.is_plugin_added::<LodkitShadersPlugin>() {
             app.add_plugins(LodkitShadersPlugin);
         }
@@ -153,6 +167,14 @@ pub enum ImpostorMaterialError {
         /// The atlas's side at level 0.
         size: u32,
     },
+    /// An atlas image [`ImpostorMaterial::from_level0_images`] cannot read.
+    #[error("ImpostorMaterial::from_level0_images: the {atlas} image {problem}")]
+    Image {
+        /// `color` or `normal_depth`.
+        atlas: &'static str,
+        /// What is wrong with it.
+        problem: String,
+    },
 }
 
 impl ImpostorMaterial {
@@ -217,6 +239,37 @@ impl ImpostorMaterial {
         })
     }
 
+    /// The material of an impostor of `layout` whose atlases are Bevy images of level 0 (frames
+    /// padded: what `lodkit lod --impostor` writes into a glTF file, read by Bevy's loader), the
+    /// mip chains built as a bake builds them ([`ImpostorAtlas::from_level0`]) and added to
+    /// `images` with the two atlases. `color`: RGBA8 holds sRGB-encoded colour (whether its
+    /// format says `Rgba8UnormSrgb` or `Rgba8Unorm`: the bytes are what the PNG held), RGBA16
+    /// and RGBA32 float linear colour; `normal_depth`: RGBA8 or RGBA16 unorm, RGBA16 or RGBA32
+    /// float, linear. An image of another format, not square, not the layout's size, or whose
+    /// texels are not in main-world memory (`RenderAssetUsages` without `MAIN_WORLD`) is an
+    /// error naming it.
+    pub fn from_level0_images(
+        layout: ImpostorLayout,
+        color: &Image,
+        normal_depth: &Image,
+        images: &mut Assets<Image>,
+    ) -> Result<Self, ImpostorMaterialError> {
+        Self::new(&Self::atlas_of_images(layout, color, normal_depth)?, images)
+    }
+
+    /// The atlas [`from_level0_images`](Self::from_level0_images) draws: the two images read and
+    /// their mip chains built.
+    pub fn atlas_of_images(
+        layout: ImpostorLayout,
+        color: &Image,
+        normal_depth: &Image,
+    ) -> Result<ImpostorAtlas, ImpostorMaterialError> {
+        layout.validate()?;
+        let color = atlas_level0(color, "color", layout.atlas_size(), true)?;
+        let normal_depth = atlas_level0(normal_depth, "normal_depth", layout.atlas_size(), false)?;
+        Ok(ImpostorAtlas::from_level0(layout, color, normal_depth)?)
+    }
+
     /// The uniform of `layout`, roughness 1 and metallic 0.
     pub fn params(layout: &ImpostorLayout) -> ImpostorParams {
         ImpostorParams {
@@ -262,6 +315,72 @@ impl ImpostorMaterial {
         .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 0.0, 1.0]; 6])
         .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, corners.to_vec())
         .with_inserted_indices(Indices::U16((0..6).collect()))
+    }
+}
+
+/// Level 0 of atlas `atlas` from a Bevy image of `size` texels a side: RGBA floats, colour
+/// linear (8-bit colour decoded from sRGB where `srgb_bytes`).
+fn atlas_level0(
+    image: &Image,
+    atlas: &'static str,
+    size: u32,
+    srgb_bytes: bool,
+) -> Result<ImpostorImage, ImpostorMaterialError> {
+    let bad = |problem: String| ImpostorMaterialError::Image { atlas, problem };
+    let (width, height) = (image.width(), image.height());
+    if (width, height) != (size, size) {
+        return Err(bad(format!(
+            "is {width} x {height} texels: the layout needs {size} x {size}"
+        )));
+    }
+    let data = image.data.as_deref().ok_or_else(|| {
+        bad("has no texels in main-world memory (its RenderAssetUsages lack MAIN_WORLD)".into())
+    })?;
+    let format = image.texture_descriptor.format;
+    let texels = (size as usize).pow(2);
+    let channel: fn(&[u8]) -> f32 = match format {
+        TextureFormat::Rgba8UnormSrgb | TextureFormat::Rgba8Unorm => |b| f32::from(b[0]) / 255.0,
+        TextureFormat::Rgba16Unorm => |b| f32::from(u16::from_le_bytes([b[0], b[1]])) / 65535.0,
+        TextureFormat::Rgba16Float => |b| half::f16::from_le_bytes([b[0], b[1]]).to_f32(),
+        TextureFormat::Rgba32Float => |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        other => {
+            return Err(bad(format!(
+                "has format {other:?}; read are RGBA8, RGBA16 unorm or float and RGBA32 float"
+            )));
+        }
+    };
+    let bytes = format.block_copy_size(None).unwrap_or(4) as usize / 4;
+    if data.len() < texels * 4 * bytes {
+        return Err(bad(format!(
+            "holds {} bytes, fewer than {size} x {size} texels of {format:?}",
+            data.len()
+        )));
+    }
+    let decode = srgb_bytes && bytes == 1;
+    let texels = data[..texels * 4 * bytes]
+        .chunks_exact(4 * bytes)
+        .map(|texel| {
+            let mut t = [0.0f32; 4];
+            for (c, value) in t.iter_mut().enumerate() {
+                let v = channel(&texel[c * bytes..]);
+                *value = if decode && c < 3 {
+                    srgb_to_linear(v)
+                } else {
+                    v
+                };
+            }
+            t
+        })
+        .collect();
+    Ok(ImpostorImage { size, texels })
+}
+
+/// The sRGB transfer function's inverse (IEC 61966-2-1).
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
     }
 }
 
@@ -329,101 +448,5 @@ impl Material for ImpostorMaterial {
 }
 
 #[cfg(test)]
-mod tests {
-    use crate::impostor::*;
-    use lodkit::impostor::ImpostorShape;
-
-    fn layout() -> ImpostorLayout {
-        ImpostorLayout {
-            frames: 2,
-            frame_size: 4,
-            shape: ImpostorShape::Hemi,
-            center: [1.0, 2.0, 3.0],
-            radius: 0.5,
-        }
-    }
-
-    /// An atlas of `layout` whose chains have `levels` levels (the layout's own: 3).
-    fn atlas(levels: u32) -> ImpostorAtlas {
-        let layout = layout();
-        let chain = (0..levels)
-            .map(|k| ImpostorImage::filled(layout.atlas_size() >> k, [0.5; 4]))
-            .collect::<Vec<_>>();
-        ImpostorAtlas {
-            layout,
-            color: chain.clone(),
-            normal_depth: chain,
-        }
-    }
-
-    #[test]
-    fn an_atlas_becomes_two_images_with_their_mip_chains() {
-        let mut images = Assets::<Image>::default();
-        let levels = ImpostorAtlas::mip_levels(&layout());
-        assert_eq!(levels, 3, "8, 4 and 2 texels a side");
-        let material = ImpostorMaterial::new(&atlas(levels), &mut images).unwrap();
-        let color = images.get(&material.color).unwrap();
-        assert_eq!(color.texture_descriptor.mip_level_count, 3);
-        assert_eq!(
-            color.texture_descriptor.format,
-            TextureFormat::Rgba8UnormSrgb
-        );
-        // 8^2 + 4^2 + 2^2 texels of 4 bytes, and of 8 bytes (four halves).
-        assert_eq!(color.data.as_ref().map(Vec::len), Some(84 * 4));
-        let normal = images.get(&material.normal_depth).unwrap();
-        assert_eq!(normal.texture_descriptor.format, TextureFormat::Rgba16Float);
-        assert_eq!(normal.data.as_ref().map(Vec::len), Some(84 * 8));
-        // 0.5 as a half: 0x3800, little-endian.
-        assert_eq!(
-            normal.data.as_ref().map(|d| [d[0], d[1]]),
-            Some([0x00, 0x38])
-        );
-        assert_eq!(material.params.sphere, Vec4::new(1.0, 2.0, 3.0, 0.5));
-        assert_eq!(material.params.atlas, UVec4::new(2, 1, 4, 0));
-    }
-
-    #[test]
-    fn an_atlas_it_cannot_draw_is_an_error_naming_the_part() {
-        let mut images = Assets::<Image>::default();
-        let short = ImpostorMaterial::new(&atlas(2), &mut images).unwrap_err();
-        assert!(
-            matches!(
-                short,
-                ImpostorMaterialError::MipChain {
-                    atlas: "color",
-                    expected: 3,
-                    ..
-                }
-            ),
-            "{short}"
-        );
-        let mut bad = atlas(3);
-        bad.layout.frames = 1;
-        let layout = ImpostorMaterial::new(&bad, &mut images).unwrap_err();
-        assert!(
-            matches!(layout, ImpostorMaterialError::Layout(_)),
-            "{layout}"
-        );
-        assert!(layout.to_string().contains("frames"), "{layout}");
-        assert_eq!(images.len(), 0, "no image added for an atlas refused");
-    }
-
-    #[test]
-    fn the_card_mesh_spans_the_bounding_sphere_box() {
-        let mesh = ImpostorMaterial::card_mesh(&layout());
-        let Some(bevy::mesh::VertexAttributeValues::Float32x3(positions)) =
-            mesh.attribute(Mesh::ATTRIBUTE_POSITION)
-        else {
-            panic!("positions as Float32x3");
-        };
-        let (lo, hi) = positions.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(Vec3::from(p)), hi.max(Vec3::from(p))),
-        );
-        assert_eq!(
-            (lo, hi),
-            (Vec3::new(0.5, 1.5, 2.5), Vec3::new(1.5, 2.5, 3.5))
-        );
-        assert_eq!(mesh.count_vertices(), 6);
-    }
-}
+#[path = "impostor_tests.rs"]
+mod tests;

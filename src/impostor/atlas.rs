@@ -2,7 +2,7 @@
 //! nearest covered texel (so filtering and mipmaps never blend the background's colour, normal
 //! or depth into the object's edge), and the mip chain that keeps frames whole.
 
-use super::ImpostorLayout;
+use super::{ImpostorError, ImpostorLayout};
 
 /// A square image of RGBA floats, row-major from the top row.
 #[derive(Clone, Debug, PartialEq)]
@@ -256,6 +256,36 @@ pub fn preserve_coverage(chain: &mut [ImpostorImage], frames: u32) {
 }
 
 impl ImpostorAtlas {
+    /// The atlas of `layout` from level 0 of each image (frames padded, as a bake leaves them
+    /// and `lodkit lod --impostor` writes them): the mip chains built as a bake builds them
+    /// ([`mip_chain`]; the colour's with [`preserve_coverage`]). Refuses a layout out of range
+    /// or an image that is not `layout.atlas_size()` texels a side.
+    pub fn from_level0(
+        layout: ImpostorLayout,
+        color: ImpostorImage,
+        normal_depth: ImpostorImage,
+    ) -> Result<Self, ImpostorError> {
+        layout.validate()?;
+        let expected = layout.atlas_size();
+        for (atlas, image) in [("color", &color), ("normal_depth", &normal_depth)] {
+            if image.size != expected || image.texels.len() != (expected as usize).pow(2) {
+                return Err(ImpostorError::ImageSize {
+                    atlas,
+                    width: image.size,
+                    height: (image.texels.len() / image.size.max(1) as usize) as u32,
+                    expected,
+                });
+            }
+        }
+        let mut color = mip_chain(color, layout.frames, layout.frame_size);
+        preserve_coverage(&mut color, layout.frames);
+        Ok(Self {
+            layout,
+            color,
+            normal_depth: mip_chain(normal_depth, layout.frames, layout.frame_size),
+        })
+    }
+
     /// Mip levels of each atlas: `log2(frame_size) + 1`.
     pub fn mip_levels(layout: &ImpostorLayout) -> u32 {
         layout.frame_size.max(1).ilog2() + 1

@@ -273,3 +273,88 @@ fn a_sample_near_a_frame_edge_takes_nothing_of_the_next_frame() {
         );
     }
 }
+
+/// A file's level 0 becomes the atlas a bake makes: three levels for 4-texel frames, the
+/// colour's thin feature kept (one covered texel of 16 in frame (0, 0): its level-1 texel
+/// averages to alpha 1/4 and is scaled to the test's 0.5, as is the level-2 texel at 1/16),
+/// the normal and depth box-averaged; an image of the wrong size is refused by name.
+#[test]
+fn an_atlas_from_level_0_gets_the_mip_chains_a_bake_gives() {
+    let l = layout(2, 4, ImpostorShape::Hemi);
+    let mut color = ImpostorImage::filled(8, [0.2, 0.4, 0.6, 0.0]);
+    color.texels[0] = [1.0, 0.0, 0.0, 1.0];
+    let mut normal_depth = ImpostorImage::filled(8, [0.5, 0.5, 1.0, 0.25]);
+    normal_depth.texels[0] = [0.5, 0.5, 1.0, 1.0];
+    let atlas = ImpostorAtlas::from_level0(l, color.clone(), normal_depth.clone()).unwrap();
+    let sizes = |chain: &[ImpostorImage]| chain.iter().map(|i| i.size).collect::<Vec<_>>();
+    assert_eq!(sizes(&atlas.color), [8, 4, 2]);
+    assert_eq!(sizes(&atlas.normal_depth), [8, 4, 2]);
+    assert_eq!(atlas.color[0], color);
+    assert!((atlas.color[1].texel(0, 0)[3] - 0.5).abs() < 1e-5);
+    assert!((atlas.color[2].texel(0, 0)[3] - 0.5).abs() < 1e-5);
+    assert_eq!(atlas.color[2].texel(1, 1)[3], 0.0);
+    // Depth: (1 + 3 x 0.25) / 4 at level 1, (1 + 15 x 0.25) / 16 at level 2.
+    assert!((atlas.normal_depth[1].texel(0, 0)[3] - 0.4375).abs() < 1e-6);
+    assert!((atlas.normal_depth[2].texel(0, 0)[3] - 0.296_875).abs() < 1e-6);
+    let small = ImpostorImage::filled(4, [0.0; 4]);
+    let e = ImpostorAtlas::from_level0(l, color, small).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ImpostorError::ImageSize {
+                atlas: "normal_depth",
+                width: 4,
+                expected: 8,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    let mut bad = l;
+    bad.frame_size = 3;
+    assert!(matches!(
+        ImpostorAtlas::from_level0(bad, normal_depth.clone(), normal_depth),
+        Err(ImpostorError::BadLayout {
+            field: "frame_size",
+            ..
+        })
+    ));
+}
+
+/// The extras `lodkit lod --impostor` writes, as docs/impostors.md spells them, read back; a
+/// shape or a field that is not one of them is refused.
+#[test]
+fn impostor_extras_read_as_the_docs_spell_them() {
+    let text = r#"{"frames": 12, "frame_size": 128, "shape": "hemi",
+        "center": [0.5, 1.0, -2.0], "radius": 1.5, "color_image": 7, "normal_depth_image": 8}"#;
+    let extras: ImpostorGltfExtras = serde_json::from_str(text).unwrap();
+    assert_eq!(extras.color_image, 7);
+    assert_eq!(extras.normal_depth_image, 8);
+    let layout = extras.layout().unwrap();
+    assert_eq!(
+        layout,
+        ImpostorLayout {
+            frames: 12,
+            frame_size: 128,
+            shape: ImpostorShape::Hemi,
+            center: [0.5, 1.0, -2.0],
+            radius: 1.5,
+        }
+    );
+    let written = serde_json::to_value(ImpostorGltfExtras::new(&layout, 7, 8)).unwrap();
+    assert_eq!(
+        written,
+        serde_json::from_str::<serde_json::Value>(text).unwrap()
+    );
+    let full = text.replace("\"hemi\"", "\"full\"");
+    let full: ImpostorGltfExtras = serde_json::from_str(&full).unwrap();
+    assert_eq!(full.shape, ImpostorShape::Full);
+    let sideways = text.replace("\"hemi\"", "\"sideways\"");
+    let e = serde_json::from_str::<ImpostorGltfExtras>(&sideways).unwrap_err();
+    assert!(e.to_string().contains("sideways"), "{e}");
+    let extra = text.replace("\"radius\"", "\"depth\": 1, \"radius\"");
+    assert!(serde_json::from_str::<ImpostorGltfExtras>(&extra).is_err());
+    let zero = text.replace("1.5", "0.0");
+    let zero: ImpostorGltfExtras = serde_json::from_str(&zero).unwrap();
+    assert!(zero.layout().is_err());
+}

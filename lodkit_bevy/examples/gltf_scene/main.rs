@@ -246,6 +246,7 @@ fn run(args: &Args) -> Result<(), Failure> {
             json!({
                 "name": g.name,
                 "levels": g.levels.len(),
+                "impostor": matches!(g.levels.last(), Some((_, runs::LevelDraw::Impostor(_)))),
                 "distances": g.distances,
                 "max_distance": g.max_distance,
                 "drawn": drawn,

@@ -11,6 +11,8 @@ use lodkit_bevy::frame_sequential::{
     FrameSequentialLodPlugin, LevelMaterial, LodLevels,
 };
 
+use lodkit_bevy::impostor::ImpostorMaterial;
+
 use crate::frames::Frame;
 use crate::headless::{
     build_app_with_assets, finish_readback, harness_camera, render_target, start_readback, step,
@@ -34,8 +36,8 @@ pub struct Failure(pub u8, pub String);
 /// run).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Technique {
-    /// Each group's level k alone (its last where it has fewer), as a plain Bevy mesh: the
-    /// references.
+    /// Each group's level k alone (its last where it has fewer), as a plain Bevy mesh (or
+    /// impostor), up to where the group is hidden: the references.
     Level(usize),
     /// Bevy's own `VisibilityRange` crossfade over the group's levels, at its distances and
     /// with the same band.
@@ -44,12 +46,29 @@ pub enum Technique {
     FrameSequential,
 }
 
+/// A level's material as a plain entity draws it: a mesh level's `StandardMaterial`, or an
+/// impostor level's `ImpostorMaterial`.
+#[derive(Clone)]
+pub enum LevelDraw {
+    Standard(Handle<StandardMaterial>),
+    Impostor(Handle<ImpostorMaterial>),
+}
+
+impl LevelDraw {
+    fn insert(&self, entity: &mut EntityWorldMut) {
+        match self {
+            Self::Standard(m) => entity.insert(MeshMaterial3d(m.clone())),
+            Self::Impostor(m) => entity.insert(MeshMaterial3d(m.clone())),
+        };
+    }
+}
+
 /// A LOD group the plugin made of the file.
 pub struct Group {
     pub entity: Entity,
     pub name: String,
-    /// Mesh and StandardMaterial of each level.
-    pub levels: Vec<(Handle<Mesh>, Handle<StandardMaterial>)>,
+    /// Mesh and material of each level.
+    pub levels: Vec<(Handle<Mesh>, LevelDraw)>,
     /// View-normalized switch distances (the first is 0).
     pub distances: Vec<f32>,
     pub max_distance: Option<f32>,
@@ -135,7 +154,14 @@ impl Scene {
                 .0
                 .iter()
                 .map(|level| match &level.material {
-                    LevelMaterial::Standard(material) => Ok((level.mesh.clone(), material.clone())),
+                    LevelMaterial::Standard(material) => {
+                        Ok((level.mesh.clone(), LevelDraw::Standard(material.clone())))
+                    }
+                    LevelMaterial::Custom { handle, .. } => handle
+                        .clone()
+                        .try_typed::<ImpostorMaterial>()
+                        .map(|m| (level.mesh.clone(), LevelDraw::Impostor(m)))
+                        .map_err(|_| Failure(1, format!("{name}: a level of another material"))),
                     _ => Err(Failure(
                         1,
                         format!("{name}: a level without a StandardMaterial"),
@@ -214,10 +240,19 @@ impl Scene {
             };
             for k in levels {
                 let (mesh, material) = group.levels[k].clone();
-                let mut copy =
-                    world.spawn((Mesh3d(mesh), MeshMaterial3d(material), group.transform));
+                let mut copy = world.spawn((Mesh3d(mesh), group.transform));
+                material.insert(&mut copy);
                 if technique == Technique::BevyCrossfade {
                     copy.insert(group.range(k, h));
+                } else if let Some(max) = group.max_distance {
+                    // A reference level shows until the group is hidden (a hard cut): a
+                    // primitive whose object's impostor another group draws is hidden there.
+                    let max = max * p11() * group.scale;
+                    copy.insert(VisibilityRange {
+                        start_margin: 0.0..0.0,
+                        end_margin: max..max,
+                        use_aabb: false,
+                    });
                 }
                 copies.push(copy.id());
             }

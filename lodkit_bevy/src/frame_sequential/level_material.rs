@@ -70,7 +70,15 @@ impl<M: Material + Clone> Plugin for FrameSequentialMaterialPlugin<M>
 where
     <FrameSequentialLevel<M> as AsBindGroup>::Data: PartialEq + Eq + Hash + Clone,
 {
+    /// Adding it for one `M` more than once is harmless (the first adds what it adds).
+    fn is_unique(&self) -> bool {
+        false
+    }
+
     fn build(&self, app: &mut App) {
+        if app.is_plugin_added::<MaterialPlugin<FrameSequentialLevel<M>>>() {
+            return;
+        }
         app.add_plugins(MaterialPlugin::<FrameSequentialLevel<M>>::default());
         add_level_material::<M, FrameSequentialBindings>(app);
     }

@@ -198,7 +198,14 @@ impl Plugin for FrameSequentialLodPlugin {
         ));
         select::build(app);
         #[cfg(feature = "gltf")]
-        crate::gltf_lod::build(app);
+        {
+            // A glTF file's impostor levels are drawn with ImpostorMaterial.
+            app.add_plugins((
+                crate::impostor::ImpostorPlugin,
+                FrameSequentialMaterialPlugin::<crate::impostor::ImpostorMaterial>::default(),
+            ));
+            crate::gltf_lod::build(app);
+        }
         #[cfg(feature = "lod_chain")]
         crate::auto_lod::build(app);
         if let Some(render_app) = app.get_sub_app_mut(RenderApp) {

@@ -55,6 +55,12 @@ pub fn run_example(name: &str, args: &[&OsStr]) -> Option<Output> {
 /// test where the example fails or logs a wgpu validation error.
 #[allow(dead_code, reason = "not every test reads a report")]
 pub fn example_report(name: &str) -> Option<serde_json::Value> {
+    example_report_with(name, &[])
+}
+
+/// [`example_report`] with `extra` arguments after `--out` and `--report`.
+#[allow(dead_code, reason = "not every test reads a report")]
+pub fn example_report_with(name: &str, extra: &[&OsStr]) -> Option<serde_json::Value> {
     let folder = tempfile::Builder::new()
         .prefix(&format!("lodkit-bevy-{name}-"))
         .tempdir()
@@ -66,6 +72,7 @@ pub fn example_report(name: &str) -> Option<serde_json::Value> {
         OsStr::new("--report"),
         report.as_os_str(),
     ];
+    let args: Vec<&OsStr> = args.iter().chain(extra).copied().collect();
     let output = run_example(name, &args)?;
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{name} failed: {stderr}");

@@ -12,7 +12,7 @@ use crate::gpu::resources::{
 use crate::gpu::{GpuContext, GpuError};
 use crate::impostor::{
     ImpostorAtlas, ImpostorImage, ImpostorLayout, dilate_frames, impostor_frame_basis,
-    impostor_frame_dir, mip_chain, preserve_coverage,
+    impostor_frame_dir,
 };
 
 /// Rust mirror of `BakeParams` in `passes/impostor_bake.wgsl`.
@@ -275,7 +275,7 @@ impl ImpostorBaker {
 
     /// Bakes the atlas `descriptor` describes: one render pass draws every frame into its
     /// viewport; the CPU then pads the frames ([`dilate_frames`]) and builds the mip chains
-    /// ([`mip_chain`]).
+    /// ([`ImpostorAtlas::from_level0`]).
     pub fn bake(
         &self,
         gpu: &GpuContext,
@@ -311,12 +311,11 @@ impl ImpostorBaker {
         let mut color = to_image(size, &color);
         let mut normal_depth = to_image(size, &normal_depth);
         dilate_frames(&mut color, &mut [&mut normal_depth], n, layout.frame_size);
-        let mut color = mip_chain(color, n, layout.frame_size);
-        preserve_coverage(&mut color, n);
-        Ok(ImpostorAtlas {
-            layout,
-            color,
-            normal_depth: mip_chain(normal_depth, n, layout.frame_size),
+        ImpostorAtlas::from_level0(layout, color, normal_depth).map_err(|e| GpuError::Invalid {
+            call: CALL,
+            parameter: "descriptor",
+            value: e.to_string(),
+            rule: "must describe an atlas lodkit can bake",
         })
     }
 

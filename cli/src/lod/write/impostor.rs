@@ -4,8 +4,8 @@
 
 use gltf::json::{self, Index, validation::Checked};
 use lodkit::impostor::{
-    ImpostorLayout, ImpostorShape, impostor_atlas_uv, impostor_blend, impostor_frame_basis,
-    impostor_frame_dir, impostor_frame_uv,
+    ImpostorGltfExtras, ImpostorLayout, ImpostorShape, impostor_atlas_uv, impostor_blend,
+    impostor_frame_basis, impostor_frame_dir, impostor_frame_uv,
 };
 
 use super::{Output, serde_json_map};
@@ -137,21 +137,13 @@ impl Output {
             }],
             weights: None,
         });
-        let shape = if hemi { "hemi" } else { "full" };
+        let fields =
+            ImpostorGltfExtras::new(layout, color_image.value(), normal_depth_image.value());
+        let fields = json::serialize::to_value(fields)
+            .expect("numbers, strings and arrays always serialize");
         let extras = json::Value::from(serde_json_map([(
             lodkit::impostor::IMPOSTOR_GLTF_EXTRAS_KEY,
-            json::Value::from(serde_json_map([
-                ("frames", json::Value::from(layout.frames)),
-                ("frame_size", json::Value::from(layout.frame_size)),
-                ("shape", json::Value::from(shape)),
-                ("center", json::Value::from(layout.center.to_vec())),
-                ("radius", json::Value::from(layout.radius)),
-                ("color_image", json::Value::from(color_image.value())),
-                (
-                    "normal_depth_image",
-                    json::Value::from(normal_depth_image.value()),
-                ),
-            ])),
+            fields,
         )]));
         ImpostorLevel { mesh, extras }
     }

@@ -1,0 +1,175 @@
+//! A node's impostor level (`lodkit lod --impostor`): read from the card node's extras
+//! ([`ImpostorGltfExtras`]) while the file loads, drawn with an [`ImpostorMaterial`] built once
+//! per file and atlas when the scene is spawned.
+
+use bevy::gltf::{GltfAssetLabel, gltf};
+use bevy::platform::collections::HashMap;
+use bevy::prelude::*;
+use lodkit::impostor::{
+    IMPOSTOR_GLTF_EXTRAS_KEY, ImpostorGltfExtras, ImpostorLayout, ImpostorShape,
+};
+
+use crate::impostor::ImpostorMaterial;
+
+/// The impostor that ends a node's levels ([`GltfLod::impostor`](super::GltfLod::impostor)):
+/// its layout and the two atlas images (level 0, as Bevy's loader read them).
+#[derive(Reflect, Clone, Debug, Default, PartialEq)]
+#[reflect(Default, Clone)]
+pub struct GltfLodImpostor {
+    /// Frames per side.
+    pub frames: u32,
+    /// Texels per side of one frame.
+    pub frame_size: u32,
+    /// The upper hemisphere of directions (else the whole sphere).
+    pub hemi: bool,
+    /// The bounding sphere's centre, in the finest mesh's space.
+    pub center: Vec3,
+    /// The bounding sphere's radius.
+    pub radius: f32,
+    /// The colour atlas.
+    pub color: Handle<Image>,
+    /// The normal and depth atlas.
+    pub normal_depth: Handle<Image>,
+}
+
+impl GltfLodImpostor {
+    /// The layout lodkit draws.
+    pub fn layout(&self) -> ImpostorLayout {
+        ImpostorLayout {
+            frames: self.frames,
+            frame_size: self.frame_size,
+            shape: if self.hemi {
+                ImpostorShape::Hemi
+            } else {
+                ImpostorShape::Full
+            },
+            center: self.center.to_array(),
+            radius: self.radius,
+        }
+    }
+}
+
+/// Per node of `gltf`: None where it is no impostor's card, else its extras read (or why they
+/// cannot be).
+pub(super) fn impostor_nodes(gltf: &gltf::Gltf) -> Vec<Option<Result<ImpostorGltfExtras, String>>> {
+    gltf.nodes()
+        .map(|node| {
+            let extras = node.extras().as_ref()?;
+            let value: gltf::json::Value = gltf::json::deserialize::from_str(extras.get()).ok()?;
+            let fields = value.get(IMPOSTOR_GLTF_EXTRAS_KEY)?;
+            Some(
+                gltf::json::deserialize::from_value::<ImpostorGltfExtras>(fields.clone())
+                    .map_err(|e| format!("extras.{IMPOSTOR_GLTF_EXTRAS_KEY}: {e}"))
+                    .and_then(|x| x.layout().map(|_| x).map_err(|e| e.to_string())),
+            )
+        })
+        .collect()
+}
+
+/// Per image of `gltf`, the first texture that shows it (Bevy's loader loads textures, not
+/// images).
+pub(super) fn image_textures(gltf: &gltf::Gltf) -> Vec<Option<usize>> {
+    let mut out = vec![None; gltf.images().len()];
+    for texture in gltf.textures() {
+        if let Some(slot) = out.get_mut(texture.source().index()) {
+            slot.get_or_insert(texture.index());
+        }
+    }
+    out
+}
+
+/// The impostor of extras `x`, its images' handles taken from the load (`textures` from
+/// [`image_textures`]).
+pub(super) fn gltf_impostor(
+    load_context: &mut bevy::asset::LoadContext<'_>,
+    x: &ImpostorGltfExtras,
+    textures: &[Option<usize>],
+) -> Result<GltfLodImpostor, String> {
+    let mut texture = |image: usize, name: &str| {
+        let t = textures
+            .get(image)
+            .ok_or_else(|| format!("its {name} image {image} does not exist"))?
+            .ok_or_else(|| {
+                format!("its {name} image {image} has no texture (Bevy loads textures)")
+            })?;
+        Ok::<_, String>(load_context.get_label_handle(GltfAssetLabel::Texture(t).to_string()))
+    };
+    Ok(GltfLodImpostor {
+        frames: x.frames,
+        frame_size: x.frame_size,
+        hemi: x.shape.is_hemi(),
+        center: Vec3::from_array(x.center),
+        radius: x.radius,
+        color: texture(x.color_image, "colour")?,
+        normal_depth: texture(x.normal_depth_image, "normal and depth")?,
+    })
+}
+
+/// What draws a node's impostor level: the card and material for the node's first primitive,
+/// and for its other primitives a mesh that draws nothing (one triangle of no area at the
+/// sphere's centre), so that their groups leave at the impostor's switch exactly as the first's
+/// enters it (same distances, same transition: where the dither drops the first's last mesh
+/// level the impostor shows, and the others' last levels are dropped at the same pixels).
+#[derive(Clone)]
+pub(super) struct ImpostorDraw {
+    pub card: Handle<Mesh>,
+    pub material: Handle<ImpostorMaterial>,
+    pub nothing: Handle<Mesh>,
+}
+
+/// The [`ImpostorDraw`] of each impostor the spawned scenes draw, built once per pair of atlas
+/// images (every spawn of a file shares it); an entry goes when its colour image is unloaded.
+#[derive(Resource, Default)]
+pub(super) struct GltfImpostors(
+    HashMap<(AssetId<Image>, AssetId<Image>), Result<ImpostorDraw, String>>,
+);
+
+impl GltfImpostors {
+    /// The draw of `impostor`, built on first use; an error says why it cannot be drawn (its
+    /// images not loaded, or not an atlas of its layout).
+    pub(super) fn get(
+        &mut self,
+        impostor: &GltfLodImpostor,
+        images: &mut Assets<Image>,
+        meshes: &mut Assets<Mesh>,
+        materials: &mut Assets<ImpostorMaterial>,
+    ) -> Result<ImpostorDraw, String> {
+        self.0.retain(|(color, _), _| images.contains(*color));
+        let key = (impostor.color.id(), impostor.normal_depth.id());
+        if let Some(made) = self.0.get(&key) {
+            return made.clone();
+        }
+        let (Some(color), Some(normal_depth)) = (
+            images.get(&impostor.color),
+            images.get(&impostor.normal_depth),
+        ) else {
+            // Not cached: the images may load later.
+            return Err("its atlas images are not loaded".into());
+        };
+        let layout = impostor.layout();
+        let made = ImpostorMaterial::atlas_of_images(layout, color, normal_depth)
+            .and_then(|atlas| ImpostorMaterial::new(&atlas, images))
+            .map(|material| ImpostorDraw {
+                card: meshes.add(ImpostorMaterial::card_mesh(&layout)),
+                material: materials.add(material),
+                nothing: meshes.add(nothing_mesh(impostor.center)),
+            })
+            .map_err(|e| e.to_string());
+        self.0.insert(key, made.clone());
+        made
+    }
+}
+
+/// One triangle of no area at `at` (no fragment is drawn), with the attributes a
+/// `StandardMaterial` may read.
+fn nothing_mesh(at: Vec3) -> Mesh {
+    Mesh::new(
+        bevy::mesh::PrimitiveTopology::TriangleList,
+        bevy::asset::RenderAssetUsages::all(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![at.to_array(); 3])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; 3])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, vec![[0.0f32, 0.0]; 3])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_TANGENT, vec![[1.0f32, 0.0, 0.0, 1.0]; 3])
+    .with_inserted_indices(bevy::mesh::Indices::U16(vec![0, 1, 2]))
+}
