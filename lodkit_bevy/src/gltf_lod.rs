@@ -26,14 +26,18 @@
 //! [`ImpostorGltfExtras`](lodkit::impostor::ImpostorGltfExtras), the last of the node's levels)
 //! is drawn with an [`ImpostorMaterial`](crate::impostor::ImpostorMaterial) (the plugin adds
 //! [`ImpostorPlugin`](crate::impostor::ImpostorPlugin)): its two atlas images, as Bevy's loader
-//! read them, get their mip chains (`ImpostorMaterial::from_level0_images`) once per file, and
+//! read them, get their mip chains (`ImpostorMaterial::from_level0_images`) once per atlas, and
 //! the card is [`ImpostorMaterial::card_mesh`](crate::impostor::ImpostorMaterial::card_mesh) of
 //! the layout, not the file's quad (which shows the object's front from every side). The
 //! impostor is the whole mesh's picture: it is the last level of the group of the node's first
-//! primitive, and the groups of its other primitives are hidden from the impostor's distance
-//! on. An impostor that cannot be drawn (extras that do not read, images that are not loaded or
-//! not an atlas of the layout) is left out with a warning naming the node and why, and the last
-//! mesh level is shown in its place, up to where the node is hidden.
+//! primitive, and the groups of its other primitives end in a level that draws nothing, with the
+//! same material and distances, so the object enters its impostor as a whole (every group of
+//! it mixes material types, so every transition of the object blends with the screen-door
+//! dither). A node whose atlas images are files of their own waits for them (its finest level
+//! shown meanwhile). An impostor that cannot be drawn (extras that do not read, images that did
+//! not load or are not an atlas of the layout, primitives turned by Bevy's
+//! `GltfConvertCoordinates::rotate_meshes`) is left out with a warning naming the node and why,
+//! and the last mesh level is shown in its place, up to where the node is hidden.
 
 use bevy::asset::LoadContext;
 use bevy::gltf::extensions::{
@@ -47,7 +51,6 @@ use lodkit::select::LodGroup;
 use crate::frame_sequential::levels::{
     FrameSequentialGroup, FrameSequentialSystems, LevelMaterial, LodLevel, LodLevels,
 };
-use crate::impostor::ImpostorMaterial;
 
 mod impostor;
 
@@ -125,6 +128,8 @@ struct MsftLod {
     impostors: Vec<Option<Result<lodkit::impostor::ImpostorGltfExtras, String>>>,
     /// Per image: the first texture that shows it.
     image_textures: Vec<Option<usize>>,
+    /// Per texture: the image Bevy's loader made of it (`on_texture`).
+    texture_handles: Vec<Option<Handle<Image>>>,
 }
 
 impl GltfExtensionHandler for MsftLod {
@@ -149,6 +154,13 @@ impl GltfExtensionHandler for MsftLod {
             .collect();
         self.impostors = impostor::impostor_nodes(gltf);
         self.image_textures = impostor::image_textures(gltf);
+        self.texture_handles = vec![None; gltf.textures().len()];
+    }
+
+    fn on_texture(&mut self, gltf_texture: &gltf::Texture, texture: Handle<Image>) {
+        if let Some(slot) = self.texture_handles.get_mut(gltf_texture.index()) {
+            *slot = Some(texture);
+        }
     }
 
     fn on_gltf_node(
@@ -238,8 +250,9 @@ impl MsftLod {
         let mut coverage = screen_coverage(node)?;
         let mut impostor = None;
         if let Some((id, extras)) = impostor_node {
-            let read = extras
-                .and_then(|x| impostor::gltf_impostor(load_context, &x, &self.image_textures));
+            let read = extras.and_then(|x| {
+                impostor::gltf_impostor(&x, &self.image_textures, &self.texture_handles)
+            });
             match read {
                 Ok(i) => impostor = Some(i),
                 Err(why) => {
@@ -394,26 +407,50 @@ fn lod_group(distances: &[f32], max: Option<f32>) -> Result<LodGroup, String> {
 /// draws nothing, at the same distance.
 fn spawn_gltf_groups(
     mut commands: Commands,
-    nodes: Query<(Entity, &GltfLod, &Children), Added<GltfLod>>,
-    primitives: Query<(&Mesh3d, &MeshMaterial3d<StandardMaterial>)>,
-    mut impostors: ResMut<impostor::GltfImpostors>,
-    mut images: ResMut<Assets<Image>>,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut impostor_materials: ResMut<Assets<ImpostorMaterial>>,
+    nodes: Query<(Entity, &GltfLod, &Children, Option<&Name>), Without<GltfLodSpawned>>,
+    primitives: Query<(&Mesh3d, &MeshMaterial3d<StandardMaterial>, &Transform)>,
+    mut impostors: impostor::ImpostorAssets,
 ) {
-    for (node, lod, children) in &nodes {
+    for (node, lod, children, name) in &nodes {
+        let name = name.map_or_else(|| format!("{node}"), |n| format!("{n:?} ({node})"));
+        // An atlas in files of its own may still be loading: the node waits for it (its
+        // finest level shown meanwhile).
+        if lod.impostor.as_ref().is_some_and(|i| impostors.loading(i)) {
+            continue;
+        }
+        commands.entity(node).insert(GltfLodSpawned);
+        let Some(mesh_levels) = lod
+            .distances
+            .len()
+            .checked_sub(usize::from(lod.impostor.is_some()))
+            .filter(|&n| n > 0)
+        else {
+            warn!("glTF node {name}: MSFT_lod ignored: no switch distance for its finest level");
+            continue;
+        };
+        // The card is placed in the primitive's space, which Bevy's coordinate conversion
+        // (`GltfConvertCoordinates::rotate_meshes`) turns by the child's transform.
+        let turned = children
+            .iter()
+            .filter_map(|c| primitives.get(c).ok())
+            .any(|(_, _, t)| *t != Transform::IDENTITY);
         let drawn = lod.impostor.as_ref().and_then(|i| {
-            impostors
-                .get(i, &mut images, &mut meshes, &mut impostor_materials)
-                .inspect_err(|why| {
-                    warn!(
-                        "glTF node {node}: impostor level left out ({why}); the last mesh level \
-                         is shown up to where the node is hidden"
-                    )
-                })
-                .ok()
+            let made = match turned {
+                true => Err(
+                    "the primitives' entities are transformed (GltfConvertCoordinates \
+                             rotate_meshes): an impostor is drawn in the file's space only"
+                        .to_owned(),
+                ),
+                false => impostors.draw(i),
+            };
+            made.inspect_err(|why| {
+                warn!(
+                    "glTF node {name}: impostor level left out ({why}); the last mesh level is \
+                     shown up to where the node is hidden"
+                )
+            })
+            .ok()
         });
-        let mesh_levels = lod.distances.len() - usize::from(lod.impostor.is_some());
         let distances = match &drawn {
             Some(_) => &lod.distances[..],
             None => &lod.distances[..mesh_levels],
@@ -422,38 +459,39 @@ fn spawn_gltf_groups(
             Ok(group) => group,
             Err(e) => {
                 warn!(
-                    "glTF node {node}: MSFT_lod ignored: the switch distances {:?} and max distance {:?}: {e}",
-                    lod.distances, lod.max_distance
+                    "glTF node {name}: MSFT_lod ignored: the switch distances {distances:?} and \
+                     max distance {:?}: {e}",
+                    lod.max_distance
                 );
                 continue;
             }
         };
+        let mut card_taken = false;
         for &child in children {
-            let Ok((mesh, material)) = primitives.get(child) else {
+            let Ok((mesh, material, _)) = primitives.get(child) else {
                 continue;
             };
-            let Some(k) = lod.primitives.iter().position(|p| p.mesh == mesh.0) else {
+            let Some(primitive) = lod.primitives.iter().find(|p| p.mesh == mesh.0) else {
                 continue;
             };
-            let primitive = &lod.primitives[k];
             let mut levels = vec![LodLevel::new(mesh.0.clone(), material.0.clone())];
             levels.extend(primitive.levels.iter().map(|level| {
                 let material = level.material.clone().unwrap_or_else(|| material.0.clone());
                 LodLevel::new(level.mesh.clone(), material)
             }));
             if let Some(draw) = &drawn {
-                levels.push(if k == 0 {
-                    LodLevel::new(
-                        draw.card.clone(),
-                        LevelMaterial::custom(draw.material.clone()),
-                    )
-                } else {
-                    // The others' last level draws nothing from the impostor's switch.
-                    LodLevel {
-                        mesh: draw.nothing.clone(),
-                        material: levels[levels.len() - 1].material.clone(),
-                    }
-                });
+                // The first primitive shows the impostor; the others' last level draws nothing,
+                // with the impostor's material, so every group of the object takes the same
+                // way through each transition (one that mixes material types blends with the
+                // screen-door dither).
+                let mesh = match std::mem::replace(&mut card_taken, true) {
+                    false => draw.card.clone(),
+                    true => draw.nothing.clone(),
+                };
+                levels.push(LodLevel::new(
+                    mesh,
+                    LevelMaterial::custom(draw.material.clone()),
+                ));
             }
             commands
                 .entity(child)
@@ -462,6 +500,10 @@ fn spawn_gltf_groups(
         }
     }
 }
+
+/// Marks a node whose primitives [`spawn_gltf_groups`] made groups of (or left as they are).
+#[derive(Component)]
+struct GltfLodSpawned;
 
 #[cfg(test)]
 mod tests {

@@ -82,7 +82,9 @@ impl Plugin for ImpostorPlugin {
     }
 
     fn build(&self, app: &mut App) {
-        if app.world().contains_resource::<ImpostorPluginBuilt>() {
+        if app.world().contains_resource::<ImpostorPluginBuilt>()
+            || app.is_plugin_added::<MaterialPlugin<ImpostorMaterial>>()
+        {
             return;
         }
         app.insert_resource(ImpostorPluginBuilt);
@@ -242,10 +244,9 @@ impl ImpostorMaterial {
     /// The material of an impostor of `layout` whose atlases are Bevy images of level 0 (frames
     /// padded: what `lodkit lod --impostor` writes into a glTF file, read by Bevy's loader), the
     /// mip chains built as a bake builds them ([`ImpostorAtlas::from_level0`]) and added to
-    /// `images` with the two atlases. `color`: RGBA8 holds sRGB-encoded colour (whether its
-    /// format says `Rgba8UnormSrgb` or `Rgba8Unorm`: the bytes are what the PNG held), RGBA16
-    /// and RGBA32 float linear colour; `normal_depth`: RGBA8 or RGBA16 unorm, RGBA16 or RGBA32
-    /// float, linear. An image of another format, not square, not the layout's size, or whose
+    /// `images` with the two atlases. `color`: RGBA8 or RGBA16 unorm holds sRGB-encoded colour
+    /// (whether its format says `Rgba8UnormSrgb` or `Rgba8Unorm`: the values are what the PNG
+    /// held), RGBA16 or RGBA32 float linear colour; `normal_depth`: any of the four, linear. An image of another format, not square, not the layout's size, or whose
     /// texels are not in main-world memory (`RenderAssetUsages` without `MAIN_WORLD`) is an
     /// error naming it.
     pub fn from_level0_images(
@@ -356,7 +357,12 @@ fn atlas_level0(
             data.len()
         )));
     }
-    let decode = srgb_bytes && bytes == 1;
+    // PNG samples are sRGB at any depth; float images hold linear values.
+    let decode = srgb_bytes
+        && matches!(
+            format,
+            TextureFormat::Rgba8UnormSrgb | TextureFormat::Rgba8Unorm | TextureFormat::Rgba16Unorm
+        );
     let texels = data[..texels * 4 * bytes]
         .chunks_exact(4 * bytes)
         .map(|texel| {

@@ -114,6 +114,28 @@ fn level_0_images_become_the_atlas_material() {
     let n = images.get(&material.normal_depth).unwrap();
     // 0.75 as a half: 0x3a00, little-endian.
     assert_eq!(n.data.as_ref().map(|d| [d[0], d[1]]), Some([0x00, 0x3a]));
+    // The same colour as RGBA8 without the sRGB flag, and as a 16-bit PNG loads (188 x 257):
+    // sRGB samples both, the same bytes back.
+    for other in [
+        image(8, TextureFormat::Rgba8Unorm, &[188, 20, 250, 255]),
+        image(
+            8,
+            TextureFormat::Rgba16Unorm,
+            &[188u16, 20, 250, 255]
+                .map(|v| (v * 257).to_le_bytes())
+                .concat(),
+        ),
+    ] {
+        let m = ImpostorMaterial::from_level0_images(layout(), &other, &nd, &mut images).unwrap();
+        let c = images.get(&m.color).unwrap();
+        let bytes = c.data.as_ref().map(|d| d[..4].to_vec());
+        assert_eq!(
+            bytes,
+            Some(vec![188, 20, 250, 255]),
+            "{:?}",
+            other.texture_descriptor.format
+        );
+    }
     let mut gone = color.clone();
     gone.data = None;
     let wrong = [
@@ -136,7 +158,11 @@ fn level_0_images_become_the_atlas_material() {
     let e =
         ImpostorMaterial::from_level0_images(layout(), &color, &small, &mut images).unwrap_err();
     assert!(e.to_string().contains("normal_depth image is 4 x 4"), "{e}");
-    assert_eq!(images.len(), 2, "images added for the atlas read only");
+    assert_eq!(
+        images.len(),
+        6,
+        "images added for the three atlases read only"
+    );
 }
 
 #[test]

@@ -11,8 +11,9 @@ use super::{ImpostorError, ImpostorLayout, ImpostorShape};
 /// {"frames": 12, "frame_size": 128, "shape": "hemi", "center": [0.0, 1.0, 0.0],
 ///  "radius": 1.5, "color_image": 7, "normal_depth_image": 8}
 /// ```
+///
+/// Fields it does not know are ignored (a later writer may add some).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct ImpostorGltfExtras {
     /// Frames per side.
     pub frames: u32,

@@ -322,7 +322,8 @@ fn an_atlas_from_level_0_gets_the_mip_chains_a_bake_gives() {
 }
 
 /// The extras `lodkit lod --impostor` writes, as docs/impostors.md spells them, read back; a
-/// shape or a field that is not one of them is refused.
+/// shape that is not one of them or a missing field is refused, a field it does not know
+/// ignored.
 #[test]
 fn impostor_extras_read_as_the_docs_spell_them() {
     let text = r#"{"frames": 12, "frame_size": 128, "shape": "hemi",
@@ -353,7 +354,14 @@ fn impostor_extras_read_as_the_docs_spell_them() {
     let e = serde_json::from_str::<ImpostorGltfExtras>(&sideways).unwrap_err();
     assert!(e.to_string().contains("sideways"), "{e}");
     let extra = text.replace("\"radius\"", "\"depth\": 1, \"radius\"");
-    assert!(serde_json::from_str::<ImpostorGltfExtras>(&extra).is_err());
+    assert_eq!(
+        serde_json::from_str::<ImpostorGltfExtras>(&extra).unwrap(),
+        extras,
+        "a field it does not know is ignored"
+    );
+    let missing = text.replace("\"color_image\": 7, ", "");
+    let e = serde_json::from_str::<ImpostorGltfExtras>(&missing).unwrap_err();
+    assert!(e.to_string().contains("color_image"), "{e}");
     let zero = text.replace("1.5", "0.0");
     let zero: ImpostorGltfExtras = serde_json::from_str(&zero).unwrap();
     assert!(zero.layout().is_err());

@@ -147,7 +147,11 @@ use crate::LodkitShadersPlugin;
 
 /// Adds frame-sequential LOD: the selection and transition scheduling of every
 /// [`FrameSequentialGroup`], the [`FrameSequentialMaterial`], and the combine pass on the camera
-/// with [`FrameSequentialLod`].
+/// with [`FrameSequentialLod`]. With the `gltf` feature it also makes groups of glTF files'
+/// `MSFT_lod` levels ([`gltf_lod`](crate::gltf_lod)) and adds
+/// [`ImpostorPlugin`](crate::impostor::ImpostorPlugin) and
+/// [`FrameSequentialMaterialPlugin::<ImpostorMaterial>`](FrameSequentialMaterialPlugin) to draw
+/// their impostor levels (an app may add either as well).
 pub struct FrameSequentialLodPlugin;
 
 impl Plugin for FrameSequentialLodPlugin {

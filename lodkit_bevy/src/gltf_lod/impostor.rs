@@ -2,7 +2,7 @@
 //! ([`ImpostorGltfExtras`]) while the file loads, drawn with an [`ImpostorMaterial`] built once
 //! per file and atlas when the scene is spawned.
 
-use bevy::gltf::{GltfAssetLabel, gltf};
+use bevy::gltf::gltf;
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use lodkit::impostor::{
@@ -66,8 +66,7 @@ pub(super) fn impostor_nodes(gltf: &gltf::Gltf) -> Vec<Option<Result<ImpostorGlt
         .collect()
 }
 
-/// Per image of `gltf`, the first texture that shows it (Bevy's loader loads textures, not
-/// images).
+/// Per image of `gltf`, the first texture that shows it.
 pub(super) fn image_textures(gltf: &gltf::Gltf) -> Vec<Option<usize>> {
     let mut out = vec![None; gltf.images().len()];
     for texture in gltf.textures() {
@@ -78,21 +77,26 @@ pub(super) fn image_textures(gltf: &gltf::Gltf) -> Vec<Option<usize>> {
     out
 }
 
-/// The impostor of extras `x`, its images' handles taken from the load (`textures` from
-/// [`image_textures`]).
+/// The impostor of extras `x`, its images' handles those Bevy's loader gave each texture
+/// (`handles`, by texture index: labelled images of the file, or images of their own files
+/// loaded by path), `textures` from [`image_textures`].
 pub(super) fn gltf_impostor(
-    load_context: &mut bevy::asset::LoadContext<'_>,
     x: &ImpostorGltfExtras,
     textures: &[Option<usize>],
+    handles: &[Option<Handle<Image>>],
 ) -> Result<GltfLodImpostor, String> {
-    let mut texture = |image: usize, name: &str| {
+    let texture = |image: usize, name: &str| {
         let t = textures
             .get(image)
             .ok_or_else(|| format!("its {name} image {image} does not exist"))?
             .ok_or_else(|| {
                 format!("its {name} image {image} has no texture (Bevy loads textures)")
             })?;
-        Ok::<_, String>(load_context.get_label_handle(GltfAssetLabel::Texture(t).to_string()))
+        handles
+            .get(t)
+            .cloned()
+            .flatten()
+            .ok_or_else(|| format!("Bevy's loader did not load texture {t} (its {name} atlas)"))
     };
     Ok(GltfLodImpostor {
         frames: x.frames,
@@ -106,9 +110,9 @@ pub(super) fn gltf_impostor(
 }
 
 /// What draws a node's impostor level: the card and material for the node's first primitive,
-/// and for its other primitives a mesh that draws nothing (one triangle of no area at the
-/// sphere's centre), so that their groups leave at the impostor's switch exactly as the first's
-/// enters it (same distances, same transition: where the dither drops the first's last mesh
+/// and for its other primitives a mesh that draws nothing with the same material (one triangle of
+/// no area), so that their groups leave at the impostor's switch exactly as the first's enters it
+/// (same distances and materials, same transition: where the dither drops the first's last mesh
 /// level the impostor shows, and the others' last levels are dropped at the same pixels).
 #[derive(Clone)]
 pub(super) struct ImpostorDraw {
@@ -117,12 +121,14 @@ pub(super) struct ImpostorDraw {
     pub nothing: Handle<Mesh>,
 }
 
-/// The [`ImpostorDraw`] of each impostor the spawned scenes draw, built once per pair of atlas
-/// images (every spawn of a file shares it); an entry goes when its colour image is unloaded.
+/// What a drawn impostor is built from: its two images and its layout's fields (as bits).
+type ImpostorKey = (AssetId<Image>, AssetId<Image>, [u32; 8]);
+
+/// The [`ImpostorDraw`] of each impostor the spawned scenes draw, built once per atlas and layout
+/// (every spawn of a file shares it); an entry goes when its colour image is unloaded (looked at
+/// when another impostor is spawned).
 #[derive(Resource, Default)]
-pub(super) struct GltfImpostors(
-    HashMap<(AssetId<Image>, AssetId<Image>), Result<ImpostorDraw, String>>,
-);
+pub(super) struct GltfImpostors(HashMap<ImpostorKey, Result<ImpostorDraw, String>>);
 
 impl GltfImpostors {
     /// The draw of `impostor`, built on first use; an error says why it cannot be drawn (its
@@ -134,8 +140,19 @@ impl GltfImpostors {
         meshes: &mut Assets<Mesh>,
         materials: &mut Assets<ImpostorMaterial>,
     ) -> Result<ImpostorDraw, String> {
-        self.0.retain(|(color, _), _| images.contains(*color));
-        let key = (impostor.color.id(), impostor.normal_depth.id());
+        self.0.retain(|(color, _, _), _| images.contains(*color));
+        let c = impostor.center;
+        let layout_bits = [
+            impostor.frames,
+            impostor.frame_size,
+            u32::from(impostor.hemi),
+            c.x.to_bits(),
+            c.y.to_bits(),
+            c.z.to_bits(),
+            impostor.radius.to_bits(),
+            0,
+        ];
+        let key = (impostor.color.id(), impostor.normal_depth.id(), layout_bits);
         if let Some(made) = self.0.get(&key) {
             return made.clone();
         }
@@ -143,8 +160,7 @@ impl GltfImpostors {
             images.get(&impostor.color),
             images.get(&impostor.normal_depth),
         ) else {
-            // Not cached: the images may load later.
-            return Err("its atlas images are not loaded".into());
+            return Err("its atlas images did not load".into());
         };
         let layout = impostor.layout();
         let made = ImpostorMaterial::atlas_of_images(layout, color, normal_depth)
@@ -172,4 +188,33 @@ fn nothing_mesh(at: Vec3) -> Mesh {
     .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, vec![[0.0f32, 0.0]; 3])
     .with_inserted_attribute(Mesh::ATTRIBUTE_TANGENT, vec![[1.0f32, 0.0, 0.0, 1.0]; 3])
     .with_inserted_indices(bevy::mesh::Indices::U16(vec![0, 1, 2]))
+}
+
+/// What [`spawn_gltf_groups`](super::spawn_gltf_groups) needs to draw impostors.
+#[derive(bevy::ecs::system::SystemParam)]
+pub(super) struct ImpostorAssets<'w> {
+    cache: ResMut<'w, GltfImpostors>,
+    images: ResMut<'w, Assets<Image>>,
+    meshes: ResMut<'w, Assets<Mesh>>,
+    materials: ResMut<'w, Assets<ImpostorMaterial>>,
+    server: Res<'w, AssetServer>,
+}
+
+impl ImpostorAssets<'_> {
+    /// Whether an atlas image of `impostor` is still loading (a file of its own).
+    pub(super) fn loading(&self, impostor: &GltfLodImpostor) -> bool {
+        [&impostor.color, &impostor.normal_depth]
+            .iter()
+            .any(|h| !self.images.contains(h.id()) && self.server.load_state(h.id()).is_loading())
+    }
+
+    /// The draw of `impostor` ([`GltfImpostors::get`]).
+    pub(super) fn draw(&mut self, impostor: &GltfLodImpostor) -> Result<ImpostorDraw, String> {
+        self.cache.get(
+            impostor,
+            &mut self.images,
+            &mut self.meshes,
+            &mut self.materials,
+        )
+    }
 }
