@@ -8,7 +8,7 @@
 //! each level's mesh (with the level's material where it has another), and the switch
 //! distances. When the scene is spawned, each primitive's entity becomes a
 //! [`FrameSequentialGroup`] with those [`LodLevels`], its `StandardMaterial` used as it is
-//! ([`LevelMaterial`](crate::frame_sequential::LevelMaterial)), its transform, its node's children
+//! ([`LevelMaterial`]), its transform, its node's children
 //! and its skin (`SkinnedMesh`, given to the entities that draw it) kept. A file without
 //! `MSFT_lod` loads as before.
 //!
@@ -30,7 +30,7 @@
 //! the card is [`ImpostorMaterial::card_mesh`](crate::impostor::ImpostorMaterial::card_mesh) of
 //! the layout, not the file's quad (which shows the object's front from every side). The
 //! impostor is the whole mesh's picture: it is the last level of the group of the node's first
-//! primitive, and the groups of its other primitives end in a level that draws nothing, with the
+//! primitive (the first that has an entity with a `StandardMaterial`), and the groups of its other primitives end in a level that draws nothing, with the
 //! same material and distances, so the object enters its impostor as a whole (every group of
 //! it mixes material types, so every transition of the object blends with the screen-door
 //! dither). A node whose atlas images are files of their own waits for them (its finest level
@@ -177,7 +177,7 @@ impl GltfExtensionHandler for MsftLod {
             || format!("node {}", gltf_node.index()),
             |n| format!("node {n:?}"),
         );
-        match self.levels(load_context, gltf_node, lod) {
+        match self.levels(load_context, gltf_node, lod, &name) {
             Ok(levels) => {
                 entity.insert(levels);
             }
@@ -189,12 +189,13 @@ impl GltfExtensionHandler for MsftLod {
 }
 
 impl MsftLod {
-    /// The [`GltfLod`] of `node`, whose `MSFT_lod` extension is `lod`.
+    /// The [`GltfLod`] of `node` (`name` in warnings), whose `MSFT_lod` extension is `lod`.
     fn levels(
         &mut self,
         load_context: &mut LoadContext<'_>,
         node: &gltf::Node,
         lod: &gltf::json::Value,
+        name: &str,
     ) -> Result<GltfLod, String> {
         let mesh = node.mesh().ok_or("the node has no mesh")?;
         let ids = lod
@@ -260,8 +261,8 @@ impl MsftLod {
                     // impostor's switch coverage goes).
                     without_last_level(coverage.as_mut(), ids.len())?;
                     warn!(
-                        "{}: impostor level node {id} left out ({why}); the last mesh level is \
-                         shown up to where the node is hidden",
+                        "{}: {name}: impostor level (node {id}) left out ({why}); the last \
+                         mesh level is shown up to where the node is hidden",
                         load_context.path()
                     );
                 }

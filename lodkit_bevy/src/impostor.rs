@@ -320,7 +320,7 @@ impl ImpostorMaterial {
 }
 
 /// Level 0 of atlas `atlas` from a Bevy image of `size` texels a side: RGBA floats, colour
-/// linear (8-bit colour decoded from sRGB where `srgb_bytes`).
+/// linear (8- or 16-bit unorm colour decoded from sRGB where `srgb_bytes`).
 fn atlas_level0(
     image: &Image,
     atlas: &'static str,

@@ -1,6 +1,6 @@
 //! A node's impostor level (`lodkit lod --impostor`): read from the card node's extras
 //! ([`ImpostorGltfExtras`]) while the file loads, drawn with an [`ImpostorMaterial`] built once
-//! per file and atlas when the scene is spawned.
+//! per atlas and layout when the scene is spawned.
 
 use bevy::gltf::gltf;
 use bevy::platform::collections::HashMap;
@@ -176,8 +176,9 @@ impl GltfImpostors {
     }
 }
 
-/// One triangle of no area at `at` (no fragment is drawn), with the attributes a
-/// `StandardMaterial` may read.
+/// One triangle of no area at `at`, drawn with the impostor's material: its shader places the
+/// card's corners by `UV_0`, all (0, 0) here, so no fragment is drawn. Normals for Bevy's
+/// pipelines that ask for them.
 fn nothing_mesh(at: Vec3) -> Mesh {
     Mesh::new(
         bevy::mesh::PrimitiveTopology::TriangleList,
@@ -186,7 +187,6 @@ fn nothing_mesh(at: Vec3) -> Mesh {
     .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![at.to_array(); 3])
     .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 1.0, 0.0]; 3])
     .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, vec![[0.0f32, 0.0]; 3])
-    .with_inserted_attribute(Mesh::ATTRIBUTE_TANGENT, vec![[1.0f32, 0.0, 0.0, 1.0]; 3])
     .with_inserted_indices(bevy::mesh::Indices::U16(vec![0, 1, 2]))
 }
 
