@@ -21,7 +21,8 @@
 //! over the whole walk; and the groups the plugin made of the file with the
 //! levels lodkit drew. `--gltf` loads another file (scene 0), `--frames` sets the walk's length
 //! (default 120), `--save-frames DIR` writes every frame of every run as
-//! `DIR/<run>/<frame>.png`, so anyone can recompute the figures.
+//! `DIR/<run>/<frame>.png`, so anyone can recompute the figures, `--msaa-off` gives every run's
+//! camera `Msaa::Off` (lodkit's frame-sequential combine instead of its dither).
 //!
 //! Exit codes: 0 done, 1 the scene did not load or render, 2 usage or I/O error.
 
@@ -50,8 +51,8 @@ use serde_json::{Value, json};
 use frames::{Frame, strip};
 use runs::{BACKGROUND, Failure, Run, Scene, Technique};
 
-const USAGE: &str =
-    "usage: gltf_scene [--out DIR] [--report FILE] [--gltf FILE] [--frames N] [--save-frames DIR]";
+const USAGE: &str = "usage: gltf_scene [--out DIR] [--report FILE] [--gltf FILE] [--frames N] [--save-frames DIR] \
+     [--msaa-off]";
 
 struct Args {
     out: PathBuf,
@@ -59,6 +60,7 @@ struct Args {
     gltf: PathBuf,
     frames: usize,
     save_frames: Option<PathBuf>,
+    msaa_off: bool,
 }
 
 fn parse() -> Result<Option<Args>, String> {
@@ -68,6 +70,7 @@ fn parse() -> Result<Option<Args>, String> {
         gltf: Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assets/lod_scene.glb"),
         frames: 120,
         save_frames: None,
+        msaa_off: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -78,6 +81,7 @@ fn parse() -> Result<Option<Args>, String> {
             "--report" => args.report = Some(PathBuf::from(value()?)),
             "--gltf" => args.gltf = PathBuf::from(value()?),
             "--save-frames" => args.save_frames = Some(PathBuf::from(value()?)),
+            "--msaa-off" => args.msaa_off = true,
             "--frames" => {
                 let v = value()?;
                 args.frames = match v.parse() {
@@ -185,6 +189,9 @@ fn run(args: &Args) -> Result<(), Failure> {
         .unwrap_or_default();
     std::fs::create_dir_all(&args.out).map_err(io)?;
     let mut scene = Scene::load(&assets, &file)?;
+    if args.msaa_off {
+        scene.msaa = Msaa::Off;
+    }
     let poses = walk(scene.sphere, 1.1 * scene.farthest_switch(), args.frames);
     let background = Frame::filled(1, 1, BACKGROUND.to_srgba().to_u8_array_no_alpha()).rgb(0, 0);
     let levels = scene
@@ -270,6 +277,7 @@ fn run(args: &Args) -> Result<(), Failure> {
         report.insert("size".into(), json!([runs::WIDTH, runs::HEIGHT]));
         report.insert("groups".into(), json!(groups));
         report.insert("plain_meshes".into(), json!(scene.plain_meshes));
+        report.insert("msaa_off".into(), json!(args.msaa_off));
         let text = serde_json::to_string_pretty(&Value::Object(report)).expect("JSON");
         std::fs::write(path, text).map_err(io)?;
     }

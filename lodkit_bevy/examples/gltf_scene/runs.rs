@@ -1,5 +1,5 @@
-//! The loaded scene and one run over it: a camera of its own (Bevy's default MSAA, nothing
-//! else changed), the scene's LOD groups drawn by lodkit, by Bevy's `VisibilityRange` crossfade
+//! The loaded scene and one run over it: a camera of its own (Bevy's default MSAA unless
+//! [`Scene::msaa`] says otherwise, nothing else changed), the scene's LOD groups drawn by lodkit, by Bevy's `VisibilityRange` crossfade
 //! from the same levels, or as one level alone (the references), every frame read back.
 
 use std::path::Path;
@@ -115,6 +115,8 @@ pub struct Scene {
     pub plain_meshes: usize,
     /// The sphere around the scene: (centre, radius).
     pub sphere: (Vec3, f32),
+    /// Every run's camera's MSAA (Bevy's default, `Sample4`, unless set).
+    pub msaa: Msaa,
 }
 
 impl Scene {
@@ -193,6 +195,7 @@ impl Scene {
             groups,
             plain_meshes,
             sphere,
+            msaa: Msaa::default(),
         })
     }
 
@@ -213,9 +216,12 @@ impl Scene {
     /// Runs `technique` with the camera at `poses`, one per frame.
     pub fn run(&mut self, technique: Technique, poses: &[Transform]) -> Result<Run, Failure> {
         let world = self.app.world_mut();
-        // An app's camera: Bevy's default MSAA (Sample4) is left as it is; no tonemapping or
-        // deband dither, so the background is the clear colour exactly.
-        let camera = world.spawn(harness_camera(&self.target, BACKGROUND, poses[0]));
+        // An app's camera: Bevy's default MSAA (Sample4) unless the scene says otherwise; no
+        // tonemapping or deband dither, so the background is the clear colour exactly.
+        let camera = world.spawn((
+            harness_camera(&self.target, BACKGROUND, poses[0]),
+            self.msaa,
+        ));
         let camera = camera.id();
         // The app's camera has no lodkit component: with groups about and no camera selecting,
         // the plugin gives it `FrameSequentialLod::default()`. The other runs' cameras are the
