@@ -90,8 +90,8 @@ fn screen_door_coverage(
         ambient: 0.4,
     };
     let instances = [ImpostorInstance {
-        model: Mat4::IDENTITY,
         alpha,
+        ..ImpostorInstance::new(Mat4::IDENTITY)
     }];
     pass.render(gpu, textures, &view, &instances, (SIZE, SIZE))
         .unwrap()

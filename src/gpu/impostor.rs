@@ -8,7 +8,8 @@ mod draw;
 
 pub use baker::ImpostorBaker;
 pub use draw::{
-    ImpostorInstance, ImpostorPass, ImpostorPassDescriptor, ImpostorView, PreparedImpostors,
+    ImpostorInstance, ImpostorLodView, ImpostorPass, ImpostorPassDescriptor, ImpostorTarget,
+    ImpostorView, PreparedImpostors,
 };
 
 use glam::Vec3;
