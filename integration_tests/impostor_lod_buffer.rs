@@ -13,9 +13,8 @@ use lodkit::gpu::frame_sequential::{
     read_lod_image,
 };
 use lodkit::gpu::impostor::{
-    ImpostorBakeDescriptor, ImpostorBaker, ImpostorInstance, ImpostorLodView, ImpostorMesh,
-    ImpostorPart, ImpostorPass, ImpostorPassDescriptor, ImpostorTarget, ImpostorTextures,
-    ImpostorView,
+    ImpostorBakeDescriptor, ImpostorBaker, ImpostorInstance, ImpostorLodView, ImpostorPass,
+    ImpostorPassDescriptor, ImpostorTarget, ImpostorTextures, ImpostorView,
 };
 use lodkit::gpu::readback::{read_depth32, read_texture_rgba8};
 use lodkit::gpu::resources::{begin_targets_pass, texture_2d};
@@ -43,18 +42,8 @@ pub(crate) fn lumpy() -> Mesh {
 
 /// The impostor of `mesh`: 12 x 12 frames of 64 texels over the whole sphere of directions.
 pub(crate) fn bake(gpu: &GpuContext, mesh: &Mesh) -> ImpostorTextures {
-    let positions: Vec<[f32; 3]> = mesh.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect();
-    let normals: Vec<[f32; 3]> = mesh.vertices.iter().map(|v| [v[3], v[4], v[5]]).collect();
-    let part = ImpostorPart {
-        mesh: ImpostorMesh {
-            positions: &positions,
-            indices: &mesh.indices,
-            normals: Some(&normals),
-            uvs: None,
-        },
-        material: Default::default(),
-    };
-    let baker = ImpostorBaker::new(gpu, &[part]).unwrap();
+    let streams = mesh.bake_streams();
+    let baker = ImpostorBaker::new(gpu, &[streams.part()]).unwrap();
     let descriptor = ImpostorBakeDescriptor {
         frames: 12,
         frame_size: 64,
@@ -289,6 +278,60 @@ fn an_impostor_in_a_lod_buffer_writes_what_its_colour_pass_covers_with_the_patte
     assert!(
         moving > 2000 && worst < 2e-4,
         "object motion off by {worst} (of up to {largest})"
+    );
+
+    // A still object under a camera that moved since the last frame: no object motion (the
+    // camera's is the combine's reprojection), and the pattern read next frame where the
+    // previous camera saw the point (visibility_next_coord on the point its depth names; a
+    // next coordinate within 1e-3 pixel of a texel edge may fall either side: skipped).
+    let before =
+        glam::camera::rh::view::look_at_mat4(eye + Vec3::new(0.3, 0.1, 0.0), Vec3::ZERO, Vec3::Y);
+    let prev_view_proj = glam::camera::rh::proj::directx::perspective(0.7, 1.0, 0.1, 20.0) * before;
+    let turned = ImpostorLodView {
+        prev_view_proj,
+        ..screen
+    };
+    draw_lod(
+        gpu,
+        (&lod_pass, &textures),
+        &buffers,
+        (1, &turned),
+        t_instance,
+    );
+    let got = read_lod_image(gpu, &buffers, 1).unwrap();
+    let (mut checked, mut edge) = (0, 0);
+    for p in (0..got.ids.len()).filter(|&p| got.ids[p] != 0) {
+        assert_eq!(
+            got.motion[p],
+            Vec2::ZERO,
+            "pixel {p}: a still object moved with the camera"
+        );
+        let point = inverse.project_point3(ndc(p, got.depths[p]));
+        let at = Vec2::new(
+            (p as u32 % SIZE) as f32 + 0.5,
+            (p as u32 / SIZE) as f32 + 0.5,
+        );
+        let then_clip = prev_view_proj * point.extend(1.0);
+        let next =
+            lodkit::visibility::visibility_next_coord(at, then_clip, Vec2::splat(SIZE as f32));
+        let off_edge = (next - next.floor() - Vec2::splat(0.5)).abs().max_element() < 0.499;
+        if !off_edge {
+            edge += 1;
+            continue;
+        }
+        checked += 1;
+        let flags = visibility_flags_screen(&vis, at, next, draw.tau, draw.tau_next);
+        assert_eq!(
+            got.flags[p], flags,
+            "pixel {p}: flags with the next frame's coordinate {next}"
+        );
+    }
+    say(&format!(
+        "camera moved: {checked} px' flags checked, {edge} within 1e-3 px of a texel edge"
+    ));
+    assert!(
+        checked > 2000 && edge * 50 < checked,
+        "{checked} checked, {edge} on an edge"
     );
 
     // Anchored to the object, the pattern moves with the surface: at the same threshold it

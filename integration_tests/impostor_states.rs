@@ -216,3 +216,97 @@ fn a_pass_refuses_what_its_target_cannot_do_by_name() {
         "{err}"
     );
 }
+
+#[test]
+fn an_update_in_place_draws_what_a_new_preparation_draws_and_ranges_draw_their_instances() {
+    let gpu = lodkit_test_gpu!();
+    let textures = bake(gpu, &lumpy());
+    let (view_proj, eye) = camera();
+    let view = impostor_view(view_proj, eye);
+    let pass = new_pass(gpu, ImpostorTarget::Color, LodRenderState::OPAQUE);
+    let opaque = (wgpu::Color::TRANSPARENT, LodRenderState::OPAQUE);
+    let left = ImpostorInstance::new(Mat4::from_translation(Vec3::new(-0.9, 0.0, 0.0)));
+    let right = ImpostorInstance {
+        tint: Vec3::new(1.0, 0.3, 0.3),
+        ..ImpostorInstance::new(Mat4::from_translation(Vec3::new(0.9, 0.0, -0.5)))
+    };
+    let both = [left, right];
+    // Prepared for one instance, then updated to two (the buffer grows) and to another view:
+    // byte for byte what a fresh preparation of the same draws.
+    let mut kept = pass.prepare(gpu, &textures, &view, &[right]).unwrap();
+    let moved = impostor_view(
+        Mat4::from_translation(Vec3::new(0.1, 0.0, 0.0)) * view_proj,
+        eye,
+    );
+    for v in [view, moved] {
+        pass.update(gpu, &mut kept, &textures, &v, None, &both)
+            .unwrap();
+        let fresh = pass.prepare(gpu, &textures, &v, &both).unwrap();
+        let (a, b) = (
+            draw_prepared(gpu, &pass, &kept, opaque, ..),
+            draw_prepared(gpu, &pass, &fresh, opaque, ..),
+        );
+        assert!(
+            a.iter().filter(|p| p[3] > 127).count() > 500,
+            "nothing drawn"
+        );
+        assert_eq!(a, b, "an updated set draws other pixels than a new one");
+    }
+    // A range draws its instances only: the two ranges make up the whole.
+    pass.update(gpu, &mut kept, &textures, &view, None, &both)
+        .unwrap();
+    let whole = draw_prepared(gpu, &pass, &kept, opaque, 0..2);
+    let first = draw_prepared(gpu, &pass, &kept, opaque, 0..1);
+    let second = draw_prepared(gpu, &pass, &kept, opaque, 1..9);
+    let alone = |i: ImpostorInstance| draw(gpu, &pass, i, opaque).0;
+    let (left_alone, right_alone) = (alone(left), alone(right));
+    assert_eq!(
+        first.concat(),
+        left_alone,
+        "range 0..1 is the first instance alone"
+    );
+    assert_eq!(
+        second.concat(),
+        right_alone,
+        "range 1..9 is the second instance alone"
+    );
+    let fresh = pass.prepare(gpu, &textures, &view, &both).unwrap();
+    let want = draw_prepared(gpu, &pass, &fresh, opaque, ..);
+    assert_eq!(whole, want, "range 0..2 is both instances");
+}
+
+/// `prepared`'s instances in `range` drawn into a cleared target: its pixels.
+fn draw_prepared(
+    gpu: &GpuContext,
+    pass: &ImpostorPass,
+    prepared: &lodkit::gpu::impostor::PreparedImpostors,
+    (clear, state): (wgpu::Color, LodRenderState),
+    range: impl std::ops::RangeBounds<u32>,
+) -> Vec<[u8; 4]> {
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let color = texture_2d(gpu, (SIZE, SIZE), FORMAT, usage, "colour").unwrap();
+    let depth_format = wgpu::TextureFormat::Depth32Float;
+    let depth = texture_2d(gpu, (SIZE, SIZE), depth_format, usage, "depth").unwrap();
+    let start = match range.start_bound() {
+        std::ops::Bound::Included(s) => *s,
+        _ => 0,
+    };
+    let end = match range.end_bound() {
+        std::ops::Bound::Excluded(e) => *e,
+        _ => u32::MAX,
+    };
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    {
+        let c = color.create_view(&Default::default());
+        let d = depth.create_view(&Default::default());
+        let mut render = begin_targets_pass(&mut encoder, &[(&c, clear)], &d, 1.0, None, "draw");
+        render.set_blend_constant(lod_blend_constant(&state));
+        pass.draw_instances(&mut render, prepared, start..end);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    read_texture_rgba8(gpu, &color)
+        .unwrap()
+        .chunks(4)
+        .map(|p| [p[0], p[1], p[2], p[3]])
+        .collect()
+}

@@ -18,8 +18,8 @@ fn expected_triangles(scene: &DemoScene, frames: usize, both: bool) -> u64 {
     for f in 0..=frames {
         let t = f as f32 / frames as f32;
         for o in &scene.objects {
-            let fine = o.fine.mesh().triangles() as u64;
-            let coarse = o.coarse.mesh().triangles() as u64;
+            let fine = o.fine.triangles();
+            let coarse = o.coarse.triangles();
             let inside = t > 0.0 && t < 1.0;
             total += match (o.transition, both && inside) {
                 (false, _) => fine,
@@ -154,6 +154,19 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
     assert_eq!(
         report.transitions.len(),
         scenes.len() * Technique::ALL.len()
+    );
+    // The scene with an octahedral impostor shows its atlas: one picture of its layout's side.
+    let atlases: Vec<_> = report.atlases.iter().map(|a| a.scene.as_str()).collect();
+    assert_eq!(atlases, ["impostors"], "scenes with an atlas picture");
+    let atlas = &report.atlases[0];
+    let picture = image::open(out.join(&atlas.picture)).unwrap();
+    assert_eq!(
+        (picture.width(), picture.height()),
+        (
+            atlas.frames * atlas.frame_size,
+            atlas.frames * atlas.frame_size
+        ),
+        "the atlas picture's size"
     );
     for scene in &scenes {
         let row = |name: &str| {
@@ -346,14 +359,25 @@ fn demo_measures_every_technique_and_its_report_opens_in_chromium() {
             "frame-seq-default in {}: see-through and ghost pixel-frames",
             scene.name
         );
+        // An octahedral impostor has no outline for the silhouettes' route: as the older level
+        // it is left to the estimate (`impostors`: 38 pixel-frames against the estimate's 94),
+        // so there fewer than the estimate and at most 45 (20 % above the measured).
+        let octahedral = scene.objects.iter().any(|o| {
+            o.fine
+                .octahedral_of()
+                .or(o.coarse.octahedral_of())
+                .is_some()
+        });
         for (estimated, known) in [
             ("frame-seq-complementary", "frame-seq-silhouettes"),
             ("frame-seq-complementary", "frame-seq-default"),
         ] {
             let wrong = |r: &TransitionMetrics| r.see_through_pixel_frames + r.ghost_pixel_frames;
             let (estimated, count) = (wrong(row(estimated)), wrong(row(known)));
+            let partly_estimated = octahedral && known == "frame-seq-silhouettes";
+            let most = if partly_estimated { 45 } else { 5 };
             assert!(
-                count <= 5 && count < estimated,
+                count <= most && count < estimated,
                 "in {}: see-through and ghosts {count} pixel-frames with {known}, {estimated} estimated",
                 scene.name
             );

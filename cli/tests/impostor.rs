@@ -68,3 +68,48 @@ fn a_scene_with_two_kinds_of_impostor_is_refused() {
     let err = scene.check().unwrap_err();
     assert!(err.contains("kinds of Impostor"), "{err}");
 }
+
+#[test]
+fn an_octahedral_scene_reads_from_ron_and_its_objects_stay_uniform_and_still() {
+    use lodkit_cli::demo::fixtures::scene::Shape;
+    let text = "(name: \"octa\", camera: (eye: (0.0, 1.0, 6.0), target: (0.0, 0.0, 0.0), \
+        moving_eye: (1.0, 1.0, 5.0)), objects: [(fine: Tree(puffs: 5, rings: 6), \
+        coarse: Octahedral(puffs: 5, rings: 6), fine_color: (0.2, 0.6, 0.2), \
+        coarse_color: (0.2, 0.5, 0.3), position: (0.0, 0.0, 0.0), scale: (0.8, 0.8, 0.8))])";
+    let scene = DemoScene::from_ron(text, "octa.ron").unwrap();
+    let coarse = scene.objects[0].coarse;
+    assert_eq!(coarse, Shape::Octahedral { puffs: 5, rings: 6 });
+    assert_eq!(coarse.triangles(), 2, "a card");
+    assert_eq!(
+        coarse.octahedral_of(),
+        Some(Shape::Tree { puffs: 5, rings: 6 })
+    );
+    let refused = |from: &str, to: &str, wanted: &str| {
+        let bad = text.replace(from, to);
+        let err = DemoScene::from_ron(&bad, "octa.ron")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(wanted), "{err}");
+    };
+    refused(
+        "scale: (0.8, 0.8, 0.8)",
+        "scale: (0.8, 1.6, 0.8)",
+        "objects[0].scale = [0.8, 1.6, 0.8] must be uniform",
+    );
+    refused(
+        "scale: (0.8, 0.8, 0.8)",
+        "scale: (0.8, 0.8, 0.8), sway: 0.1",
+        "objects[0].sway = 0.1 must be 0",
+    );
+    refused(
+        "Octahedral(puffs: 5",
+        "Octahedral(puffs: 40",
+        "objects[0].coarse: puffs = 40",
+    );
+    let mut two = scene.clone();
+    let mut other = two.objects[0].clone();
+    other.coarse = Shape::Octahedral { puffs: 3, rings: 6 };
+    two.objects.push(other);
+    let err = two.check().unwrap_err();
+    assert!(err.contains("kinds of Octahedral"), "{err}");
+}

@@ -3,7 +3,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::mesh::{GpuMesh, UNFILTERABLE, masked_view_group};
+use crate::mesh::{GpuMesh, PassDraw, UNFILTERABLE, draw_foreign, masked_view_group};
 use lodkit::alpha_mask::AlphaMask;
 use lodkit::combine::DepthConvention;
 use lodkit::frame_sequential::FrameDraw;
@@ -95,6 +95,9 @@ pub struct LodBufferFrame<'a> {
     pub clear: wgpu::Color,
     /// Counts the pass's fragment-shader invocations. Default: none.
     pub counter: Option<&'a FragmentCounter>,
+    /// The caller's own draws in the same pass, between the items (an impostor level drawn by
+    /// `lodkit::gpu::impostor::ImpostorPass`, say). Default: none.
+    pub foreign: &'a [PassDraw<'a>],
 }
 
 impl Default for LodBufferFrame<'_> {
@@ -105,6 +108,7 @@ impl Default for LodBufferFrame<'_> {
             items: &[],
             clear: wgpu::Color::BLACK,
             counter: None,
+            foreign: &[],
         }
     }
 }
@@ -366,6 +370,7 @@ impl LodBufferRenderer {
             items,
             clear,
             counter,
+            foreign,
         } = *frame;
         let call = match level_depth {
             true => "LodBufferRenderer::render_level_depth",
@@ -417,21 +422,27 @@ impl LodBufferRenderer {
                 if let Some(c) = counter {
                     c.begin(&mut pass);
                 }
-                pass.set_pipeline(match (level_depth, buffers.motion()) {
+                let pipeline = match (level_depth, buffers.motion()) {
                     (true, _) => &self.level_depth_pipeline,
                     (false, Some(_)) => &self.pipeline,
                     (false, None) => &self.still_pipeline,
-                });
-                pass.set_bind_group(0, &self.camera_group, &[]);
-                for (i, item) in items
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, item)| level_depth || item.shows_anything())
-                {
+                };
+                let mut bound = false;
+                for (i, item) in items.iter().enumerate() {
+                    bound &= !draw_foreign(&mut pass, foreign, i, items.len());
+                    if !(level_depth || item.shows_anything()) {
+                        continue;
+                    }
+                    if !bound {
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, &self.camera_group, &[]);
+                        bound = true;
+                    }
                     pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                     item.mesh.draw(&mut pass);
                     triangles += u64::from(item.mesh.triangles());
                 }
+                draw_foreign(&mut pass, foreign, items.len(), items.len());
                 if let Some(c) = counter {
                     c.end(&mut pass);
                 }

@@ -129,6 +129,15 @@ impl Mesh {
         self.indices.len() / 3
     }
 
+    /// Its streams as an impostor bake reads them (positions and normals apart).
+    pub fn bake_streams(&self) -> BakeStreams {
+        BakeStreams {
+            positions: self.vertices.iter().map(|v| [v[0], v[1], v[2]]).collect(),
+            normals: self.vertices.iter().map(|v| [v[3], v[4], v[5]]).collect(),
+            indices: self.indices.clone(),
+        }
+    }
+
     /// Appends `other` transformed by `transform` (normals by its inverse transpose), to build
     /// one mesh out of several parts.
     pub fn append(&mut self, other: &Mesh, transform: Mat4) {
@@ -140,6 +149,31 @@ impl Mesh {
             [p.x, p.y, p.z, n.x, n.y, n.z]
         }));
         self.indices.extend(other.indices.iter().map(|i| i + base));
+    }
+}
+
+/// A [`Mesh`]'s positions, normals and indices, held for an impostor bake
+/// ([`Mesh::bake_streams`]).
+#[derive(Clone, Debug, Default)]
+pub struct BakeStreams {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    indices: Vec<u32>,
+}
+
+impl BakeStreams {
+    /// The part `lodkit::gpu::impostor::ImpostorBaker` bakes: the mesh in a white, opaque,
+    /// single-sided material.
+    pub fn part(&self) -> lodkit::gpu::impostor::ImpostorPart<'_> {
+        lodkit::gpu::impostor::ImpostorPart {
+            mesh: lodkit::gpu::impostor::ImpostorMesh {
+                positions: &self.positions,
+                indices: &self.indices,
+                normals: Some(&self.normals),
+                uvs: None,
+            },
+            material: Default::default(),
+        }
     }
 }
 
@@ -236,6 +270,8 @@ pub struct MeshFrame<'a> {
     pub items: &'a [DrawItem<'a>],
     /// Counts the pass's fragment-shader invocations. Default: none.
     pub counter: Option<&'a FragmentCounter>,
+    /// The caller's own draws in the same pass, between the items. Default: none.
+    pub foreign: &'a [PassDraw<'a>],
 }
 
 impl Default for MeshFrame<'_> {
@@ -246,8 +282,47 @@ impl Default for MeshFrame<'_> {
             light_dir: Vec3::Z,
             items: &[],
             counter: None,
+            foreign: &[],
         }
     }
+}
+
+/// A draw of the caller's own (an impostor, say) inside a renderer's pass, between its items:
+/// it sets its own pipeline, bind groups and blend constant; the renderer sets its own again
+/// after it. Counted by the frame's counter with the rest of the pass.
+#[derive(Clone, Copy)]
+pub struct PassDraw<'a> {
+    /// Drawn before item `before` (`items.len()` or more: after the last).
+    pub before: usize,
+    /// Records the draw into the pass.
+    pub draw: &'a dyn Fn(&mut wgpu::RenderPass<'_>),
+}
+
+impl std::fmt::Debug for PassDraw<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PassDraw")
+            .field("before", &self.before)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Records the draws of `foreign` that go before item `i` of `n` (all that are left at `n`);
+/// whether there were any.
+pub(crate) fn draw_foreign(
+    pass: &mut wgpu::RenderPass<'_>,
+    foreign: &[PassDraw<'_>],
+    i: usize,
+    n: usize,
+) -> bool {
+    let mut drew = false;
+    for f in foreign
+        .iter()
+        .filter(|f| f.before == i || (i == n && f.before > n))
+    {
+        (f.draw)(pass);
+        drew = true;
+    }
+    drew
 }
 
 /// One draw: a mesh, where, its color, and how it takes part in a transition.
@@ -395,6 +470,7 @@ impl MeshRenderer {
             light_dir,
             items,
             counter,
+            foreign,
         } = *frame;
         const CALL: &str = "MeshRenderer::render";
         self.draws.check_count(CALL, items.len())?;
@@ -432,8 +508,9 @@ impl MeshRenderer {
                 if let Some(c) = counter {
                     c.begin(&mut pass);
                 }
-                pass.set_bind_group(0, &self.camera_group, &[]);
                 for (i, item) in items.iter().enumerate() {
+                    draw_foreign(&mut pass, foreign, i, items.len());
+                    pass.set_bind_group(0, &self.camera_group, &[]);
                     pass.set_pipeline(if item.state.blend {
                         &self.blended
                     } else {
@@ -443,6 +520,7 @@ impl MeshRenderer {
                     pass.set_bind_group(1, &self.draw_group, &[self.draws.offset(i)]);
                     item.mesh.draw(&mut pass);
                 }
+                draw_foreign(&mut pass, foreign, items.len(), items.len());
                 if let Some(c) = counter {
                     c.end(&mut pass);
                 }

@@ -136,7 +136,7 @@ fn vs_main(
 }
 
 /// What every entry point takes of a fragment: whether the frames cover it, its colour, the
-/// surface point they saw (normalized object space) and where it lies now in the world.
+/// surface point they saw (object space) and where it lies now in the world.
 struct Shaded {
     keep: bool,
     color: vec4<f32>,

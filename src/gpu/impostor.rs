@@ -5,12 +5,13 @@
 
 mod baker;
 mod draw;
+mod instance;
+mod prepare;
 
 pub use baker::ImpostorBaker;
-pub use draw::{
-    ImpostorInstance, ImpostorLodView, ImpostorPass, ImpostorPassDescriptor, ImpostorTarget,
-    ImpostorView, PreparedImpostors,
-};
+pub use draw::{ImpostorPass, ImpostorPassDescriptor, ImpostorTarget};
+pub use instance::{ImpostorInstance, ImpostorLodView, ImpostorView};
+pub use prepare::PreparedImpostors;
 
 use glam::Vec3;
 

@@ -35,7 +35,7 @@ use fixtures::render;
 use fixtures::scene::{DemoScene, SceneError};
 pub use measures::DemoReport;
 use measures::{
-    closed_loop, combine_timing, controllers, frame_cost, host_cost, lod_chain,
+    closed_loop, combine_timing, controllers, frame_cost, host_cost, impostor_atlas, lod_chain,
     packed_upsample_timing, selection, transitions, upsample_quality, upsample_timing,
 };
 use report::{doc_pictures, framebuffer_lod, plots};
@@ -181,7 +181,15 @@ pub fn run(options: &DemoOptions) -> Result<DemoReport, DemoError> {
 /// Most scenes whose transitions are measured at once.
 const MAX_SCENE_WORKERS: usize = 4;
 
-/// The transitions of every scene, in `scenes`' order, and the fragment counter's description.
+/// The transitions' rows, what the fragment counts count, and the scenes' impostor atlases.
+type Transitions = (
+    Vec<transitions::TransitionMetrics>,
+    String,
+    Vec<impostor_atlas::AtlasFigure>,
+);
+
+/// The transitions of every scene, in `scenes`' order, the fragment counter's description and
+/// the scenes' octahedral impostor atlases (their pictures written into the output folder).
 ///
 /// Scenes are measured side by side, one thread each, up to the machine's cores (at most
 /// [`MAX_SCENE_WORKERS`]): a scene's metrics are CPU work between its GPU runs, so a second
@@ -193,7 +201,7 @@ fn measure_transitions(
     options: &DemoOptions,
     scenes: &[DemoScene],
     bar: &crate::progress::Progress,
-) -> Result<(Vec<transitions::TransitionMetrics>, String), DemoError> {
+) -> Result<Transitions, DemoError> {
     use std::sync::Mutex;
     use std::sync::atomic::{AtomicUsize, Ordering};
     for scene in scenes {
@@ -206,6 +214,7 @@ fn measure_transitions(
         bar.set_message(format!("scene {}", scene.name));
         let renderer = render::SceneRenderer::new(gpu, scene, options.size, options.frames)?;
         let counter = renderer.counter().kind().describe().to_owned();
+        let atlas = impostor_atlas::write(&renderer, &scene.name, &options.out)?;
         let mut tick = |name: &str| bar.done(format!("scene {}: {name}", scene.name));
         let rows = transitions::measure_scene(
             gpu,
@@ -215,7 +224,7 @@ fn measure_transitions(
             &options.out,
             &mut tick,
         )?;
-        Ok::<_, DemoError>((rows, counter))
+        Ok::<_, DemoError>((rows, counter, atlas))
     };
     let mut order: Vec<usize> = (0..scenes.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse(scenes[i].objects.len()));
@@ -262,13 +271,14 @@ fn measure_transitions(
     if let Some(Some(Err(e))) = first.and_then(|i| results.get_mut(i)).map(Option::take) {
         return Err(e);
     }
-    let (mut rows, mut counter) = (Vec::new(), String::new());
+    let (mut rows, mut counter, mut atlases) = (Vec::new(), String::new(), Vec::new());
     for result in results.into_iter().flatten() {
-        let (scene_rows, scene_counter) = result?;
+        let (scene_rows, scene_counter, atlas) = result?;
         rows.extend(scene_rows);
         counter = scene_counter;
+        atlases.extend(atlas);
     }
-    Ok((rows, counter))
+    Ok((rows, counter, atlases))
 }
 
 /// Runs the demo on `gpu` over `scenes`.
@@ -284,7 +294,7 @@ pub fn run_on(
     let steps =
         scenes.len() * render::Technique::ALL.len() + upsample_quality::RESIZE_FACTORS.len() + 7;
     let bar = crate::progress::Progress::new(options.progress, steps);
-    let (transitions, counter) = measure_transitions(gpu, options, scenes, &bar)?;
+    let (transitions, counter, atlases) = measure_transitions(gpu, options, scenes, &bar)?;
     bar.set_message("framebuffer LOD");
     let mut tick = |name: &str| bar.done(format!("framebuffer LOD: {name}"));
     let rounds = (options.timing_pairs / 4).max(3);
@@ -356,6 +366,7 @@ pub fn run_on(
         controllers,
         selection,
         cpu,
+        atlases,
         chain,
         plot_text: plots::plot_font().is_some(),
         seconds: 0.0,

@@ -2,15 +2,14 @@
 //! (`passes/impostor.wgsl`).
 
 use super::ImpostorTextures;
+use super::instance::{INSTANCE_ATTRIBUTES, ImpostorInstance, ImpostorView, InstanceWords};
 use crate::combine::DepthConvention;
-use crate::frame_sequential::FrameDraw;
 use crate::gpu::frame_sequential::LOD_DEPTH_FORMAT;
-use crate::gpu::resources::{buffer_with_data, uniform_entry};
+use crate::gpu::resources::uniform_entry;
 use crate::gpu::{GpuContext, GpuError};
 use crate::lod_buffer::{ID_FORMAT, MOTION_FORMAT};
 use crate::screen_door::DitherPattern;
 use crate::unpopping::LodRenderState;
-use crate::visibility::VisibilitySpace;
 
 /// What an [`ImpostorPass`] draws into.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -57,7 +56,8 @@ pub struct ImpostorPassDescriptor {
     /// screen door of [`ImpostorInstance::alpha`] for dithered transitions) or blended with the
     /// blend constant, depth-tested without writes, for unpopping and cross-fades (set it with
     /// `lodkit::gpu::unpopping::lod_blend_constant` before [`draw`](ImpostorPass::draw)): two
-    /// passes serve every role, as two pipelines serve a mesh's. Other targets draw opaque.
+    /// passes serve every role, as two pipelines serve a mesh's. Other targets take only
+    /// [`LodRenderState::OPAQUE`] ([`ImpostorPass::new`] refuses the rest by name).
     pub state: LodRenderState,
 }
 
@@ -76,142 +76,12 @@ impl Default for ImpostorPassDescriptor {
     }
 }
 
-/// The view impostors are drawn for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ImpostorView {
-    /// World to clip (wgpu's clip space: z in [0, 1]).
-    pub view_proj: glam::Mat4,
-    /// The camera's world position.
-    pub eye: glam::Vec3,
-    /// World-space direction toward the light (unit length).
-    pub light: glam::Vec3,
-    /// The ambient share of the lighting, in [0, 1].
-    pub ambient: f32,
-}
-
-/// What the frame-sequential passes ([`ImpostorTarget::LodBuffer`]) need beyond the view: the
-/// previous frame's camera and the visibility pattern.
-#[derive(Clone, Copy, Debug)]
-pub struct ImpostorLodView<'a> {
-    /// The previous frame's world to clip (this frame's when there is none): where a surface
-    /// point was, for its object motion and for where the pattern is read next frame.
-    pub prev_view_proj: glam::Mat4,
-    /// The LOD buffers' size in pixels.
-    pub size: (u32, u32),
-    /// The visibility pattern (`R32Float`, read with `textureLoad`): the one the mesh levels are
-    /// drawn with and the combine reads (`CombineCoverage::Known::pattern`).
-    pub visibility: &'a wgpu::TextureView,
-    /// Where the pattern is anchored: on the screen, one texel per pixel (lodkit's default), or
-    /// on the surface point the frames saw.
-    pub space: VisibilitySpace,
-    /// Pattern repeats per object-space unit where it is anchored to the object (finite,
-    /// positive; the mesh levels' value).
-    pub vis_scale: f32,
-}
-
-/// One impostor instance: its object-to-world transform (a rotation, a uniform scale and a
-/// translation; the card and the depth it writes assume no shear), its screen-door alpha and,
-/// in a LOD buffer, its instance id and visibility thresholds.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ImpostorInstance {
-    /// Object to world.
-    pub model: glam::Mat4,
-    /// The complementary screen-door pattern's alpha (`lodkit::screen_door`), in [-1, 1]: 1
-    /// draws every pixel; in a transition from a mesh level at `-(1 - t)` the impostor takes
-    /// `t` (or the other way round), and the two cover disjoint pixels whose union is the
-    /// object's. Values outside are clamped, a NaN taken as 1. Not read in a LOD buffer.
-    pub alpha: f32,
-    /// LOD buffer: the previous frame's object to world (`model` for an object that did not
-    /// move), for the object motion.
-    pub prev_model: glam::Mat4,
-    /// LOD buffer: the instance id (`FrameDraw::id`; 0: an n-instance, always shown).
-    pub id: u32,
-    /// LOD buffer: the visibility threshold this frame (`FrameDraw::tau`).
-    pub tau: f32,
-    /// LOD buffer: the threshold next frame (`FrameDraw::tau_next`).
-    pub tau_next: f32,
-    /// Linear RGB the baked base colour is multiplied with (1: as baked): one atlas for
-    /// objects that differ only in colour.
-    pub tint: glam::Vec3,
-}
-
-impl ImpostorInstance {
-    /// An instance at `model` that did not move, drawn whole (alpha 1; in a LOD buffer an
-    /// n-instance).
-    pub fn new(model: glam::Mat4) -> Self {
-        Self {
-            model,
-            alpha: 1.0,
-            prev_model: model,
-            id: 0,
-            tau: 1.0,
-            tau_next: 1.0,
-            tint: glam::Vec3::ONE,
-        }
-    }
-
-    /// An instance at `model` (at `prev_model` the frame before) drawn into a LOD buffer as the
-    /// scheduler's `draw` says (`TransitionScheduler::draw`).
-    pub fn from_draw(model: glam::Mat4, prev_model: glam::Mat4, draw: &FrameDraw) -> Self {
-        Self {
-            prev_model,
-            id: draw.id,
-            tau: draw.tau,
-            tau_next: draw.tau_next,
-            ..Self::new(model)
-        }
-    }
-}
-
-/// Rust mirror of `ImpostorView` in `passes/impostor.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct ViewUniform {
-    view_proj: [f32; 16],
-    eye: [f32; 4],
-    light: [f32; 4],
-    sphere: [f32; 4],
-    atlas: [u32; 4],
-    prev_view_proj: [f32; 16],
-    viewport: [f32; 4],
-}
-
-/// Rust mirror of the instance attributes of `vs_main` in `passes/impostor.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct InstanceWords {
-    model: [f32; 16],
-    /// Screen-door alpha, tau, tau next, unused.
-    door: [f32; 4],
-    /// Instance id, unused x 3.
-    id: [u32; 4],
-    prev_model: [f32; 16],
-    /// The tint, 1.
-    tint: [f32; 4],
-}
-
-/// The attributes of [`InstanceWords`].
-const INSTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 11] = wgpu::vertex_attr_array![
-    0 => Float32x4, 1 => Float32x4, 2 => Float32x4, 3 => Float32x4, 4 => Float32x4,
-    5 => Uint32x4, 6 => Float32x4, 7 => Float32x4, 8 => Float32x4, 9 => Float32x4,
-    10 => Float32x4
-];
-
 /// A pipeline that draws impostors.
 #[derive(Debug)]
 pub struct ImpostorPass {
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroupLayout,
     descriptor: ImpostorPassDescriptor,
-}
-
-/// What one [`ImpostorPass::draw`] needs: the view's uniform, the atlas's bind group and the
-/// instances.
-#[derive(Debug)]
-pub struct PreparedImpostors {
-    bind_group: wgpu::BindGroup,
-    instances: wgpu::Buffer,
-    count: u32,
 }
 
 impl ImpostorPass {
@@ -338,173 +208,19 @@ impl ImpostorPass {
         })
     }
 
-    /// The uniform, bind group and instance buffer for drawing `instances` of `textures` seen
-    /// from `view`, for a colour or level-depth target ([`GpuError::Mismatch`] for a LOD-buffer
-    /// one: [`prepare_lod_buffer`](Self::prepare_lod_buffer)).
-    pub fn prepare(
-        &self,
-        gpu: &GpuContext,
-        textures: &ImpostorTextures,
-        view: &ImpostorView,
-        instances: &[ImpostorInstance],
-    ) -> Result<PreparedImpostors, GpuError> {
-        self.prepare_with(
-            gpu,
-            "ImpostorPass::prepare",
-            textures,
-            view,
-            None,
-            instances,
-        )
+    /// The descriptor it was built with.
+    pub fn descriptor(&self) -> &ImpostorPassDescriptor {
+        &self.descriptor
     }
 
-    /// [`prepare`](Self::prepare) for a LOD-buffer target ([`GpuError::Mismatch`] for another),
-    /// with the previous frame's camera and the visibility pattern of `lod`
-    /// ([`GpuError::Invalid`] for a `vis_scale` that is not finite and positive where the
-    /// pattern is anchored to the object).
-    pub fn prepare_lod_buffer(
-        &self,
-        gpu: &GpuContext,
-        textures: &ImpostorTextures,
-        view: &ImpostorView,
-        lod: &ImpostorLodView<'_>,
-        instances: &[ImpostorInstance],
-    ) -> Result<PreparedImpostors, GpuError> {
-        const CALL: &str = "ImpostorPass::prepare_lod_buffer";
-        let object = lod.space == VisibilitySpace::Object;
-        if object && !(lod.vis_scale.is_finite() && lod.vis_scale > 0.0) {
-            return Err(GpuError::Invalid {
-                call: CALL,
-                parameter: "lod.vis_scale",
-                value: lod.vis_scale.to_string(),
-                rule: "finite and positive where the pattern is anchored to the object",
-            });
-        }
-        self.prepare_with(gpu, CALL, textures, view, Some(lod), instances)
+    /// The bind group layout of its group 0.
+    pub(super) fn group(&self) -> &wgpu::BindGroupLayout {
+        &self.group
     }
 
-    fn prepare_with(
-        &self,
-        gpu: &GpuContext,
-        call: &'static str,
-        textures: &ImpostorTextures,
-        view: &ImpostorView,
-        lod: Option<&ImpostorLodView<'_>>,
-        instances: &[ImpostorInstance],
-    ) -> Result<PreparedImpostors, GpuError> {
-        let lod_target = matches!(self.descriptor.target, ImpostorTarget::LodBuffer { .. });
-        if lod_target != lod.is_some() {
-            return Err(GpuError::Mismatch {
-                call,
-                parameter: "self",
-                found: format!("a pass built for {:?}", self.descriptor.target),
-                expected: match lod_target {
-                    true => "ImpostorPass::prepare_lod_buffer for a LOD-buffer target".into(),
-                    false => "ImpostorPass::prepare for a colour or level-depth target".into(),
-                },
-            });
-        }
-        let l = textures.layout;
-        let (prev_view_proj, viewport) = match lod {
-            Some(lod) => (
-                lod.prev_view_proj,
-                [
-                    lod.size.0 as f32,
-                    lod.size.1 as f32,
-                    f32::from(u8::from(lod.space == VisibilitySpace::Screen)),
-                    lod.vis_scale,
-                ],
-            ),
-            None => (view.view_proj, [0.0; 4]),
-        };
-        let uniform = ViewUniform {
-            view_proj: view.view_proj.to_cols_array(),
-            eye: view.eye.extend(1.0).to_array(),
-            light: view.light.extend(view.ambient.clamp(0.0, 1.0)).to_array(),
-            sphere: [l.center[0], l.center[1], l.center[2], l.radius],
-            atlas: [l.frames, u32::from(l.shape.is_hemi()), l.frame_size, 0],
-            prev_view_proj: prev_view_proj.to_cols_array(),
-            viewport,
-        };
-        let uniform = buffer_with_data(
-            gpu,
-            bytemuck::bytes_of(&uniform),
-            wgpu::BufferUsages::UNIFORM,
-            "impostor view",
-        )?;
-        let words: Vec<InstanceWords> = instances
-            .iter()
-            .map(|i| InstanceWords {
-                model: i.model.to_cols_array(),
-                door: [
-                    match i.alpha.is_nan() {
-                        true => 1.0,
-                        false => i.alpha.clamp(-1.0, 1.0),
-                    },
-                    i.tau,
-                    i.tau_next,
-                    0.0,
-                ],
-                id: [i.id, 0, 0, 0],
-                prev_model: i.prev_model.to_cols_array(),
-                tint: i.tint.extend(1.0).to_array(),
-            })
-            .collect();
-        let buffer = buffer_with_data(
-            gpu,
-            bytemuck::cast_slice(&words),
-            wgpu::BufferUsages::VERTEX,
-            "impostor instances",
-        )?;
-        gpu.guarded(call, || {
-            let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-            let (color, normal_depth) = (view(&textures.color), view(&textures.normal_depth));
-            let mut entries = vec![
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniform.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&color),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&normal_depth),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::Sampler(&textures.sampler),
-                },
-            ];
-            entries.extend(lod.map(|lod| wgpu::BindGroupEntry {
-                binding: 4,
-                resource: wgpu::BindingResource::TextureView(lod.visibility),
-            }));
-            let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("impostor"),
-                layout: &self.group,
-                entries: &entries,
-            });
-            Ok(PreparedImpostors {
-                bind_group,
-                instances: buffer,
-                count: instances.len() as u32,
-            })
-        })
-    }
-
-    /// Draws the prepared instances into `pass`: one with one colour target of the descriptor's
-    /// format and its depth target, a LOD buffer's (`LodBuffers::begin_pass`) or the level-depth
-    /// pass (`LodBuffers::begin_level_depth_pass`), as the descriptor's `target` says.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, prepared: &PreparedImpostors) {
-        if prepared.count == 0 {
-            return;
-        }
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &prepared.bind_group, &[]);
-        pass.set_vertex_buffer(0, prepared.instances.slice(..));
-        pass.draw(0..6, 0..prepared.count);
+    /// Its pipeline.
+    pub(super) fn pipeline(&self) -> &wgpu::RenderPipeline {
+        &self.pipeline
     }
 
     /// `instances` drawn into a new `width x height` target of the descriptor's colour format

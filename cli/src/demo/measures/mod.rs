@@ -7,6 +7,7 @@ pub mod controllers;
 pub mod frame_cost;
 pub mod gpu_report;
 pub mod host_cost;
+pub mod impostor_atlas;
 pub mod lod_chain;
 pub mod packed_upsample_timing;
 pub mod reads;
@@ -60,6 +61,8 @@ pub struct DemoReport {
     pub selection: selection::SelectionReport,
     /// Host-side figures (composition, selection).
     pub cpu: Vec<host_cost::CpuFigure>,
+    /// The octahedral impostor atlases of the scenes that have one.
+    pub atlases: Vec<impostor_atlas::AtlasFigure>,
     /// The generated LOD chain's levels, when its scene was measured.
     pub chain: Option<lod_chain::ChainReport>,
     /// Whether the plots have text (a font was found).

@@ -466,6 +466,23 @@ pub fn write_report(report: &DemoReport, out: &Path) -> Result<(), DemoError> {
         if let Some(chain) = report.chain.as_ref().filter(|c| &c.scene == scene) {
             h.push_str(&lod_chain::html(chain));
         }
+        for atlas in report.atlases.iter().filter(|a| &a.scene == scene) {
+            h.push_str(&img(
+                &atlas.picture,
+                &format!(
+                    "the octahedral impostor's colour atlas (lodkit::gpu::impostor, baked when \
+                     the scene is loaded): {f} x {f} frames of {} texels, {} sphere of \
+                     directions",
+                    atlas.frame_size,
+                    if atlas.hemi {
+                        "upper half of the"
+                    } else {
+                        "the whole"
+                    },
+                    f = atlas.frames
+                ),
+            ));
+        }
         let rows: Vec<_> = report
             .transitions
             .iter()
