@@ -118,6 +118,8 @@ fn an_impostor_in_a_lod_buffer_writes_what_its_colour_pass_covers_with_the_patte
     let color_pass = pass(gpu, ImpostorTarget::Color);
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let color = texture_2d(gpu, (SIZE, SIZE), FORMAT, usage, "colour").unwrap();
+    // Bound as a texture too: where depth cannot be copied (GL), read_depth32 draws it out.
+    let usage = usage | wgpu::TextureUsages::TEXTURE_BINDING;
     let depth = texture_2d(
         gpu,
         (SIZE, SIZE),

@@ -37,6 +37,8 @@ fn draw(
     let (view_proj, eye) = camera();
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let color = texture_2d(gpu, (SIZE, SIZE), FORMAT, usage, "colour").unwrap();
+    // Bound as a texture too: where depth cannot be copied (GL), read_depth32 draws it out.
+    let usage = usage | wgpu::TextureUsages::TEXTURE_BINDING;
     let depth_format = wgpu::TextureFormat::Depth32Float;
     let depth = texture_2d(gpu, (SIZE, SIZE), depth_format, usage, "depth").unwrap();
     let view = impostor_view(view_proj, eye);
@@ -285,6 +287,8 @@ fn draw_prepared(
 ) -> Vec<[u8; 4]> {
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let color = texture_2d(gpu, (SIZE, SIZE), FORMAT, usage, "colour").unwrap();
+    // Bound as a texture too: where depth cannot be copied (GL), read_depth32 draws it out.
+    let usage = usage | wgpu::TextureUsages::TEXTURE_BINDING;
     let depth_format = wgpu::TextureFormat::Depth32Float;
     let depth = texture_2d(gpu, (SIZE, SIZE), depth_format, usage, "depth").unwrap();
     let start = match range.start_bound() {
